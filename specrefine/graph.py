@@ -1,0 +1,188 @@
+"""The task graph: a DAG of reach-avoid subtasks on networkx.
+
+Vertices carry ``region`` = I(v) and an optional representative ``point``; edges carry
+``avoid`` = O(e).  Provenance makes refinement checkable (Theorem 4.1): a vertex's
+``refines`` names the vertex of the original graph whose set it narrows (None for an
+intermediate waypoint introduced by an edge split), and an edge's ``parent`` names the
+original edge it helps to implement.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from itertools import count
+
+import networkx as nx
+import numpy as np
+
+from .errors import InvalidRefinement
+from .regions import Region, from_dict, is_subset
+
+
+class TaskGraph:
+    def __init__(self, initial: str = "v0"):
+        self.g = nx.DiGraph()
+        self.initial = initial
+        self.finals: set[str] = set()
+        self._ids = count()
+
+    # --- construction ------------------------------------------------------------
+    def add_vertex(self, name: str | None, region: Region, *, point=None, refines="self", label=None) -> str:
+        name = name if name is not None else self.fresh_name()
+        refines = name if refines == "self" else refines
+        pt = None if point is None else tuple(float(v) for v in point)
+        self.g.add_node(name, region=region, point=pt, refines=refines, label=label or name)
+        return name
+
+    def add_edge(self, u: str, v: str, avoid: Region, *, parent=None) -> None:
+        for x in (u, v):
+            if x not in self.g:
+                raise KeyError(f"unknown vertex {x!r}")
+        self.g.add_edge(u, v, avoid=avoid, parent=tuple(parent) if parent else (u, v))
+        if not nx.is_directed_acyclic_graph(self.g):
+            self.g.remove_edge(u, v)
+            raise ValueError(f"edge {u}->{v} would create a cycle")
+
+    def fresh_name(self) -> str:
+        while True:
+            name = f"x{next(self._ids)}"
+            if name not in self.g:
+                return name
+
+    # --- queries -----------------------------------------------------------------
+    def region(self, v: str) -> Region:
+        return self.g.nodes[v]["region"]
+
+    def goal_point(self, v: str):
+        pt = self.g.nodes[v]["point"]
+        return None if pt is None else np.asarray(pt)
+
+    def avoid(self, u: str, v: str) -> Region:
+        return self.g.edges[u, v]["avoid"]
+
+    def vertices(self) -> list[str]:
+        return list(self.g.nodes)
+
+    def edges(self) -> list[tuple[str, str]]:
+        return list(self.g.edges)
+
+    def successors(self, v: str) -> list[str]:
+        return list(self.g.successors(v))
+
+    def predecessors(self, v: str) -> list[str]:
+        return list(self.g.predecessors(v))
+
+    def copy(self) -> "TaskGraph":
+        return TaskGraph.from_json(self.to_json())
+
+    def __repr__(self):
+        return f"TaskGraph({self.g.number_of_nodes()} vertices, {self.g.number_of_edges()} edges)"
+
+    # --- serialisation -----------------------------------------------------------
+    def to_dict(self) -> dict:
+        return {
+            "initial": self.initial,
+            "finals": sorted(self.finals),
+            "vertices": [
+                {"name": v, "region": d["region"].to_dict(), "point": d["point"], "refines": d["refines"],
+                 "label": d["label"]}
+                for v, d in self.g.nodes(data=True)
+            ],
+            "edges": [
+                {"u": u, "v": v, "avoid": d["avoid"].to_dict(), "parent": list(d["parent"])}
+                for u, v, d in self.g.edges(data=True)
+            ],
+        }
+
+    def to_json(self, **kw) -> str:
+        return json.dumps(self.to_dict(), **kw)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "TaskGraph":
+        tg = cls(d["initial"])
+        for vd in d["vertices"]:
+            tg.add_vertex(vd["name"], from_dict(vd["region"]), point=vd.get("point"),
+                          refines=vd.get("refines", vd["name"]), label=vd.get("label"))
+        for ed in d["edges"]:
+            tg.add_edge(ed["u"], ed["v"], from_dict(ed["avoid"]), parent=ed.get("parent"))
+        tg.finals = set(d["finals"])
+        return tg
+
+    @classmethod
+    def from_json(cls, text: str) -> "TaskGraph":
+        return cls.from_dict(json.loads(text))
+
+    def __eq__(self, other):
+        return isinstance(other, TaskGraph) and self.to_dict() == other.to_dict()
+
+
+def path_graph(regions: list[Region], avoid: Region, names: list[str] | None = None) -> TaskGraph:
+    """The chain v0 -> v1 -> ... -> vn with the same avoid set on every edge."""
+    names = names or [f"v{i}" for i in range(len(regions))]
+    tg = TaskGraph(names[0])
+    for name, region in zip(names, regions):
+        tg.add_vertex(name, region)
+    for u, v in zip(names, names[1:]):
+        tg.add_edge(u, v, avoid)
+    tg.finals = {names[-1]}
+    return tg
+
+
+@dataclass(frozen=True)
+class Violation:
+    condition: str
+    where: str
+
+    def __str__(self):
+        return f"{self.where}: {self.condition}"
+
+
+def check_refines(refined: TaskGraph, original: TaskGraph) -> list[Violation]:
+    """Theorem 4.1 conditions for vertex-subset and edge-split refinements.
+
+    Returns the violated conditions (empty list = ``refined`` implies ``original``).
+    """
+    out: list[Violation] = []
+    rg, og = refined.g, original.g
+
+    def origin(v):
+        return rg.nodes[v]["refines"]
+
+    for v, d in rg.nodes(data=True):
+        o = d["refines"]
+        if o is None:
+            continue
+        if o not in og:
+            out.append(Violation(f"refines unknown original vertex {o!r}", f"vertex {v}"))
+        elif not is_subset(d["region"], og.nodes[o]["region"]):
+            out.append(Violation(f"I'({v}) is not a subset of I({o}) (vertex subset)", f"vertex {v}"))
+    if refined.initial not in rg or origin(refined.initial) != original.initial:
+        out.append(Violation(f"initial vertex must refine the original initial {original.initial!r}",
+                             f"vertex {refined.initial}"))
+    for f in refined.finals:
+        if f not in rg or origin(f) not in original.finals:
+            out.append(Violation("final vertex must refine an original final vertex", f"vertex {f}"))
+    for a, b, d in rg.edges(data=True):
+        u, v = d["parent"]
+        where = f"edge {a}->{b}"
+        if not og.has_edge(u, v):
+            out.append(Violation(f"parent edge {u}->{v} is not in the original graph", where))
+            continue
+        if not is_subset(og.edges[u, v]["avoid"], d["avoid"]):
+            out.append(Violation(f"O({a}->{b}) does not contain the avoid set of its parent {u}->{v} (edge split)",
+                                 where))
+        if not (origin(a) == u or (origin(a) is None and all(rg.edges[p, a]["parent"] == (u, v)
+                                                             for p in rg.predecessors(a)) and rg.in_degree(a))):
+            out.append(Violation(f"start {a} neither refines {u} nor continues a split of {u}->{v}", where))
+        if not (origin(b) == v or (origin(b) is None and all(rg.edges[b, s]["parent"] == (u, v)
+                                                             for s in rg.successors(b)) and rg.out_degree(b))):
+            out.append(Violation(f"end {b} neither refines {v} nor leads on in a split of {u}->{v}", where))
+    return out
+
+
+def assert_refines(refined: TaskGraph, original: TaskGraph) -> None:
+    problems = check_refines(refined, original)
+    if problems:
+        raise InvalidRefinement(f"refined graph does not imply the original: {problems[0]}"
+                                + (f" (+{len(problems) - 1} more)" if len(problems) > 1 else ""))

@@ -1,0 +1,263 @@
+"""2-D regions in the (x, y) plane: boxes, discs and their unions.
+
+Every region answers membership and signed distance for batches of points
+(arrays of shape ``(..., 2)``), samples uniformly with a seeded generator, and
+round-trips through plain dicts (JSON).  ``is_subset`` is exact for boxes and
+discs inside boxes or unions of boxes, and conservative (it may answer False
+for a true subset, never True for a false one) when the outer set holds discs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable
+
+import numpy as np
+
+
+class Region:
+    """Base class; subclasses are frozen dataclasses."""
+
+    def contains(self, points) -> np.ndarray:
+        return self.signed_distance(points) <= 0.0
+
+    def signed_distance(self, points) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def bounds(self) -> tuple[float, float, float, float]:  # pragma: no cover
+        raise NotImplementedError
+
+    @property
+    def area(self) -> float:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:  # pragma: no cover
+        raise NotImplementedError
+
+    def centre(self) -> np.ndarray:
+        """A representative point inside the region."""
+        raise NotImplementedError  # pragma: no cover
+
+    def to_dict(self) -> dict:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def parts(self) -> tuple["Region", ...]:
+        return (self,)
+
+
+def _as_points(points) -> np.ndarray:
+    pts = np.asarray(points, dtype=float)
+    if pts.shape[-1] != 2:
+        raise ValueError(f"points must have a trailing dimension of 2, got shape {pts.shape}")
+    return pts
+
+
+@dataclass(frozen=True)
+class Box(Region):
+    xmin: float
+    ymin: float
+    xmax: float
+    ymax: float
+
+    def __post_init__(self):
+        for f in ("xmin", "ymin", "xmax", "ymax"):
+            object.__setattr__(self, f, float(getattr(self, f)))
+        if not (self.xmax > self.xmin and self.ymax > self.ymin):
+            raise ValueError(f"empty box {self}")
+
+    def signed_distance(self, points) -> np.ndarray:
+        p = _as_points(points)
+        cx, cy = (self.xmin + self.xmax) / 2, (self.ymin + self.ymax) / 2
+        hx, hy = (self.xmax - self.xmin) / 2, (self.ymax - self.ymin) / 2
+        dx = np.abs(p[..., 0] - cx) - hx
+        dy = np.abs(p[..., 1] - cy) - hy
+        outside = np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+        inside = np.minimum(np.maximum(dx, dy), 0.0)
+        return outside + inside
+
+    def bounds(self):
+        return (self.xmin, self.ymin, self.xmax, self.ymax)
+
+    @property
+    def area(self) -> float:
+        return (self.xmax - self.xmin) * (self.ymax - self.ymin)
+
+    def sample(self, n, rng):
+        u = rng.random((n, 2))
+        return np.stack(
+            [self.xmin + u[:, 0] * (self.xmax - self.xmin), self.ymin + u[:, 1] * (self.ymax - self.ymin)],
+            axis=-1,
+        )
+
+    def centre(self):
+        return np.array([(self.xmin + self.xmax) / 2, (self.ymin + self.ymax) / 2])
+
+    def to_dict(self):
+        return {"type": "box", "xmin": self.xmin, "ymin": self.ymin, "xmax": self.xmax, "ymax": self.ymax}
+
+
+@dataclass(frozen=True)
+class Disc(Region):
+    cx: float
+    cy: float
+    r: float
+
+    def __post_init__(self):
+        for f in ("cx", "cy", "r"):
+            object.__setattr__(self, f, float(getattr(self, f)))
+        if not self.r > 0:
+            raise ValueError(f"disc radius must be positive, got {self.r}")
+
+    def signed_distance(self, points) -> np.ndarray:
+        p = _as_points(points)
+        return np.hypot(p[..., 0] - self.cx, p[..., 1] - self.cy) - self.r
+
+    def bounds(self):
+        return (self.cx - self.r, self.cy - self.r, self.cx + self.r, self.cy + self.r)
+
+    @property
+    def area(self) -> float:
+        return float(np.pi * self.r**2)
+
+    def sample(self, n, rng):
+        radius = self.r * np.sqrt(rng.random(n))
+        angle = rng.random(n) * 2 * np.pi
+        return np.stack([self.cx + radius * np.cos(angle), self.cy + radius * np.sin(angle)], axis=-1)
+
+    def centre(self):
+        return np.array([self.cx, self.cy])
+
+    def to_dict(self):
+        return {"type": "disc", "cx": self.cx, "cy": self.cy, "r": self.r}
+
+
+@dataclass(frozen=True)
+class Union(Region):
+    members: tuple[Region, ...]
+
+    def __post_init__(self):
+        flat: list[Region] = []
+        for m in self.members:
+            flat.extend(m.parts())
+        if not flat:
+            raise ValueError("a union needs at least one member")
+        object.__setattr__(self, "members", tuple(flat))
+
+    def parts(self):
+        return self.members
+
+    def signed_distance(self, points) -> np.ndarray:
+        return np.min(np.stack([m.signed_distance(points) for m in self.members]), axis=0)
+
+    def bounds(self):
+        b = np.array([m.bounds() for m in self.members])
+        return (b[:, 0].min(), b[:, 1].min(), b[:, 2].max(), b[:, 3].max())
+
+    @property
+    def area(self) -> float:
+        """Area of the union (exact for boxes; Monte Carlo estimate if discs are present)."""
+        if all(isinstance(m, Box) for m in self.members):
+            xs, ys, covered = _elementary_cells(self.members, [])
+            widths = np.diff(xs)[:, None] * np.diff(ys)[None, :]
+            return float((widths * covered).sum())
+        rng = np.random.default_rng(0)
+        pts = Box(*self.bounds()).sample(20000, rng)
+        return Box(*self.bounds()).area * float(self.contains(pts).mean())
+
+    def sample(self, n, rng):
+        """Uniform over the union: rejection from the members, weighted by area."""
+        areas = np.array([m.area for m in self.members])
+        chunks, total = [], 0
+        while total < n:
+            counts = rng.multinomial(2 * max(n - total, 16), areas / areas.sum())
+            for i, count in enumerate(counts):
+                pts = self.members[i].sample(count, rng)
+                # drop points an earlier member also covers, so overlaps are not sampled twice
+                seen = np.zeros(len(pts), dtype=bool)
+                for earlier in self.members[:i]:
+                    seen |= earlier.contains(pts)
+                chunks.append(pts[~seen])
+                total += int((~seen).sum())
+        out = np.concatenate(chunks)
+        out = out[rng.permutation(len(out))]
+        return out[:n]
+
+    def centre(self):
+        """The member centre closest to the union's centroid (always inside)."""
+        centres = np.array([m.centre() for m in self.members])
+        areas = np.array([m.area for m in self.members])
+        centroid = (centres * areas[:, None]).sum(0) / areas.sum()
+        return centres[np.argmin(np.linalg.norm(centres - centroid, axis=1))]
+
+    def to_dict(self):
+        return {"type": "union", "members": [m.to_dict() for m in self.members]}
+
+
+def union(regions: Iterable[Region]) -> Region:
+    regions = list(regions)
+    return regions[0] if len(regions) == 1 else Union(tuple(regions))
+
+
+def from_dict(d: dict) -> Region:
+    kind = d.get("type")
+    if kind == "box":
+        return Box(float(d["xmin"]), float(d["ymin"]), float(d["xmax"]), float(d["ymax"]))
+    if kind == "disc":
+        return Disc(float(d["cx"]), float(d["cy"]), float(d["r"]))
+    if kind == "union":
+        return union(from_dict(m) for m in d["members"])
+    raise ValueError(f"unknown region type {kind!r}")
+
+
+def _elementary_cells(boxes, extra_bounds):
+    """Split the plane along every box edge; return edges and which cells the boxes cover."""
+    xs = sorted({v for b in boxes for v in (b.xmin, b.xmax)} | {v for e in extra_bounds for v in (e[0], e[2])})
+    ys = sorted({v for b in boxes for v in (b.ymin, b.ymax)} | {v for e in extra_bounds for v in (e[1], e[3])})
+    xs, ys = np.array(xs), np.array(ys)
+    mx, my = (xs[:-1] + xs[1:]) / 2, (ys[:-1] + ys[1:]) / 2
+    centres = np.stack(np.meshgrid(mx, my, indexing="ij"), axis=-1)
+    covered = np.zeros(centres.shape[:2], dtype=bool)
+    for b in boxes:
+        covered |= b.contains(centres)
+    return xs, ys, covered
+
+
+def _part_in_boxes(part: Region, boxes: list[Box]) -> bool:
+    """Exact test that a box or disc lies inside a union of boxes (closed sets)."""
+    xs, ys, covered = _elementary_cells(boxes, [part.bounds()])
+    for i in range(len(xs) - 1):
+        for j in range(len(ys) - 1):
+            if covered[i, j]:
+                continue
+            cell = Box(xs[i], ys[j], xs[i + 1], ys[j + 1])
+            if _interiors_meet(part, cell):
+                return False
+    return True
+
+
+def _interiors_meet(part: Region, cell: Box) -> bool:
+    if isinstance(part, Box):
+        return part.xmin < cell.xmax and cell.xmin < part.xmax and part.ymin < cell.ymax and cell.ymin < part.ymax
+    return float(cell.signed_distance(part.centre())) < part.r  # disc
+
+
+def _part_in_part(a: Region, b: Region, tol: float) -> bool:
+    if isinstance(b, Box):
+        ax0, ay0, ax1, ay1 = a.bounds()
+        return ax0 >= b.xmin - tol and ay0 >= b.ymin - tol and ax1 <= b.xmax + tol and ay1 <= b.ymax + tol
+    if isinstance(a, Disc):
+        return np.hypot(a.cx - b.cx, a.cy - b.cy) + a.r <= b.r + tol
+    corners = np.array([[a.xmin, a.ymin], [a.xmin, a.ymax], [a.xmax, a.ymin], [a.xmax, a.ymax]])
+    return bool(np.all(b.signed_distance(corners) <= tol))
+
+
+def is_subset(inner: Region, outer: Region, tol: float = 1e-9) -> bool:
+    """True if every point of ``inner`` lies in ``outer``."""
+    outer_parts = outer.parts()
+    for part in inner.parts():
+        if any(_part_in_part(part, o, tol) for o in outer_parts):
+            continue
+        if all(isinstance(o, Box) for o in outer_parts) and _part_in_boxes(part, list(outer_parts)):
+            continue
+        return False
+    return True
