@@ -1,0 +1,75 @@
+"""Shared pieces of the refinement algorithms: edge weights and path evaluation with start propagation."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from ..regions import Region
+
+
+class SubtaskEvaluator(Protocol):
+    """What the refinement algorithms need from `specrefine.evaluate.Evaluator` (tests may stub it)."""
+
+    n: int
+
+    def evaluate(self, start, goal: Region, avoid: Region, goal_point=None, seed=None): ...
+
+
+def weight(p: float, n: int) -> float:
+    """Edge weight -log p, with p = 0 guarded by half a success in n rollouts."""
+    return -math.log(max(p, 0.5 / max(n, 1)))
+
+
+def start_of(result):
+    """Start distribution for the next subtask: the end states of this one's successful rollouts."""
+    return result.end_states if result is not None and result.successes > 0 else None
+
+
+@dataclass(frozen=True)
+class _Unreached:
+    """Stands for a subtask that was never reached: probability 0."""
+
+    p: float = 0.0
+    successes: int = 0
+    end_states: object = None
+    ci: tuple = (0.0, 0.0)
+
+
+UNREACHED = _Unreached()
+
+
+@dataclass
+class Leg:
+    goal: Region
+    avoid: Region
+    goal_point: object = None
+
+
+@dataclass
+class PathEvaluation:
+    """A sequence of subtasks evaluated one after another (DiRL-style start propagation)."""
+
+    results: list = field(default_factory=list)
+
+    @property
+    def probabilities(self) -> list[float]:
+        return [r.p for r in self.results]
+
+    @property
+    def p(self) -> float:
+        return math.prod(self.probabilities) if self.results else 0.0
+
+    def cost(self, n: int) -> float:
+        return sum(weight(r.p, n) for r in self.results)
+
+
+def evaluate_path(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> PathEvaluation:
+    """Evaluate legs in order; a leg with no successes ends the evaluation (the rest has p = 0)."""
+    out = PathEvaluation()
+    for leg in legs:
+        result = UNREACHED if start is None else evaluator.evaluate(start, leg.goal, leg.avoid, goal_point=leg.goal_point)
+        out.results.append(result)
+        start = start_of(result)
+    return out

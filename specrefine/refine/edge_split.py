@@ -1,0 +1,77 @@
+"""Edge split refinement (Algorithm 1).
+
+The proposer (a VLM, or an offline stand-in) is asked for w candidate paths replacing
+the edge u -> v; each candidate is evaluated subtask by subtask.  In each of the d - 1
+follow-up rounds the proposer sees every earlier candidate's per-subtask success and
+rollouts, and the new candidates are tuned by the chain vertex refinement (Algorithm 2,
+line 10 of Algorithm 1).  The best of the d x w candidates by product of success
+probabilities is returned.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..regions import Region
+from .common import Leg, SubtaskEvaluator, evaluate_path
+from .vertex import refine_chain
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class SplitCandidate:
+    waypoints: list[Region]  # intermediate vertices x_1 .. x_{k-1}
+    results: list  # EdgeResults of the k subtasks
+    round: int
+    tuned: bool = False  # went through the chain vertex refinement
+
+    @property
+    def probabilities(self) -> list[float]:
+        return [r.p for r in self.results]
+
+    @property
+    def p(self) -> float:
+        return float(np.prod(self.probabilities)) if self.results else 0.0
+
+
+@dataclass
+class SplitOutcome:
+    best: SplitCandidate | None
+    candidates: list[SplitCandidate] = field(default_factory=list)
+    evaluations: int = 0
+
+
+def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = 3, d: int = 2,
+               k: int = 5, rng: np.random.Generator, picture: Callable | None = None) -> SplitOutcome:
+    """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
+    from ..proposers import CandidateFeedback
+
+    outcome = SplitOutcome(best=None)
+    avoid, goal = query.avoid, query.goal
+    for round_ in range(d):
+        feedback = [CandidateFeedback(waypoints=c.waypoints, subtask_success=c.probabilities,
+                                      image_png=picture(c) if picture else None) for c in outcome.candidates]
+        proposals = proposer.propose_split(query, w, feedback) if round_ else proposer.propose_split(query, w)
+        if not proposals:
+            log.info("edge split round %d: the proposer returned no valid candidate", round_ + 1)
+        for waypoints in (p for p in proposals if p):
+            if round_ == 0:
+                legs = [Leg(x, avoid) for x in waypoints] + [Leg(goal, avoid, goal_point)]
+                path = evaluate_path(evaluator, start, legs)
+                outcome.evaluations += len(legs)
+                candidate = SplitCandidate(list(waypoints), path.results, round_)
+            else:
+                choice = refine_chain(evaluator, start, list(waypoints), goal, [avoid] * (len(waypoints) + 1),
+                                      k, rng, goal_point)
+                outcome.evaluations += choice.evaluations
+                candidate = SplitCandidate(choice.regions, choice.results, round_, tuned=True)
+            outcome.candidates.append(candidate)
+    if outcome.candidates:
+        outcome.best = max(outcome.candidates, key=lambda c: c.p)
+    return outcome
+

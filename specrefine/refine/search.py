@@ -1,0 +1,283 @@
+"""A* search over the task graph with interleaved refinement (Algorithm 3).
+
+Progress is the search of a single-source shortest path with edge weights -log p,
+evaluated lazily when an edge's source vertex is closed, starting from the end states of
+the successful rollouts that reached it (DiRL).  The heuristic is zero, so progress is
+Dijkstra's order; what makes the search "inadmissible" is the refinement in between.
+
+Between two progress steps, refinements of the open frontier compete with progress:
+for every open vertex v (reached from the closed vertex u), an edge split of u -> v
+(Algorithm 1) and, where deg_in(v) = deg_out(v) = 1, a vertex subset of v (Algorithm 2).
+A refinement's cost is the cost its far endpoint would have afterwards (for a vertex
+subset, cost(v) minus the gain it brings to v's successor).  The cheapest is incorporated
+while it beats the cheapest open vertex by tau; tau grows linearly from 0.02 by 0.02 per
+incorporated refinement, capped at 0.1.  Two prunings skip generating refinements that
+cannot pass that test (they never change the outcome): an edge split is only generated
+when cost(u) < c_progress - tau and cost(v) - cost(u) > tau.
+
+Every accepted refinement is checked against the input graph (Theorem 4.1); a failure
+raises InvalidRefinement, because it is a bug.  Every step is recorded for replay.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..graph import TaskGraph, assert_refines
+from .common import Leg, SubtaskEvaluator, evaluate_path, start_of, weight
+from .edge_split import edge_split
+from .vertex import refine_chain
+
+
+@dataclass
+class SearchConfig:
+    w: int = 3  # candidate edge splits per proposer query
+    d: int = 2  # proposer rounds per edge split
+    k: int = 5  # subsets sampled per vertex refinement
+    edge_refinement: bool = True
+    vertex_refinement: bool = True
+    tau0: float = 0.02
+    tau_step: float = 0.02
+    tau_max: float = 0.1
+    max_edge_splits: int = 30  # budget of Algorithm 1 calls (proposer queries) per search
+    seed: int = 0
+
+
+@dataclass
+class Refinement:
+    kind: str  # "split" or "vertex"
+    u: str
+    v: str
+    cost: float
+    data: object  # SplitCandidate or ChainChoice
+
+
+@dataclass
+class SearchResult:
+    graph: TaskGraph
+    path: list[str] | None
+    edge_probabilities: list[float]
+    steps: list[dict]
+    refinements: int
+    edge_splits_generated: int
+    vertex_refinements_generated: int
+
+    @property
+    def predicted_success(self) -> float:
+        return float(math.prod(self.edge_probabilities)) if self.path else 0.0
+
+
+@dataclass
+class _Frontier:
+    cost: dict = field(default_factory=dict)  # v -> best cost (closed and open)
+    parent: dict = field(default_factory=dict)
+    arrivals: dict = field(default_factory=dict)  # v -> start distribution of its out-edges
+    open: set = field(default_factory=set)
+    closed: list = field(default_factory=list)  # in closing order
+
+
+class RefinementSearch:
+    def __init__(self, graph: TaskGraph, evaluator: SubtaskEvaluator, *, proposer=None, config=None,
+                 query_for: Callable | None = None, picture: Callable | None = None,
+                 on_step: Callable[[dict], None] | None = None):
+        self.original = graph
+        self.graph = graph.copy()
+        self.evaluator = evaluator
+        self.proposer = proposer
+        self.cfg = config or SearchConfig()
+        self.query_for = query_for  # (graph, u, v, EdgeResult) -> EdgeQuery for the proposer
+        self.picture = picture  # SplitCandidate -> PNG bytes for proposer feedback
+        self.on_step = on_step
+        self.rng = np.random.default_rng(self.cfg.seed)
+        self.tau = self.cfg.tau0
+        self.f = _Frontier()
+        self.results: dict[tuple[str, str], object] = {}
+        self.memo: dict[tuple, Refinement | None] = {}
+        self.steps: list[dict] = []
+        self.accepted = 0
+        self.splits_generated = 0
+        self.vertex_generated = 0
+        if self.cfg.edge_refinement and (proposer is None or query_for is None):
+            raise ValueError("edge refinement needs a proposer and a query builder")
+
+    # --- the loop (Algorithm 3) ----------------------------------------------------
+    def run(self) -> SearchResult:
+        g, f = self.graph, self.f
+        f.cost[g.initial], f.arrivals[g.initial] = 0.0, g.region(g.initial)
+        f.open.add(g.initial)
+        final = None
+        while f.open:
+            u = min(f.open, key=lambda v: (f.cost[v], v))
+            f.open.discard(u)
+            f.closed.append(u)
+            self._log("expand", vertex=u, cost=f.cost[u])
+            if u in g.finals:
+                final = u
+                break
+            for v in g.successors(u):
+                self._relax(u, v)
+            self._refine()
+        path = self._trace(final)
+        probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
+        self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0)
+        return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
+                            self.vertex_generated)
+
+    def _relax(self, u: str, v: str) -> None:
+        f = self.f
+        result = self.results.get((u, v))
+        if result is None:
+            result = self._evaluate(f.arrivals[u], v, (u, v))
+            self.results[(u, v)] = result
+            self._log("evaluate", edge=[u, v], p=result.p, ci=list(result.ci))
+        c = f.cost[u] + weight(result.p, self.evaluator.n)
+        if v not in f.open or c < f.cost[v]:
+            f.cost[v], f.parent[v], f.arrivals[v] = c, u, start_of(result)
+            f.open.add(v)
+
+    def _evaluate(self, start, v: str, edge):
+        g = self.graph
+        return evaluate_path(self.evaluator, start, [Leg(g.region(v), g.avoid(*edge), g.goal_point(v))]).results[0]
+
+    def _refine(self) -> None:
+        f = self.f
+        while f.open:
+            c_progress = min(f.cost[v] for v in f.open)
+            best = self._best_refinement(c_progress)
+            if best is None or not best.cost < c_progress - self.tau:
+                if best is not None:
+                    self._log("refine-declined", kind=best.kind, edge=[best.u, best.v], cost=best.cost,
+                              c_progress=c_progress, tau=self.tau)
+                return
+            self._apply(best)
+            self._log("refine-accept", kind=best.kind, edge=[best.u, best.v], cost=best.cost,
+                      c_progress=c_progress, tau=self.tau, graph=self.graph.to_dict())
+            self.tau = min(self.tau + self.cfg.tau_step, self.cfg.tau_max)
+
+    # --- generating refinements ("Update refinements") -------------------------------
+    def _best_refinement(self, c_progress: float) -> Refinement | None:
+        candidates = []
+        for v in sorted(self.f.open, key=lambda x: self.f.cost[x]):
+            u = self.f.parent.get(v)
+            if u is None:
+                continue
+            if self.cfg.edge_refinement and self._split_may_win(u, v, c_progress):
+                candidates.append(self._memo(("split",) + self._signature(u, v), lambda: self._gen_split(u, v)))
+            if self.cfg.vertex_refinement and self._vertex_eligible(v):
+                w = self.graph.successors(v)[0]
+                sig = ("vertex",) + self._signature(u, v) + self._signature(v, w)
+                candidates.append(self._memo(sig, lambda: self._gen_vertex(u, v, w)))
+        candidates = [c for c in candidates if c is not None]
+        return min(candidates, key=lambda c: c.cost) if candidates else None
+
+    def _split_may_win(self, u, v, c_progress) -> bool:
+        f = self.f
+        if f.cost[u] >= c_progress - self.tau or f.cost[v] - f.cost[u] <= self.tau:
+            return False
+        sig = ("split",) + self._signature(u, v)
+        return sig in self.memo or self.splits_generated < self.cfg.max_edge_splits
+
+    def _vertex_eligible(self, v) -> bool:
+        g = self.graph
+        if v in g.finals or v == g.initial or g.g.in_degree(v) != 1 or g.g.out_degree(v) != 1:
+            return False
+        return g.successors(v)[0] not in self.f.closed
+
+    def _signature(self, u, v) -> tuple:
+        g = self.graph
+        return (u, v, json.dumps(g.region(u).to_dict()), json.dumps(g.region(v).to_dict()))
+
+    def _memo(self, sig, generate):
+        if sig not in self.memo:
+            self.memo[sig] = generate()
+        return self.memo[sig]
+
+    def _gen_split(self, u, v) -> Refinement | None:
+        self.splits_generated += 1
+        f, g = self.f, self.graph
+        query = self.query_for(g, u, v, self.results[(u, v)])
+        outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
+                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture)
+        self._log("split-generated", edge=[u, v], candidates=[
+            {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
+             "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
+        best = outcome.best
+        if best is None:
+            return None
+        cost = f.cost[u] + sum(weight(p, self.evaluator.n) for p in best.probabilities)
+        return Refinement("split", u, v, cost, best)
+
+    def _gen_vertex(self, u, v, w) -> Refinement | None:
+        self.vertex_generated += 1
+        f, g = self.f, self.graph
+        avoids = [g.avoid(u, v), g.avoid(v, w)]
+        choice = refine_chain(self.evaluator, f.arrivals[u], [g.region(v)], g.region(w), avoids, self.cfg.k,
+                              self.rng, g.goal_point(w))
+        current = evaluate_path(self.evaluator, f.arrivals[u],
+                                [Leg(g.region(v), avoids[0], g.goal_point(v)), Leg(g.region(w), avoids[1],
+                                                                                   g.goal_point(w))])
+        n = self.evaluator.n
+        gain = current.cost(n) - sum(weight(r.p, n) for r in choice.results)
+        self._log("vertex-generated", vertex=v, p_current=current.p, p_best=choice.p,
+                  region=choice.regions[0].to_dict())
+        if choice.regions[0] == g.region(v) or gain <= 0:
+            return None
+        return Refinement("vertex", u, v, f.cost[v] - gain, choice)
+
+    # --- incorporating a refinement ------------------------------------------------
+    def _apply(self, ref: Refinement) -> None:
+        g = self.graph
+        if ref.kind == "split":
+            avoid, parent = g.avoid(ref.u, ref.v), g.g.edges[ref.u, ref.v]["parent"]
+            g.g.remove_edge(ref.u, ref.v)
+            self.results.pop((ref.u, ref.v), None)
+            chain = [ref.u] + [g.add_vertex(None, x, refines=None) for x in ref.data.waypoints] + [ref.v]
+            for a, b in zip(chain, chain[1:]):
+                g.add_edge(a, b, avoid, parent=parent)
+            self.results[(chain[0], chain[1])] = ref.data.results[0]
+        else:
+            node = g.g.nodes[ref.v]
+            node["region"], node["point"] = ref.data.regions[0], None
+            self.results[(ref.u, ref.v)] = ref.data.results[0]
+        self.accepted += 1
+        assert_refines(g, self.original)
+        self._reopen()
+
+    def _reopen(self) -> None:
+        """Recompute the open set's tentative costs from the closed vertices ("Update open")."""
+        f = self.f
+        for v in list(f.open):
+            f.cost.pop(v, None)
+            f.parent.pop(v, None)
+            f.arrivals.pop(v, None)
+        f.open.clear()
+        for u in f.closed:
+            for v in self.graph.successors(u):
+                if v not in f.closed:
+                    self._relax(u, v)
+
+    def _trace(self, final) -> list[str] | None:
+        if final is None:
+            return None
+        path = [final]
+        while path[-1] != self.graph.initial:
+            path.append(self.f.parent[path[-1]])
+        return path[::-1]
+
+    def _log(self, event: str, **detail) -> None:
+        step = {"step": len(self.steps), "event": event, "open": sorted(self.f.open),
+                "closed": list(self.f.closed), **detail}
+        self.steps.append(step)
+        if self.on_step:
+            self.on_step(step)
+
+
+def shortest_path(graph: TaskGraph, evaluator: SubtaskEvaluator, seed: int = 0) -> SearchResult:
+    """DiRL: no refinement, just the lazy shortest-path search over the input graph."""
+    cfg = SearchConfig(edge_refinement=False, vertex_refinement=False, seed=seed)
+    return RefinementSearch(graph, evaluator, config=cfg).run()
