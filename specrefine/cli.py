@@ -28,8 +28,15 @@ def proposer_arg(text: str) -> str:
         f"invalid proposer {text!r}: use geometric, random, replay:PATH or litellm:MODEL")
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (no usage block), still exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="specrefine", description=__doc__.split("\n")[0])
+    parser = _OneLineParser(prog="specrefine", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
     r = sub.add_parser("refine", help="refine a maze task's specification and measure the resulting policy",
                        description="Refine the task graph of MAZE_FILE (S -> a -> ... -> G, avoiding walls), "

@@ -73,7 +73,7 @@ class TaskGraph:
     def predecessors(self, v: str) -> list[str]:
         return list(self.g.predecessors(v))
 
-    def copy(self) -> "TaskGraph":
+    def copy(self) -> TaskGraph:
         return TaskGraph.from_json(self.to_json())
 
     def __repr__(self):
@@ -99,7 +99,7 @@ class TaskGraph:
         return json.dumps(self.to_dict(), **kw)
 
     @classmethod
-    def from_dict(cls, d: dict) -> "TaskGraph":
+    def from_dict(cls, d: dict) -> TaskGraph:
         tg = cls(d["initial"])
         for vd in d["vertices"]:
             tg.add_vertex(vd["name"], from_dict(vd["region"]), point=vd.get("point"),
@@ -110,7 +110,7 @@ class TaskGraph:
         return tg
 
     @classmethod
-    def from_json(cls, text: str) -> "TaskGraph":
+    def from_json(cls, text: str) -> TaskGraph:
         return cls.from_dict(json.loads(text))
 
     def __eq__(self, other):
@@ -121,9 +121,9 @@ def path_graph(regions: list[Region], avoid: Region, names: list[str] | None = N
     """The chain v0 -> v1 -> ... -> vn with the same avoid set on every edge."""
     names = names or [f"v{i}" for i in range(len(regions))]
     tg = TaskGraph(names[0])
-    for name, region in zip(names, regions):
+    for name, region in zip(names, regions, strict=True):
         tg.add_vertex(name, region)
-    for u, v in zip(names, names[1:]):
+    for u, v in zip(names, names[1:], strict=False):
         tg.add_edge(u, v, avoid)
     tg.finals = {names[-1]}
     return tg

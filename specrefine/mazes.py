@@ -41,10 +41,10 @@ class Maze:
     def cols(self) -> int:
         return len(self.grid[0])
 
-    def scaled(self, cell_size: float) -> "Maze":
+    def scaled(self, cell_size: float) -> Maze:
         return Maze(self.name, self.grid, cell_size)
 
-    def for_agent(self, agent: str) -> "Maze":
+    def for_agent(self, agent: str) -> Maze:
         return self.scaled(CELL_SIZE[agent])
 
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
@@ -57,10 +57,10 @@ class Maze:
         return self.rows * self.cell_size
 
     def cell_to_xy(self, row, col) -> np.ndarray:
-        """Centre of cell (row, col); works on arrays."""
+        """Centre of cell (row, col); works on arrays (broadcast against each other)."""
         x = (np.asarray(col) + 0.5) * self.cell_size - self.width / 2
         y = self.height / 2 - (np.asarray(row) + 0.5) * self.cell_size
-        return np.stack([x, y], axis=-1).astype(float)
+        return np.stack(np.broadcast_arrays(x, y), axis=-1).astype(float)
 
     def xy_to_cell(self, xy) -> np.ndarray:
         """(row, col) integer indices of the cell holding each point (may lie outside the grid)."""
@@ -137,7 +137,8 @@ class Maze:
         lines = [
             f"Maze '{self.name}': {self.rows} rows x {self.cols} columns, cell size {self.cell_size} m.",
             "Frame: origin at the map centre, x to the right (columns), y up (row 0 is the top row).",
-            f"Map extent: x in [{-self.width / 2:g}, {self.width / 2:g}], y in [{-self.height / 2:g}, {self.height / 2:g}].",
+            f"Map extent: x in [{-self.width / 2:g}, {self.width / 2:g}], "
+            f"y in [{-self.height / 2:g}, {self.height / 2:g}].",
             "Cell (row, col) has centre x = (col + 0.5) * cell - width/2, y = height/2 - (row + 0.5) * cell.",
             "Grid ('#' wall, '.' free, 'S' start, 'G' goal, letters = subgoals):",
             *("    " + line for line in self.grid),
@@ -181,10 +182,15 @@ def _check_cells(maze: Maze, name: str, linenos: list[int]) -> None:
     for goal in goals:
         if goal not in reached:
             raise MazeError(f"{where(goal)}: goal cell 'G' is not reachable from the start through free cells")
+    to_goal = reachable_cells(maze, goals)
+    for start in starts:  # the initial distribution covers every S cell, so each must lead to the goal
+        if start not in to_goal:
+            raise MazeError(f"{where(start)}: start cell 'S' cannot reach the goal through free cells")
     for letter in maze.subgoals:
-        cell = maze.cells(letter)[0]
-        if cell not in reached:
-            raise MazeError(f"{where(cell)}: subgoal {letter!r} is not reachable from the start through free cells")
+        for cell in maze.cells(letter):
+            if cell not in reached:
+                raise MazeError(
+                    f"{where(cell)}: subgoal {letter!r} is not reachable from the start through free cells")
 
 
 def reachable_cells(maze: Maze, sources) -> set[tuple[int, int]]:
