@@ -69,7 +69,10 @@ def evaluate_path(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> PathEv
     """Evaluate legs in order; a leg with no successes ends the evaluation (the rest has p = 0)."""
     out = PathEvaluation()
     for leg in legs:
-        result = UNREACHED if start is None else evaluator.evaluate(start, leg.goal, leg.avoid, goal_point=leg.goal_point)
+        if start is None:
+            result = UNREACHED
+        else:
+            result = evaluator.evaluate(start, leg.goal, leg.avoid, goal_point=leg.goal_point)
         out.results.append(result)
         start = start_of(result)
     return out

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -167,11 +167,11 @@ class RefinementSearch:
             if u is None:
                 continue
             if self.cfg.edge_refinement and self._split_may_win(u, v, c_progress):
-                candidates.append(self._memo(("split",) + self._signature(u, v), lambda: self._gen_split(u, v)))
+                candidates.append(self._memo(("split",) + self._signature(u, v), lambda u=u, v=v: self._gen_split(u, v)))
             if self.cfg.vertex_refinement and self._vertex_eligible(v):
                 w = self.graph.successors(v)[0]
                 sig = ("vertex",) + self._signature(u, v) + self._signature(v, w)
-                candidates.append(self._memo(sig, lambda: self._gen_vertex(u, v, w)))
+                candidates.append(self._memo(sig, lambda u=u, v=v, w=w: self._gen_vertex(u, v, w)))
         candidates = [c for c in candidates if c is not None]
         return min(candidates, key=lambda c: c.cost) if candidates else None
 

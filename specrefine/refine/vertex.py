@@ -91,7 +91,8 @@ def _best_extension(layer: list[_Path], option: int | None, extend) -> _Path:
             continue
         step = extend(prev.results[-1])
         if best is None or prev.p * step.p > best.p:
-            best = _Path(prev.p * step.p, prev.results + [step], prev.choices + ([option] if option is not None else []))
+            tail = [option] if option is not None else []
+            best = _Path(prev.p * step.p, prev.results + [step], prev.choices + tail)
     if best is None:
         base = layer[0]
         best = _Path(0.0, base.results + [UNREACHED], base.choices + ([option] if option is not None else []))
