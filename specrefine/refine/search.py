@@ -167,11 +167,11 @@ class RefinementSearch:
             if u is None:
                 continue
             if self.cfg.edge_refinement and self._split_may_win(u, v, c_progress):
-                candidates.append(self._memo(("split",) + self._signature(u, v), lambda u=u, v=v: self._gen_split(u, v)))
+                candidates.append(self._memo(("split",) + self._signature(u, v), self._gen_split, u, v))
             if self.cfg.vertex_refinement and self._vertex_eligible(v):
                 w = self.graph.successors(v)[0]
                 sig = ("vertex",) + self._signature(u, v) + self._signature(v, w)
-                candidates.append(self._memo(sig, lambda u=u, v=v, w=w: self._gen_vertex(u, v, w)))
+                candidates.append(self._memo(sig, self._gen_vertex, u, v, w))
         candidates = [c for c in candidates if c is not None]
         return min(candidates, key=lambda c: c.cost) if candidates else None
 
@@ -192,9 +192,9 @@ class RefinementSearch:
         g = self.graph
         return (u, v, json.dumps(g.region(u).to_dict()), json.dumps(g.region(v).to_dict()))
 
-    def _memo(self, sig, generate):
+    def _memo(self, sig, generate, *args):
         if sig not in self.memo:
-            self.memo[sig] = generate()
+            self.memo[sig] = generate(*args)
         return self.memo[sig]
 
     def _gen_split(self, u, v) -> Refinement | None:
