@@ -1,0 +1,529 @@
+"""Subtask evaluation: batched rollouts of the goal policy on a reach-avoid edge, and the monitor.
+
+``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
+policy, started from ``start`` (uniform in a region, or resampled end states of a preceding edge),
+reaches ``goal`` before entering ``avoid`` (its signed distance below the agent's body radius) and
+before flipping, within ``horizon`` control steps.  The policy's goal point is ``goal_point`` if
+given, else a point sampled uniformly from ``goal`` per rollout (the paper's "representative
+waypoint randomly sampled from the inclusion set of the subtask's goal vertex").
+
+All ``n`` rollouts of a call run in one :class:`~specrefine.sim.BatchedSim` (one per batch size,
+built lazily and reused); a rollout that has finished is frozen (zero action, excluded from the
+checks, its trajectory padded with its last point) and the loop stops once all have finished.
+
+Reproducible: the seed fixes start states, goal points and (through them) the deterministic policy
+and physics, so the same seed gives identical numbers.  Results are cached in memory and, with
+``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the canonical
+JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon, seed, agent,
+maze, body radius, code version), written atomically (a run interrupted midway keeps every entry it
+finished); an unreadable or mismatching entry is ignored with a warning and recomputed.
+
+``run_path`` runs a compositional policy (a sequence of legs, the goal switching when a leg's goal
+region is reached) end to end; ``satisfies`` is a monitor that checks trajectories against a task
+graph's specification (used to measure success on the ORIGINAL task).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from .errors import SpecrefineError
+from .mazes import CELL_SIZE, Maze
+from .regions import Box, Disc, Region
+
+CACHE_VERSION = 1
+SUCCESS, AVOID, FLIPPED, TIMEOUT, UNFINISHED = 0, 1, 2, 3, 4
+OUTCOMES = ("success", "avoid", "flipped", "timeout", "unfinished")
+
+
+# --- results ---------------------------------------------------------------------------------------
+@dataclass
+class StartStates:
+    """A start distribution given by full physics states (resampled with replacement)."""
+
+    states: np.ndarray  # (m, state_dim)
+    xy: np.ndarray  # (m, 2)
+
+    def __len__(self) -> int:
+        return len(self.states)
+
+    def digest(self) -> str:
+        h = hashlib.sha256(np.ascontiguousarray(self.states, dtype=np.float64).tobytes())
+        h.update(str(self.states.shape).encode())
+        return h.hexdigest()[:32]
+
+
+@dataclass
+class EdgeResult:
+    p: float
+    ci: tuple[float, float]
+    n: int
+    successes: int
+    success: np.ndarray  # (n,) bool
+    trajectories: np.ndarray  # (n, T, 2) float32; row i is valid up to lengths[i], then padded with its last point
+    lengths: np.ndarray  # (n,) int: number of valid points (1 + control steps taken)
+    end_states: StartStates | None  # states of the successful rollouts at the moment they reached the goal
+    steps: int  # environment steps simulated (the batch is stepped together: n x loop iterations)
+    cached: bool = False
+    outcome: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int8))  # per rollout, see OUTCOMES
+
+    @property
+    def weight(self) -> float:
+        """-log p (inf for p = 0)."""
+        return -math.log(self.p) if self.p > 0 else math.inf
+
+    def counts(self) -> dict[str, int]:
+        return {name: int(np.sum(self.outcome == i)) for i, name in enumerate(OUTCOMES) if np.any(self.outcome == i)}
+
+
+@dataclass
+class PathResult:
+    p: float
+    ci: tuple[float, float]
+    n: int
+    successes: int
+    success: np.ndarray  # (n,) bool: every leg completed
+    legs_done: np.ndarray  # (n,) int: legs completed by each episode
+    trajectories: np.ndarray  # (n, T, 2) float32, padded like EdgeResult's
+    lengths: np.ndarray  # (n,)
+    steps: int
+    outcome: np.ndarray  # (n,) int8, see OUTCOMES
+
+    n_legs: int = 1
+
+    @property
+    def leg_success(self) -> list[float | None]:
+        """Empirical success probability of each leg among the episodes that started it (None: none did)."""
+        out = []
+        for k in range(self.n_legs):
+            started = self.legs_done >= k
+            out.append(float(np.mean(self.legs_done[started] > k)) if started.any() else None)
+        return out
+
+
+def wilson_ci(successes, n, z: float = 1.96) -> tuple[float, float]:
+    """Wilson score interval for a binomial proportion (95 % by default); (0, 1) when n = 0."""
+    n = int(n)
+    if n <= 0:
+        return (0.0, 1.0)
+    p = successes / n
+    z2 = z * z
+    denom = 1 + z2 / n
+    centre = (p + z2 / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+# --- fast region checks ------------------------------------------------------------------------------
+class CompiledRegion:
+    """A region's boxes and discs as arrays: signed distance of many points in a few numpy calls.
+
+    Gives the same numbers as ``Region.signed_distance`` (the same formula, vectorised over parts).
+    """
+
+    def __init__(self, region: Region):
+        self.region = region
+        parts = region.parts()
+        boxes = [p for p in parts if isinstance(p, Box)]
+        discs = [p for p in parts if isinstance(p, Disc)]
+        self.other = [p for p in parts if not isinstance(p, (Box, Disc))]
+        self.bc = np.array([[(b.xmin + b.xmax) / 2, (b.ymin + b.ymax) / 2] for b in boxes]).reshape(-1, 2)
+        self.bh = np.array([[(b.xmax - b.xmin) / 2, (b.ymax - b.ymin) / 2] for b in boxes]).reshape(-1, 2)
+        self.dc = np.array([[d.cx, d.cy] for d in discs]).reshape(-1, 2)
+        self.dr = np.array([d.r for d in discs])
+
+    def signed_distance(self, pts: np.ndarray) -> np.ndarray:
+        pts = np.asarray(pts, dtype=float).reshape(-1, 2)
+        out = np.full(len(pts), np.inf)
+        if len(self.bc):
+            d = np.abs(pts[:, None, :] - self.bc[None]) - self.bh[None]  # (n, m, 2)
+            dx, dy = d[..., 0], d[..., 1]
+            outside = np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+            inside = np.minimum(np.maximum(dx, dy), 0.0)
+            out = np.minimum(out, (outside + inside).min(axis=1))
+        if len(self.dc):
+            dd = np.hypot(pts[:, None, 0] - self.dc[None, :, 0], pts[:, None, 1] - self.dc[None, :, 1]) - self.dr
+            out = np.minimum(out, dd.min(axis=1))
+        for p in self.other:
+            out = np.minimum(out, p.signed_distance(pts))
+        return out
+
+    def contains(self, pts: np.ndarray) -> np.ndarray:
+        return self.signed_distance(pts) <= 0.0
+
+
+def _region_key(region: Region) -> dict:
+    return region.to_dict()
+
+
+# --- the evaluator --------------------------------------------------------------------------------
+class Evaluator:
+    """N batched rollouts of a goal policy per subtask, with counters and a cache.
+
+    maze: the maze at the agent's scale (``maze.for_agent(agent)``); regions passed to the methods are
+    in its metres.  policy: a :class:`~specrefine.policy.GoalPolicy` or any callable obs -> actions in
+    [-1, 1] (an object with ``.act(obs)`` is called that way; a ``fingerprint`` attribute identifies
+    it in cache keys; without one, results are cached in memory only).
+    """
+
+    def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
+                 cache_dir=None, nthread: int | None = None):
+        from .sim import agent_spec
+
+        if agent not in CELL_SIZE:
+            raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(CELL_SIZE)}")
+        if abs(maze.cell_size - CELL_SIZE[agent]) > 1e-9:
+            raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
+                                  f"{CELL_SIZE[agent]:g} m: pass maze.for_agent({agent!r})")
+        spec = agent_spec(agent)
+        self.maze, self.agent, self.policy = maze, agent, policy
+        self.n, self.seed, self.nthread = int(n), seed, nthread
+        self.horizon = int(horizon) if horizon is not None else spec.default_horizon
+        self.body_radius = float(spec.body_radius)
+        self.cache_dir = Path(cache_dir) if cache_dir is not None else None
+        self.evaluations = 0  # subtask evaluations actually simulated
+        self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
+        self.cache_hits = 0
+        self._act = policy.act if hasattr(policy, "act") else policy
+        self._sims: dict[int, object] = {}
+        self._memo: dict[str, EdgeResult] = {}
+        self._compiled: dict[Region, CompiledRegion] = {}
+        self._walls = self.compiled(maze.walls)
+        grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
+        self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
+
+    # --- plumbing ------------------------------------------------------------------------------
+    def sim(self, n: int | None = None):
+        """The BatchedSim of batch ``n`` (built on first use, then reused)."""
+        from .sim import BatchedSim
+
+        n = int(n or self.n)
+        if n not in self._sims:
+            self._sims[n] = BatchedSim(self.agent, self.maze, n, nthread=self.nthread)
+        return self._sims[n]
+
+    def compiled(self, region: Region) -> CompiledRegion:
+        c = self._compiled.get(region)
+        if c is None:
+            if len(self._compiled) > 256:
+                self._compiled.clear()
+            c = self._compiled[region] = CompiledRegion(region)
+        return c
+
+    @property
+    def policy_fingerprint(self) -> str | None:
+        fp = getattr(self.policy, "fingerprint", None)
+        return str(fp) if fp is not None else None
+
+    def sample_free(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
+        """``k`` points uniform in ``region`` where the agent's body fits (wall distance >= body radius).
+
+        Falls back to plain uniform samples if the region has (almost) no such points.
+        """
+        chunks, got = [], 0
+        for _ in range(64):
+            pts = region.sample(max(2 * (k - got), 16), rng)
+            ok = pts[self._walls.signed_distance(pts) >= self.body_radius]
+            chunks.append(ok[: k - got])
+            got += len(chunks[-1])
+            if got >= k:
+                return np.concatenate(chunks)
+        warnings.warn(f"region {region.to_dict()} has almost no room for the agent's body; sampling it plainly",
+                      stacklevel=2)
+        return np.concatenate(chunks + [region.sample(k - got, rng)])
+
+    def _key(self, kind: str, start, legs, n: int, seed) -> tuple[str, str]:
+        if isinstance(start, StartStates):
+            start_key = {"states": start.digest(), "m": len(start)}
+        else:
+            start_key = _region_key(start)
+        fp = self.policy_fingerprint or f"id:{id(self.policy)}"
+        legs_key = [[_region_key(g), _region_key(a), None if p is None else [float(v) for v in np.ravel(p)]]
+                    for g, a, p in legs]
+        body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
+                "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius}
+        text = json.dumps(body, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:40], text
+
+    def _cache_path(self, key: str) -> Path | None:
+        if self.cache_dir is None or self.policy_fingerprint is None:
+            return None
+        return self.cache_dir / key[:2] / f"{key}.npz"
+
+    def _load(self, key: str, text: str) -> EdgeResult | None:
+        path = self._cache_path(key)
+        if path is None or not path.exists():
+            return None
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if str(z["key"]) != text:
+                    raise ValueError("key mismatch")
+                success = z["success"].astype(bool)
+                n = len(success)
+                end = StartStates(z["end_states"].astype(np.float64), z["end_xy"].astype(np.float64))
+                res = EdgeResult(p=float(success.mean()) if n else 0.0, ci=wilson_ci(int(success.sum()), n), n=n,
+                                 successes=int(success.sum()), success=success, trajectories=z["trajectories"],
+                                 lengths=z["lengths"].astype(np.int64), end_states=end, steps=int(z["steps"]),
+                                 cached=True, outcome=z["outcome"].astype(np.int8))
+                if len(res.lengths) != n or len(res.trajectories) != n or len(end) != res.successes:
+                    raise ValueError("inconsistent arrays")
+                return res
+        except Exception as e:  # corrupt, truncated, foreign: never crash, recompute
+            warnings.warn(f"ignoring unreadable cache entry {path}: {type(e).__name__}: {e}", stacklevel=3)
+            return None
+
+    def _store(self, key: str, text: str, res: EdgeResult) -> None:
+        path = self._cache_path(key)
+        if path is None:
+            return
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, key=np.array(text), success=res.success, trajectories=res.trajectories,
+                                    lengths=res.lengths, end_states=res.end_states.states, end_xy=res.end_states.xy,
+                                    steps=np.array(res.steps), outcome=res.outcome)
+            os.replace(tmp, path)
+        except OSError as e:
+            warnings.warn(f"could not write cache entry {path}: {e}", stacklevel=3)
+
+    # --- public API ----------------------------------------------------------------------------
+    def evaluate(self, start: Region | StartStates, goal: Region, avoid: Region, goal_point=None, seed=None,
+                 n: int | None = None) -> EdgeResult:
+        """Success probability of the subtask start -> goal avoiding ``avoid`` (see the module docstring)."""
+        n = int(n or self.n)
+        seed = self.seed if seed is None else seed
+        legs = [(goal, avoid, goal_point)]
+        key, text = self._key("edge", start, legs, n, seed)
+        hit = self._memo.get(key)
+        if hit is None:
+            hit = self._load(key, text)
+            if hit is not None:
+                self._memo[key] = replace(hit, cached=False)
+        if hit is not None:
+            self.cache_hits += 1
+            return replace(hit, cached=True)
+        if isinstance(start, StartStates) and len(start) == 0:  # nothing reached the start: p = 0, nothing run
+            sdim = start.states.shape[1] if start.states.ndim == 2 else 0
+            return EdgeResult(0.0, (0.0, 1.0), 0, 0, np.zeros(0, bool), np.zeros((0, 1, 2), np.float32),
+                              np.zeros(0, np.int64), StartStates(np.zeros((0, sdim)), np.zeros((0, 2))), 0,
+                              outcome=np.zeros(0, np.int8))
+        out = self._rollout(start, legs, n, seed)
+        success = out["legs_done"] == 1
+        k = int(success.sum())
+        res = EdgeResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                         trajectories=out["trajectories"], lengths=out["lengths"],
+                         end_states=StartStates(out["end_states"][success], out["end_xy"][success]),
+                         steps=out["steps"], outcome=out["outcome"])
+        self.evaluations += 1
+        self._memo[key] = res
+        self._store(key, text, res)
+        return res
+
+    def evaluate_edge(self, graph, u: str, v: str, start: Region | StartStates | None = None, seed=None,
+                      n: int | None = None) -> EdgeResult:
+        """``evaluate`` on the graph edge u -> v (start defaults to I(u); goal point = v's point, if any)."""
+        return self.evaluate(graph.region(u) if start is None else start, graph.region(v), graph.avoid(u, v),
+                             goal_point=graph.goal_point(v), seed=seed, n=n)
+
+    def run_path(self, start: Region | StartStates, legs, n: int | None = None, seed=None) -> PathResult:
+        """Run the compositional policy: legs ``[(goal, avoid, goal_point | None), ...]`` end to end.
+
+        Each episode starts in ``start`` and pursues leg 0's goal point; on reaching a leg's goal region it
+        switches to the next leg (fresh ``horizon`` steps per leg).  It fails on entering the current leg's
+        avoid set, flipping, or running out of a leg's horizon.
+        """
+        n = int(n or self.n)
+        seed = self.seed if seed is None else seed
+        legs = [tuple(leg) if len(leg) == 3 else (leg[0], leg[1], None) for leg in legs]
+        if not legs:
+            raise SpecrefineError("run_path needs at least one leg")
+        out = self._rollout(start, legs, n, seed)
+        success = out["legs_done"] == len(legs)
+        k = int(success.sum())
+        res = PathResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success, legs_done=out["legs_done"],
+                         trajectories=out["trajectories"], lengths=out["lengths"], steps=out["steps"],
+                         outcome=out["outcome"], n_legs=len(legs))
+        return res
+
+    def run_graph_path(self, graph, path: list[str], n: int | None = None, seed=None) -> PathResult:
+        """``run_path`` along a vertex path of a task graph, from I(path[0])."""
+        return self.run_path(graph.region(path[0]), path_legs(graph, path), n=n, seed=seed)
+
+    # --- the hot loop --------------------------------------------------------------------------
+    def _rollout(self, start, legs, n: int, seed) -> dict:
+        rng = np.random.default_rng(seed)
+        sim = self.sim(n)
+        if isinstance(start, StartStates):
+            if len(start) == 0:
+                raise SpecrefineError("empty start distribution (no successful rollouts to start from)")
+            sim.reset(states=start.states[rng.integers(len(start), size=n)])
+        else:
+            sim.reset(xy=self.sample_free(start, n, rng), rng=rng)
+        L, H, r = len(legs), self.horizon, self.body_radius
+        goal_pts = np.empty((L, n, 2))
+        for k, (goal, _, point) in enumerate(legs):
+            goal_pts[k] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) if point is not None \
+                else self.sample_free(goal, n, rng)
+        goals = [self.compiled(g) for g, _, _ in legs]
+        avoids = [self.compiled(a) for _, a, _ in legs]
+        rows = np.arange(n)
+        T = L * H + 1
+        traj = np.empty((n, T, 2), dtype=np.float32)
+        leg = np.zeros(n, dtype=np.int64)
+        t_leg = np.zeros(n, dtype=np.int64)
+        active = np.ones(n, dtype=bool)
+        lengths = np.full(n, T, dtype=np.int64)
+        outcome = np.full(n, UNFINISHED, dtype=np.int8)
+        end_states = np.zeros((n, sim.state_dim))
+        end_xy = np.zeros((n, 2))
+        xy = sim.xy
+        traj[:, 0] = xy
+        steps = 0
+
+        def check(t: int, xy: np.ndarray) -> None:
+            """Classify the active rollouts at time t (after the step that led there)."""
+            flipped = sim.flipped
+            idx = np.flatnonzero(active)
+            for _ in range(L + 1):  # a point may lie in several consecutive goals: advance through all of them
+                if not len(idx):
+                    break
+                advanced = []
+                for k in (np.unique(leg[idx]) if L > 1 else (0,)):
+                    sel = idx[leg[idx] == k] if L > 1 else idx
+                    p = xy[sel]
+                    bad = (avoids[k].signed_distance(p) < r) | flipped[sel]
+                    reached = ~bad & goals[k].contains(p)
+                    if bad.any():
+                        b = sel[bad]
+                        outcome[b] = np.where(flipped[b], FLIPPED, AVOID)
+                        active[b] = False
+                        lengths[b] = t + 1
+                    if reached.any():
+                        g = sel[reached]
+                        leg[g] += 1
+                        t_leg[g] = 0
+                        done = g[leg[g] == L]
+                        if len(done):
+                            outcome[done] = SUCCESS
+                            active[done] = False
+                            lengths[done] = t + 1
+                            end_states[done] = sim.get_state()[done]
+                            end_xy[done] = xy[done]
+                        advanced.append(g[leg[g] < L])
+                idx = np.concatenate(advanced) if advanced else idx[:0]
+
+        check(0, xy)
+        import torch
+
+        with torch.inference_mode():
+            for t in range(1, T):
+                if not active.any():
+                    break
+                obs = sim.observe(goal_pts[np.minimum(leg, L - 1), rows])
+                act = np.asarray(self._act(obs), dtype=np.float64)
+                act[~active] = 0.0  # frozen rollouts stay still
+                sim.step(act)
+                steps += n
+                xy = sim.xy
+                traj[:, t] = xy
+                t_leg[active] += 1
+                check(t, xy)
+                late = active & (t_leg >= H)
+                if late.any():
+                    outcome[late] = TIMEOUT
+                    active[late] = False
+                    lengths[late] = t + 1
+        used = int(lengths.max(initial=1))
+        pad = np.minimum(np.arange(used)[None, :], lengths[:, None] - 1)
+        traj = traj[rows[:, None], pad]
+        self.sim_steps += steps
+        return {"legs_done": leg, "trajectories": traj, "lengths": lengths, "outcome": outcome,
+                "end_states": end_states, "end_xy": end_xy, "steps": steps}
+
+
+def path_legs(graph, path: list[str]) -> list[tuple[Region, Region, np.ndarray | None]]:
+    """Legs ``(I(v), O(u, v), point(v))`` for consecutive vertices of a path in a task graph."""
+    return [(graph.region(v), graph.avoid(u, v), graph.goal_point(v)) for u, v in zip(path, path[1:], strict=False)]
+
+
+# --- the monitor --------------------------------------------------------------------------------------
+def satisfies(graph, trajectories, lengths=None, body_radius: float = 0.0) -> np.ndarray:
+    """Which trajectories satisfy the task graph's specification.
+
+    A trajectory s_0..s_{T-1} satisfies the graph if there are a path v0 = initial -> v1 -> ... -> vk
+    (vk final) and times 0 = t0 <= t1 <= ... <= tk < T with s_{ti} in I(vi) and, for every i >= 1, no
+    state s_t with t_{i-1} <= t <= t_i inside O(v_{i-1} -> v_i) (signed distance < ``body_radius``).
+    Choices in the DAG are resolved nondeterministically: the monitor tracks the set of edges a
+    trajectory may currently be traversing (an NFA over edges), vectorised over trajectories.
+    """
+    traj = np.asarray(trajectories, dtype=float)
+    if traj.ndim == 2:
+        traj = traj[None]
+    n, T = traj.shape[:2]
+    lengths = np.full(n, T) if lengths is None else np.asarray(lengths, dtype=np.int64)
+    valid = np.arange(T)[None, :] < lengths[:, None]  # (n, T)
+    flat = traj.reshape(-1, 2)
+    g = graph.g
+    order = list(_topological(graph))
+    in_v = {v: CompiledRegion(graph.region(v)).contains(flat).reshape(n, T) for v in order}
+    bad = {}
+    for u, v in graph.edges():
+        bad[(u, v)] = CompiledRegion(graph.avoid(u, v)).signed_distance(flat).reshape(n, T) < body_radius
+    active = {e: np.zeros(n, dtype=bool) for e in bad}
+    accepted = np.zeros(n, dtype=bool)
+    finals = set(graph.finals)
+    for t in range(T):
+        ok_t = valid[:, t]
+        reached = {}
+        for v in order:
+            r = (in_v[v][:, t] & ok_t) if (t == 0 and v == graph.initial) else np.zeros(n, dtype=bool)
+            for u in g.predecessors(v):
+                r |= active[(u, v)] & in_v[v][:, t]
+            reached[v] = r
+            if v in finals:
+                accepted |= r
+            for w in g.successors(v):
+                e = (v, w)
+                active[e] = (active[e] | r) & ~bad[e][:, t] & ok_t
+        # edges into v were updated before v was visited (topological order), so reaching v at time t
+        # uses edges that survived time t -- the avoid check includes the reaching state itself
+        if not any(a.any() for a in active.values()):
+            break
+    return accepted
+
+
+def _topological(graph):
+    import networkx as nx
+
+    return nx.topological_sort(graph.g)
+
+
+# --- a scripted controller for the point mass ------------------------------------------------------
+class PointController:
+    """Proportional-derivative controller for the point mass: a = clip(kp (goal - xy) - kd v, -1, 1).
+
+    Observation layout as in :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).
+    Deterministic and training-free: a stand-in policy for tests and for notebooks without a checkpoint.
+    """
+
+    agent = "point"
+
+    def __init__(self, kp: float = 2.0, kd: float = 0.3):
+        self.kp, self.kd = float(kp), float(kd)
+        self.fingerprint = f"point-pd-kp{self.kp:g}-kd{self.kd:g}"
+
+    def act(self, obs, deterministic: bool = True) -> np.ndarray:
+        obs = np.asarray(obs, dtype=np.float64)
+        return np.clip(self.kp * obs[:, 2:4] - self.kd * obs[:, 0:2], -1.0, 1.0)
+
+    __call__ = act
