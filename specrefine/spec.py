@@ -78,6 +78,10 @@ def _check_specs(name, items):
 
 def compile_spec(start: Region, spec: Spec, avoid: Region | None = None, initial: str = "v0") -> TaskGraph:
     """Compile ``spec``, started from ``start``, to a task graph (one vertex per ``reach``)."""
+    if not isinstance(start, Region):
+        raise SpecError(f"compile_spec() needs a start Region, got {type(start).__name__}")
+    if avoid is not None and not isinstance(avoid, Region):
+        raise SpecError(f"compile_spec() needs avoid to be a Region or None, got {type(avoid).__name__}")
     tg = TaskGraph(initial)
     tg.add_vertex(initial, start, label="start")
     tg.finals = set(_compile(tg, spec, [initial], [avoid] if avoid is not None else []))
