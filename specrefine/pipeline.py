@@ -1,16 +1,217 @@
-"""One refinement run, end to end: maze -> task graph -> refine -> measure -> result.json."""
+"""One refinement run, end to end: maze -> task graph -> refine -> measure -> result.json.
+
+``refine_maze`` is what ``specrefine refine`` runs.  The output policy is measured on
+FRESH rollouts from the initial distribution (a seed disjoint from the search's), and
+success is judged by the monitor of the ORIGINAL task graph, not the refined one.
+The step log is appended as the search goes and evaluations are cached under ``out``,
+so an interrupted run keeps what it computed and a rerun resumes from the cache.
+"""
 
 from __future__ import annotations
 
+import json
+import math
+import time
+from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from .errors import SpecrefineError
+from .graph import check_refines
 from .mazes import load_maze
 from .spec import maze_task
 
+MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
+
+
+@dataclass
+class RunResult:
+    data: dict
+    out: Path
+
+    def summary(self) -> str:
+        d = self.data
+        lo, hi = d["success_ci"]
+        return (f"{d['maze']} | {d['agent']} | method={d['method']} proposer={d['proposer']} seed={d['seed']}\n"
+                f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
+                f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
+                f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
+                f"subtasks; refines input: {d['refines_input']}\n"
+                f"  {d['evaluations']} subtask evaluations, {d['sim_steps']} sim steps, {d['vlm_calls']} "
+                f"proposer calls ({'VLM' if d['proposer_is_vlm'] else 'offline, not a VLM'}), "
+                f"{d['wall_seconds']:.1f} s\n  -> {self.out / 'result.json'}")
+
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
-                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5):
+                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None) -> RunResult:
+    from .evaluate import Evaluator
+    from .policy import load_policy
+
+    t0 = time.time()
     maze = load_maze(maze_path).for_agent(agent)
-    graph = maze_task(maze)
-    raise SpecrefineError(f"compiled {graph} for {maze.name}; the refinement search is not built yet")
+    original = maze_task(maze)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if evaluator is None:
+        policy = load_policy(policy_path or agent)
+        evaluator = Evaluator(maze, agent, policy, n=rollouts, seed=seed, cache_dir=out / "cache")
+    prop = _make_proposer(proposer, method, seed, out)
+    steps_log = (out / "steps.jsonl").open("w")
+    try:
+        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k,
+                         on_step=lambda s: steps_log.write(json.dumps(s, default=_jsonable) + "\n") or steps_log.flush())
+    finally:
+        steps_log.close()
+    measured = _measure(evaluator, original, search, episodes, seed)
+    data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
+    (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
+    _pictures(maze, search, measured, out, data)
+    return RunResult(data, out)
+
+
+def _make_proposer(spec: str, method: str, seed: int, out: Path):
+    if method not in ("ours", "vlm-oneshot"):
+        return None
+    from .proposers import make_proposer
+
+    return make_proposer(spec, seed=seed, record_path=out / "vlm_recording.jsonl")
+
+
+def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step):
+    from .refine import RefinementSearch, SearchConfig, shortest_path
+
+    if method == "dirl":
+        return shortest_path(original, evaluator, seed=seed)
+    if method == "symbolic":
+        cfg = SearchConfig(k=k, edge_refinement=False, seed=seed)
+        return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
+    if method == "ours":
+        cfg = SearchConfig(w=w, d=d, k=k, seed=seed)
+        return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
+                                query_for=edge_query_builder(maze, agent), picture=candidate_picture(maze)).run()
+    if method == "vlm-oneshot":
+        from .refine.oneshot import oneshot
+
+        return oneshot(original, evaluator, proposer, maze=maze, agent=agent, w=w, rounds=d, seed=seed,
+                       on_step=on_step)
+    raise SpecrefineError(f"unknown method {method!r}")
+
+
+def edge_query_builder(maze, agent):
+    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts."""
+    from .proposers import EdgeQuery
+    from .render import render_task, to_png
+
+    def build(graph, u, v, result):
+        fig = render_task(maze, _edge_graph(graph, u, v), trajectories=getattr(result, "trajectories", None),
+                          success=getattr(result, "success", None), lengths=getattr(result, "lengths", None),
+                          title=f"{u} -> {v}: {result.p:.0%} of {result.n} rollouts succeed")
+        return EdgeQuery(maze=maze, agent=agent, start=graph.region(u), goal=graph.region(v),
+                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph)
+
+    return build
+
+
+def _edge_graph(graph, u, v):
+    from .graph import TaskGraph
+
+    sub = TaskGraph(u)
+    sub.add_vertex(u, graph.region(u), label=graph.g.nodes[u]["label"])
+    sub.add_vertex(v, graph.region(v), label=graph.g.nodes[v]["label"])
+    sub.add_edge(u, v, graph.avoid(u, v))
+    sub.finals = {v}
+    return sub
+
+
+def candidate_picture(maze):
+    """SplitCandidate -> PNG of its waypoints and the rollouts of each of its subtasks."""
+    from .render import render_task, to_png
+
+    def picture(candidate):
+        legs = [r for r in candidate.results if getattr(r, "trajectories", None) is not None and r.n]
+        if not legs:
+            return None
+        width = max(r.trajectories.shape[1] for r in legs)
+        traj = np.concatenate([_pad(r.trajectories, width) for r in legs])
+        fig = render_task(maze, trajectories=traj, success=np.concatenate([r.success for r in legs]),
+                          lengths=np.concatenate([r.lengths for r in legs]), waypoints=candidate.waypoints,
+                          title="subtask success: " + ", ".join(f"{p:.2f}" for p in candidate.probabilities))
+        return to_png(fig)
+
+    return picture
+
+
+def _pad(traj, width):
+    if traj.shape[1] == width:
+        return traj
+    return np.concatenate([traj, np.repeat(traj[:, -1:], width - traj.shape[1], axis=1)], axis=1)
+
+
+@dataclass
+class Measurement:
+    success: np.ndarray
+    path_result: object | None
+
+    @property
+    def rate(self) -> float:
+        return float(self.success.mean()) if len(self.success) else 0.0
+
+
+def _measure(evaluator, original, search, episodes, seed) -> Measurement:
+    from .evaluate import satisfies
+
+    if not search.path:
+        return Measurement(np.zeros(0, dtype=bool), None)
+    pr = evaluator.run_graph_path(search.graph, search.path, n=episodes, seed=seed + MEASURE_SEED_OFFSET)
+    ok = satisfies(original, pr.trajectories, pr.lengths, body_radius=evaluator.body_radius)
+    return Measurement(ok, pr)
+
+
+def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, search, measured, evaluator, t0):
+    from .evaluate import wilson_ci
+
+    n_ok, n = int(measured.success.sum()), len(measured.success)
+    graph = search.graph
+    path_edges = len(search.path) - 1 if search.path else 0
+    return {
+        "maze": maze.name, "agent": agent, "method": method, "proposer": proposer_spec,
+        "proposer_is_vlm": bool(getattr(proposer, "is_vlm", False)), "seed": seed,
+        "success_rate": measured.rate, "success_ci": list(wilson_ci(n_ok, n)), "episodes": n,
+        "path_success_rate": float(measured.path_result.p) if measured.path_result else 0.0,
+        "predicted_success": search.predicted_success, "edge_probabilities": search.edge_probabilities,
+        "evaluations": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
+        "sim_steps": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
+        "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
+        "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,
+        "refines_input": not check_refines(graph, original), "path": search.path,
+        "graph_vertices": graph.g.number_of_nodes(), "graph_edges": graph.g.number_of_edges(),
+        "path_edges": path_edges, "graph": graph.to_dict(), "input_graph": original.to_dict(),
+    }
+
+
+def _pictures(maze, search, measured, out, data) -> None:
+    from .render import render_graph_diagram, render_task, save_png
+
+    pr = measured.path_result
+    lo, hi = data["success_ci"]
+    title = (f"{maze.name} [{data['method']}, {data['proposer']}]: {data['success_rate']:.0%} "
+             f"(95% CI {lo:.0%}-{hi:.0%}, {data['episodes']} episodes)")
+    fig = render_task(maze, search.graph, trajectories=pr.trajectories if pr else None,
+                      success=measured.success if pr else None, lengths=pr.lengths if pr else None,
+                      path=search.path, title=title)
+    save_png(fig, out / "refined.png")
+    probs = {(a, b): p for (a, b), p in zip(zip(search.path, search.path[1:]), search.edge_probabilities)} \
+        if search.path else None
+    save_png(render_graph_diagram(search.graph, probs, path=search.path, title="refined task graph"),
+             out / "graph.png")
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, float) and math.isinf(obj):
+        return None
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

@@ -164,7 +164,7 @@ class RefinementSearch:
         candidates = []
         for v in sorted(self.f.open, key=lambda x: self.f.cost[x]):
             u = self.f.parent.get(v)
-            if u is None:
+            if u is None or self.f.arrivals.get(u) is None:  # nothing reaches u: nothing to evaluate from
                 continue
             if self.cfg.edge_refinement and self._split_may_win(u, v, c_progress):
                 candidates.append(self._memo(("split",) + self._signature(u, v), self._gen_split, u, v))
