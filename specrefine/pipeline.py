@@ -57,12 +57,13 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
         policy = load_policy(policy_path or agent)
         evaluator = Evaluator(maze, agent, policy, n=rollouts, seed=seed, cache_dir=out / "cache")
     prop = _make_proposer(proposer, method, seed, out)
-    steps_log = (out / "steps.jsonl").open("w")
-    try:
-        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k,
-                         on_step=lambda s: steps_log.write(json.dumps(s, default=_jsonable) + "\n") or steps_log.flush())
-    finally:
-        steps_log.close()
+    with (out / "steps.jsonl").open("w") as steps_log:
+
+        def on_step(step):
+            steps_log.write(json.dumps(step, default=_jsonable) + "\n")
+            steps_log.flush()
+
+        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
     measured = _measure(evaluator, original, search, episodes, seed)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
