@@ -186,3 +186,28 @@ def assert_refines(refined: TaskGraph, original: TaskGraph) -> None:
     if problems:
         raise InvalidRefinement(f"refined graph does not imply the original: {problems[0]}"
                                 + (f" (+{len(problems) - 1} more)" if len(problems) > 1 else ""))
+
+
+def infer_parents(proposal: TaskGraph, original: TaskGraph) -> TaskGraph:
+    """Give a whole-graph proposal (e.g. the one-shot VLM baseline's) edge provenance.
+
+    Vertices must already say which original vertex they refine (``refines``; None for new
+    waypoints).  Each edge a -> b gets as parent the original edge u -> v, where u is the first
+    refining vertex found walking back from a and v the first walking on from b through
+    unbranched new waypoints.  ``check_refines`` then judges whether the proposal implies the input.
+    """
+    g = proposal.g
+
+    def walk(x, step, degree):
+        seen = set()
+        while g.nodes[x]["refines"] is None and degree(x) == 1 and x not in seen:
+            seen.add(x)
+            x = next(iter(step(x)))
+        return g.nodes[x]["refines"]
+
+    for a, b in g.edges:
+        u = walk(a, g.predecessors, g.in_degree)
+        v = walk(b, g.successors, g.out_degree)
+        if u is not None and v is not None:
+            g.edges[a, b]["parent"] = (u, v)
+    return proposal

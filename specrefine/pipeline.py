@@ -162,9 +162,13 @@ class Measurement:
 def _measure(evaluator, original, search, episodes, seed) -> Measurement:
     from .evaluate import satisfies
 
-    if not search.path:
+    if not search.path or len(search.path) < 2:
         return Measurement(np.zeros(0, dtype=bool), None)
-    pr = evaluator.run_graph_path(search.graph, search.path, n=episodes, seed=seed + MEASURE_SEED_OFFSET)
+    from .evaluate import path_legs
+
+    # always from the ORIGINAL initial distribution, even if a baseline changed the initial vertex
+    pr = evaluator.run_path(original.region(original.initial), path_legs(search.graph, search.path), n=episodes,
+                            seed=seed + MEASURE_SEED_OFFSET)
     ok = satisfies(original, pr.trajectories, pr.lengths, body_radius=evaluator.body_radius)
     return Measurement(ok, pr)
 

@@ -1,0 +1,215 @@
+"""Experiment sweeps: a grid of (maze x method x proposer x seed) runs -> one tidy CSV table.
+
+Each cell is one ``refine_maze`` run (the CLI's code path) in its own output directory
+``OUT/cells/<cell id>/``; its row is appended to ``OUT/results.csv`` as soon as it
+finishes.  Rerunning a sweep skips cells that already have a row with status ``ok``
+(resume after a kill), retries failed ones, and keeps each cell's evaluation cache, so
+an interrupted cell restarts from what it had evaluated.
+
+Backends: ``local`` (a process pool sized to the machine) and ``ray`` (the same cells as
+Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import time
+import traceback
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from tqdm.auto import tqdm
+
+COLUMNS = [
+    "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
+    "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
+    "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
+    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation",
+]
+PROPOSER_METHODS = ("ours", "vlm-oneshot")
+
+
+@dataclass(frozen=True)
+class Cell:
+    maze: str
+    agent: str
+    method: str
+    proposer: str  # "none" for methods that use no proposer
+    seed: int
+    rollouts: int = 32
+    episodes: int = 200
+
+    @property
+    def id(self) -> str:
+        prop = self.proposer.replace(":", "-").replace("/", "-")
+        return f"{self.maze}__{self.agent}__{self.method}__{prop}__s{self.seed}"
+
+
+def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
+         agent: str = "point", rollouts: int = 32, episodes: int = 200) -> list[Cell]:
+    """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer."""
+    cells = []
+    for maze in mazes:
+        for method in methods:
+            props = list(proposers) if method in PROPOSER_METHODS else ["none"]
+            for proposer in props:
+                for seed in seeds:
+                    cells.append(Cell(Path(maze).stem, agent, method, proposer, int(seed), rollouts, episodes))
+    return cells
+
+
+def run_cell(cell: Cell, out_root: str) -> dict:
+    """Run one cell; never raises: a failure becomes a row with status 'error'."""
+    from .pipeline import refine_maze
+
+    row = {**asdict(cell), "cell": cell.id}
+    try:
+        result = refine_maze(cell.maze, agent=cell.agent, method=cell.method,
+                             proposer="geometric" if cell.proposer == "none" else cell.proposer, seed=cell.seed,
+                             out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes)
+    except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
+        last = traceback.format_exception_only(type(exc), exc)[-1].strip()
+        return {**row, "status": "error", "error": last[:300]}
+    d = result.data
+    lo, hi = d["success_ci"]
+    row.update({k: d[k] for k in COLUMNS if k in d and k not in row})
+    row.update(status="ok", error="", success_ci_low=lo, success_ci_high=hi,
+               proposer_is_vlm=d["proposer_is_vlm"] if cell.proposer != "none" else False)
+    return row
+
+
+def read_table(path) -> list[dict]:
+    path = Path(path)
+    if not path.exists():
+        return []
+    with path.open(newline="") as fh:
+        return [_typed(r) for r in csv.DictReader(fh)]
+
+
+def _typed(row: dict) -> dict:
+    out = {}
+    for k, v in row.items():
+        if v in ("True", "False"):
+            out[k] = v == "True"
+        else:
+            try:
+                out[k] = int(v) if k in ("seed", "episodes", "evaluations", "sim_steps", "vlm_calls") else float(v)
+            except (TypeError, ValueError):
+                out[k] = v
+    return out
+
+
+def _append(path: Path, row: dict) -> None:
+    new = not path.exists()
+    with path.open("a", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
+        if new:
+            writer.writeheader()
+        writer.writerow({k: row.get(k, "") for k in COLUMNS})
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def pending(cells: list[Cell], table: Path) -> list[Cell]:
+    done = {r["cell"] for r in read_table(table) if r.get("status") == "ok"}
+    return [c for c in cells if c.id not in done]
+
+
+def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
+              address: str | None = None, retries: int = 1) -> Path:
+    """Run every pending cell, appending rows to OUT/results.csv; returns the table's path."""
+    out_root = Path(out_root)
+    out_root.mkdir(parents=True, exist_ok=True)
+    table = out_root / "results.csv"
+    for attempt in range(retries + 1):
+        todo = pending(cells, table)
+        if not todo:
+            break
+        runner = _run_ray if backend == "ray" else _run_local
+        for row in tqdm(runner(todo, str(out_root), workers, address), total=len(todo),
+                        desc=f"sweep ({backend}, try {attempt + 1})"):
+            _append(table, row)
+    return table
+
+
+def _run_local(cells, out_root, workers, _address):
+    workers = workers or max(1, (os.cpu_count() or 1))
+    if workers == 1:
+        for cell in cells:
+            yield run_cell(cell, out_root)
+        return
+    with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init) as pool:
+        futures = [pool.submit(run_cell, cell, out_root) for cell in cells]
+        for fut in as_completed(futures):
+            yield fut.result()
+
+
+def _worker_init():
+    import torch
+
+    torch.set_num_threads(1)
+
+
+def _run_ray(cells, out_root, _workers, address):
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    remote = ray.remote(num_cpus=1)(run_cell)
+    refs = [remote.remote(cell, out_root) for cell in cells]
+    while refs:
+        ready, refs = ray.wait(refs, num_returns=1)
+        yield ray.get(ready[0])
+
+
+def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]:
+    """Mean and population std (np.std, as in the paper) of success over seeds, per group."""
+    import numpy as np
+
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        if r.get("status") == "ok":
+            groups.setdefault(tuple(r[k] for k in by), []).append(r)
+    out = []
+    for key, rs in sorted(groups.items()):
+        s = np.array([r["success_rate"] for r in rs], dtype=float)
+        v = np.array([r["graph_vertices"] for r in rs], dtype=float)
+        out.append({**dict(zip(by, key)), "runs": len(rs), "success_mean": float(s.mean()),
+                    "success_std": float(s.std()), "vertices_mean": float(v.mean()), "vertices_std": float(v.std()),
+                    "seeds": sorted(int(r["seed"]) for r in rs)})
+    return out
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    from .mazes import benchmark_mazes
+
+    p = argparse.ArgumentParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
+    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()), help="maze names or files")
+    p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
+    p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
+    p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
+    p.add_argument("--agent", default="point", choices=["point", "ant"])
+    p.add_argument("--rollouts", type=int, default=32)
+    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--out", default="runs/sweep")
+    p.add_argument("--backend", choices=["local", "ray"], default="local")
+    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: CPU count)")
+    args = p.parse_args(argv)
+    cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
+                 episodes=args.episodes)
+    t0 = time.time()
+    table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
+    rows = read_table(table)
+    failed = [r for r in rows if r.get("status") != "ok"]
+    print(f"{len(cells)} cells -> {table} ({len(failed)} failed rows) in {time.time() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
