@@ -1,9 +1,11 @@
 """Subtask evaluation: batched rollouts of the goal policy on a reach-avoid edge, and the monitor.
 
 ``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
-policy, started from ``start`` (uniform in a region, or resampled end states of a preceding edge),
-reaches ``goal`` before entering ``avoid`` (its signed distance below the agent's body radius) and
-before flipping, within ``horizon`` control steps.  The policy's goal point is ``goal_point`` if
+policy, started from ``start`` (uniform in a region where the body fits, or resampled end states of
+a preceding edge), reaches ``goal`` before entering ``avoid`` and before flipping, within
+``horizon`` control steps.  Entering means touching: ``avoid.signed_distance(xy) < avoid_radius``
+with ``avoid_radius`` = the agent's body radius + MuJoCo's contact margin (pass
+``Evaluator.avoid_radius`` to ``satisfies`` too).  The policy's goal point is ``goal_point`` if
 given, else a point sampled uniformly from ``goal`` per rollout (the paper's "representative
 waypoint randomly sampled from the inclusion set of the subtask's goal vertex").
 
@@ -176,7 +178,9 @@ class Evaluator:
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
                  cache_dir=None, nthread: int | None = None):
-        from .sim import agent_spec
+        import mujoco
+
+        from .sim import agent_spec, build_model
 
         if agent not in CELL_SIZE:
             raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(CELL_SIZE)}")
@@ -188,6 +192,14 @@ class Evaluator:
         self.n, self.seed, self.nthread = int(n), seed, nthread
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon
         self.body_radius = float(spec.body_radius)
+        model = build_model(agent, maze)
+        names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
+        wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
+        agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
+        #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
+        self.contact_margin = float(wall_margin + agent_margin)
+        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < avoid_radius
+        self.avoid_radius = self.body_radius + self.contact_margin
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
@@ -231,7 +243,7 @@ class Evaluator:
         chunks, got = [], 0
         for _ in range(64):
             pts = region.sample(max(2 * (k - got), 16), rng)
-            ok = pts[self._walls.signed_distance(pts) >= self.body_radius]
+            ok = pts[self._walls.signed_distance(pts) >= self.avoid_radius]
             chunks.append(ok[: k - got])
             got += len(chunks[-1])
             if got >= k:
@@ -250,7 +262,7 @@ class Evaluator:
                     for g, a, p in legs]
         body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
                 "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
-                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius}
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.avoid_radius}
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
@@ -369,7 +381,7 @@ class Evaluator:
             sim.reset(states=start.states[rng.integers(len(start), size=n)])
         else:
             sim.reset(xy=self.sample_free(start, n, rng), rng=rng)
-        L, H, r = len(legs), self.horizon, self.body_radius
+        L, H, r = len(legs), self.horizon, self.avoid_radius
         goal_pts = np.empty((L, n, 2))
         for k, (goal, _, point) in enumerate(legs):
             goal_pts[k] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) if point is not None \
@@ -510,20 +522,25 @@ def _topological(graph):
 
 # --- a scripted controller for the point mass ------------------------------------------------------
 class PointController:
-    """Proportional-derivative controller for the point mass: a = clip(kp (goal - xy) - kd v, -1, 1).
+    """A straight-line controller for the point mass (no learning, no knowledge of walls).
 
-    Observation layout as in :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).
-    Deterministic and training-free: a stand-in policy for tests and for notebooks without a checkpoint.
+    It tracks the velocity ``min(gain * |e|, vmax)`` towards the goal (``e`` = goal - xy) with a
+    proportional force: ``a = clip(kv * (v* - v), -1, 1)``.  Observation layout as in
+    :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).  Deterministic;
+    a stand-in policy for tests and for notebooks without a trained checkpoint.
     """
 
     agent = "point"
 
-    def __init__(self, kp: float = 2.0, kd: float = 0.3):
-        self.kp, self.kd = float(kp), float(kd)
-        self.fingerprint = f"point-pd-kp{self.kp:g}-kd{self.kd:g}"
+    def __init__(self, gain: float = 4.0, vmax: float = 2.0, kv: float = 0.2):
+        self.gain, self.vmax, self.kv = float(gain), float(vmax), float(kv)
+        self.fingerprint = f"point-line-g{self.gain:g}-v{self.vmax:g}-k{self.kv:g}"
 
     def act(self, obs, deterministic: bool = True) -> np.ndarray:
         obs = np.asarray(obs, dtype=np.float64)
-        return np.clip(self.kp * obs[:, 2:4] - self.kd * obs[:, 0:2], -1.0, 1.0)
+        e = obs[:, 2:4]
+        d = np.linalg.norm(e, axis=1, keepdims=True)
+        v_star = e * np.minimum(self.gain, self.vmax / np.maximum(d, 1e-9))
+        return np.clip(self.kv * (v_star - obs[:, 0:2]), -1.0, 1.0)
 
     __call__ = act
