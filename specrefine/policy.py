@@ -1,0 +1,133 @@
+"""The goal-conditioned subtask policy: observation normaliser + 2x256 tanh-Gaussian actor.
+
+A checkpoint is a small ``torch.save`` dict (float32 ``state_dict`` plus a few header
+fields), loaded with ``weights_only=True``; ``load_policy`` checks the header and shapes and
+turns any problem into a one-line :class:`PolicyError`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+
+from .errors import SpecrefineError
+
+FORMAT = "specrefine-policy"
+VERSION = 1
+HIDDEN = 256
+POLICY_DIR = Path(__file__).resolve().parent.parent / "data" / "policies"
+OBS_ACT_DIMS = {"point": (4, 2), "ant": (29, 8)}
+
+
+class PolicyError(SpecrefineError):
+    """A policy file is missing, corrupt, or does not fit the agent."""
+
+
+def mlp(n_in: int, n_out: int, hidden: int = HIDDEN) -> nn.Sequential:
+    return nn.Sequential(nn.Linear(n_in, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(),
+                         nn.Linear(hidden, n_out))
+
+
+class Normalizer(nn.Module):
+    """Running mean / variance of observations (parallel Welford); output clipped to +-10."""
+
+    def __init__(self, dim: int, clip: float = 10.0):
+        super().__init__()
+        self.clip = clip
+        self.register_buffer("mean", torch.zeros(dim))
+        self.register_buffer("var", torch.ones(dim))
+        self.register_buffer("count", torch.tensor(1e-4))
+
+    @torch.no_grad()
+    def update(self, x: torch.Tensor) -> None:
+        x = x.reshape(-1, self.mean.numel()).double()
+        n, m, v = x.shape[0], x.mean(0), x.var(0, unbiased=False)
+        tot = self.count.double() + n
+        delta = m - self.mean.double()
+        self.var.copy_((self.var * self.count + v * n + delta**2 * self.count * n / tot) / tot)
+        self.mean.copy_(self.mean + delta * n / tot)
+        self.count.copy_(tot)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return ((x - self.mean) / torch.sqrt(self.var + 1e-8)).clamp(-self.clip, self.clip)
+
+
+class GoalPolicy(nn.Module):
+    """``forward(obs) -> (loc, scale)`` of a Gaussian squashed by tanh into [-1, 1]."""
+
+    def __init__(self, agent: str, obs_dim: int | None = None, act_dim: int | None = None):
+        super().__init__()
+        if agent not in OBS_ACT_DIMS:
+            raise PolicyError(f"unknown agent {agent!r}; expected one of {', '.join(OBS_ACT_DIMS)}")
+        self.agent = agent
+        self.obs_dim, self.act_dim = (obs_dim, act_dim) if obs_dim else OBS_ACT_DIMS[agent]
+        self.norm = Normalizer(self.obs_dim)
+        self.net = mlp(self.obs_dim, 2 * self.act_dim)
+        self.min_scale = 1e-3
+
+    def forward(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        loc, s = self.net(self.norm(obs)).chunk(2, dim=-1)
+        return loc, nn.functional.softplus(s - 0.5) + self.min_scale  # initial scale ~0.47
+
+    @torch.no_grad()
+    def act(self, obs: np.ndarray, deterministic: bool = True, generator: torch.Generator | None = None) -> np.ndarray:
+        """Actions in [-1, 1] for a batch of observations ``(n, obs_dim)``."""
+        loc, scale = self(torch.as_tensor(np.asarray(obs, dtype=np.float32)))
+        if not deterministic:
+            loc = loc + scale * torch.randn(loc.shape, generator=generator)
+        return torch.tanh(loc).numpy()
+
+    @property
+    def fingerprint(self) -> str:
+        h = hashlib.sha1(self.agent.encode())
+        for name, t in sorted(self.state_dict().items()):
+            h.update(name.encode())
+            h.update(t.detach().cpu().float().contiguous().numpy().tobytes())
+        return h.hexdigest()[:12]
+
+
+def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    state = {k: v.detach().cpu().float().clone() for k, v in policy.state_dict().items()}
+    torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
+                "act_dim": policy.act_dim, "state_dict": state, "meta": dict(meta or {})}, path)
+
+
+def _resolve(path_or_agent) -> Path:
+    if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS:
+        return POLICY_DIR / f"{path_or_agent}.pt"
+    return Path(path_or_agent)
+
+
+def load_policy(path_or_agent) -> GoalPolicy:
+    """``'point'`` / ``'ant'`` (the shipped files) or a path -> :class:`GoalPolicy` in eval mode."""
+    path = _resolve(path_or_agent)
+    if not path.is_file():
+        raise PolicyError(f"{path}: policy file not found")
+    try:
+        blob = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as e:  # truncated zip, pickle garbage, ...
+        raise PolicyError(f"{path}: not a readable policy file ({type(e).__name__})") from None
+    if not isinstance(blob, dict) or blob.get("format") != FORMAT:
+        raise PolicyError(f"{path}: not a specrefine policy file")
+    if blob.get("version") != VERSION:
+        raise PolicyError(f"{path}: policy format version {blob.get('version')}, this code reads {VERSION}")
+    agent = blob.get("agent")
+    if agent not in OBS_ACT_DIMS or (blob.get("obs_dim"), blob.get("act_dim")) != OBS_ACT_DIMS[agent]:
+        raise PolicyError(f"{path}: agent/shape header ({agent}, {blob.get('obs_dim')}, {blob.get('act_dim')}) "
+                          "does not match a known agent")
+    if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS and agent != path_or_agent:
+        raise PolicyError(f"{path}: holds a {agent} policy, expected {path_or_agent}")
+    policy = GoalPolicy(agent)
+    try:
+        policy.load_state_dict(blob["state_dict"])
+    except (RuntimeError, KeyError, TypeError) as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
+    policy.meta = blob.get("meta", {})
+    return policy.eval()

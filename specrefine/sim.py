@@ -1,0 +1,296 @@
+"""Batched MuJoCo agents (point mass, Ant) in a maze built from a :class:`~specrefine.mazes.Maze`.
+
+One process holds the full physics state of all ``n`` rollouts as one ``(n, state_dim)`` array
+and advances them together with ``mujoco.rollout`` (a persistent thread pool, ``nthread``
+threads); no gym env per rollout.  ``benchmarks/bench_train.py`` measured this against a Python
+loop of ``mj_step(model, data, nstep=frame_skip)`` over ``n`` MjData: for 32 Ants on this 2-core
+machine rollout was faster, so it is the only code path.
+
+Physics (the same for training and evaluation; the model is built here and nowhere else):
+
+* point: Gymnasium-Robotics ``point.xml`` (sphere r = 0.1 m, gear 100, no gravity), Euler
+  integrator, timestep 0.01 s, frame_skip 5 -> control period ``dt`` = 0.05 s.  As in
+  ``PointEnv`` the planar velocity is clipped to [-5, 5] m/s (here once per control step).
+  Cell 1 m.  Observation (4) = velocity (2) + (goal - xy) (2).
+* ant: Gymnasium ``ant.xml``, RK4 integrator, timestep 0.01 s, frame_skip 5 -> ``dt`` = 0.05 s
+  (the AntMaze settings).  Cell 4 m.  Observation (29) = qpos without x, y (13) + qvel (14) +
+  goal - torso xy (2), the last expressed in the torso's heading (yaw) frame so that the
+  policy does not have to learn the rotation.  An Ant whose torso up-vector points below the
+  horizon (z-component of the body z axis < 0) is ``flipped``.
+
+Walls are static box geoms, one per part of ``maze.walls`` (``maze=None``: open floor).
+``default_horizon`` (control steps per subtask evaluation) is long enough for a trained
+policy to cover a subtask of about six cells: point 100 steps (5 s), Ant 600 steps (30 s).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import torch
+from mujoco import rollout
+from tensordict import TensorDict
+from torchrl.data import Bounded, Categorical, Composite, Unbounded
+from torchrl.envs import EnvBase
+
+from .errors import SpecrefineError
+from .mazes import Maze
+
+AGENTS = ("point", "ant")
+
+
+@dataclass(frozen=True)
+class AgentSpec:
+    xml: Path
+    integrator: int
+    timestep: float
+    frame_skip: int
+    body_radius: float
+    default_horizon: int
+    wall_half_height: float
+
+
+def _asset(module: str, *parts: str) -> Path:
+    import importlib
+
+    return Path(importlib.import_module(module).__file__).parent.joinpath(*parts)
+
+
+def agent_spec(agent: str) -> AgentSpec:
+    if agent == "point":
+        return AgentSpec(_asset("gymnasium_robotics", "envs", "assets", "point", "point.xml"),
+                         mujoco.mjtIntegrator.mjINT_EULER, 0.01, 5, 0.1, 100, 0.5)
+    if agent == "ant":
+        return AgentSpec(_asset("gymnasium", "envs", "mujoco", "assets", "ant.xml"),
+                         mujoco.mjtIntegrator.mjINT_RK4, 0.01, 5, 0.5, 600, 0.5)
+    raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(AGENTS)}")
+
+
+def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
+    """The agent's MJCF plus one static box geom per wall part of ``maze``."""
+    spec_ = agent_spec(agent)
+    spec = mujoco.MjSpec.from_file(str(spec_.xml))
+    spec.option.integrator = spec_.integrator
+    spec.option.timestep = spec_.timestep
+    if maze is not None:
+        h = spec_.wall_half_height
+        for i, box in enumerate(maze.for_agent(agent).walls.parts()):
+            x0, y0, x1, y1 = box.bounds()
+            spec.worldbody.add_geom(
+                name=f"wall_{i}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=[(x1 - x0) / 2, (y1 - y0) / 2, h], pos=[(x0 + x1) / 2, (y0 + y1) / 2, h if agent == "ant" else 0],
+                contype=1, conaffinity=1, rgba=[0.4, 0.4, 0.5, 1])
+    return spec.compile()
+
+
+class BatchedSim:
+    """``n`` copies of one agent in one maze, stepped together.  See the module docstring."""
+
+    STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+
+    def __init__(self, agent: str, maze: Maze | None, n: int, nthread: int | None = None):
+        if n < 1:
+            raise SpecrefineError(f"BatchedSim needs n >= 1 rollouts, got {n}")
+        self.agent, self.n, self.maze = agent, int(n), maze
+        self._spec = agent_spec(agent)
+        self.model = build_model(agent, maze)
+        m = self.model
+        self.frame_skip = self._spec.frame_skip
+        self.dt = self._spec.timestep * self.frame_skip
+        self.body_radius = self._spec.body_radius
+        self.default_horizon = self._spec.default_horizon
+        self.act_dim = m.nu
+        self.obs_dim = 4 if agent == "point" else (m.nq - 2) + m.nv + 2
+        self.state_dim = mujoco.mj_stateSize(m, self.STATE_SPEC)
+        self._qpos = slice(1, 1 + m.nq)  # FULLPHYSICS layout: time, qpos, qvel, act, ...
+        self._qvel = slice(1 + m.nq, 1 + m.nq + m.nv)
+        self.nthread = max(1, min(os.cpu_count() or 1, 2) if nthread is None else int(nthread))
+        self._datas = [mujoco.MjData(m) for _ in range(self.nthread)]
+        self._pool = rollout.Rollout(nthread=self.nthread if self.nthread > 1 else 0)
+        self._models = [m] * self.n  # skip_checks=True wants the per-rollout list already expanded
+        self._out = np.zeros((self.n, self.frame_skip, self.state_dim))
+        self._state = np.zeros((self.n, self.state_dim))
+        self.reset()
+
+    # --- state -------------------------------------------------------------------------------
+    def _default_state(self, k: int, rng: np.random.Generator | None) -> np.ndarray:
+        d = self._datas[0]
+        mujoco.mj_resetData(self.model, d)
+        base = np.empty(self.state_dim)
+        mujoco.mj_getState(self.model, d, base, self.STATE_SPEC)
+        states = np.tile(base, (k, 1))
+        if rng is not None and self.agent == "ant":  # Gymnasium's reset noise (0.1), not on x, y
+            nq, nv = self.model.nq, self.model.nv
+            states[:, 3:1 + nq] += rng.uniform(-0.1, 0.1, size=(k, nq - 2))
+            states[:, self._qvel] += 0.1 * rng.standard_normal((k, nv))
+        return states
+
+    def reset(self, xy=None, states=None, rng: np.random.Generator | None = None, idx=None) -> None:
+        """Place rollouts ``idx`` (default: all) at ``xy`` in the default pose, or restore ``states``."""
+        idx = np.arange(self.n) if idx is None else np.asarray(idx)
+        k = len(idx) if idx.dtype != bool else int(idx.sum())
+        if states is not None:
+            states = np.asarray(states, dtype=float)
+            if states.shape != (k, self.state_dim):
+                raise SpecrefineError(f"reset: states must have shape ({k}, {self.state_dim}), got {states.shape}")
+            self._state[idx] = states
+            return
+        new = self._default_state(k, rng)
+        if xy is not None:
+            xy = np.asarray(xy, dtype=float)
+            if xy.shape != (k, 2):
+                raise SpecrefineError(f"reset: xy must have shape ({k}, 2), got {xy.shape}")
+            new[:, 1:3] = xy
+        self._state[idx] = new
+
+    def get_state(self) -> np.ndarray:
+        return self._state.copy()
+
+    @property
+    def qpos(self) -> np.ndarray:
+        return self._state[:, self._qpos]
+
+    @property
+    def qvel(self) -> np.ndarray:
+        return self._state[:, self._qvel]
+
+    @property
+    def xy(self) -> np.ndarray:
+        return self._state[:, 1:3].copy()
+
+    @property
+    def flipped(self) -> np.ndarray:
+        if self.agent != "ant":
+            return np.zeros(self.n, dtype=bool)
+        _, qx, qy, _ = self.qpos[:, 3:7].T
+        return 1.0 - 2.0 * (qx * qx + qy * qy) < 0.0  # z-component of the torso's z axis
+
+    def _yaw(self) -> np.ndarray:
+        w, x, y, z = self.qpos[:, 3:7].T
+        return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+    # --- observe / step --------------------------------------------------------------------
+    def observe(self, goals: np.ndarray) -> np.ndarray:
+        rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
+        if self.agent == "point":
+            return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
+        c, s = np.cos(self._yaw()), np.sin(self._yaw())
+        local = np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
+        return np.concatenate([self.qpos[:, 2:], self.qvel, local], axis=1).astype(np.float32)
+
+    def step(self, actions: np.ndarray) -> None:
+        ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)
+        ctrl = np.ascontiguousarray(np.broadcast_to(ctrl, (self.n, self.frame_skip, self.act_dim)))
+        self._pool.rollout(self._models, self._datas, self._state, ctrl, nstep=self.frame_skip,
+                           state=self._out, skip_checks=True)
+        self._state[:] = self._out[:, -1]
+        if self.agent == "point":
+            np.clip(self._state[:, self._qvel], -5.0, 5.0, out=self._state[:, self._qvel])
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.close()
+            self._pool = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown
+            pass
+
+
+# --- goal-conditioned reach task for training (open floor) -----------------------------------
+@dataclass(frozen=True)
+class ReachTask:
+    goal_min: float
+    goal_max: float
+    success_radius: float
+    max_steps: int
+    progress_scale: float  # reward per metre of progress towards the goal
+    success_bonus: float
+    flip_penalty: float
+
+
+REACH_TASKS = {
+    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0),
+    "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0),
+}
+
+
+def sample_goals(xy: np.ndarray, lo: float, hi: float, rng: np.random.Generator) -> np.ndarray:
+    """Goals at a uniform distance in [lo, hi] and a uniform direction from each row of ``xy``."""
+    r = rng.uniform(lo, hi, size=len(xy))
+    a = rng.uniform(-np.pi, np.pi, size=len(xy))
+    return xy + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
+class GoalReachEnv(EnvBase):
+    """TorchRL env, batch_size [n]: reach a goal on the open floor (training task).
+
+    Reward = ``progress_scale`` x (metres closer to the goal) + ``success_bonus`` on reaching
+    it - ``flip_penalty`` on flipping.  Done on success, flip or ``max_steps``; finished
+    envs are reset by TorchRL's partial ``_reset`` (the collector does it automatically).
+    """
+
+    def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None):
+        super().__init__(batch_size=torch.Size([n]), device="cpu")
+        self.sim = BatchedSim(agent, None, n, nthread=nthread)
+        self.task = task or REACH_TASKS[agent]
+        self.rng = np.random.default_rng(seed)
+        self.goals = np.zeros((n, 2))
+        self.dist = np.zeros(n)
+        self.t = np.zeros(n, dtype=np.int64)
+        bs = self.batch_size
+        self.observation_spec = Composite(
+            observation=Unbounded((*bs, self.sim.obs_dim), dtype=torch.float32),
+            success=Categorical(2, (*bs, 1), dtype=torch.bool), flipped=Categorical(2, (*bs, 1), dtype=torch.bool),
+            shape=bs)
+        self.action_spec = Bounded(-1.0, 1.0, (*bs, self.sim.act_dim), dtype=torch.float32)
+        self.reward_spec = Unbounded((*bs, 1), dtype=torch.float32)
+
+    def _set_seed(self, seed: int | None):
+        self.rng = np.random.default_rng(seed)
+
+    def _obs_td(self, success, flipped) -> TensorDict:
+        return TensorDict({
+            "observation": torch.from_numpy(self.sim.observe(self.goals)),
+            "success": torch.from_numpy(success).unsqueeze(-1), "flipped": torch.from_numpy(flipped).unsqueeze(-1),
+        }, batch_size=self.batch_size)
+
+    def _reset(self, tensordict: TensorDict | None = None, **kwargs) -> TensorDict:
+        mask = np.ones(self.sim.n, dtype=bool)
+        if tensordict is not None and "_reset" in tensordict.keys():
+            mask = tensordict["_reset"].reshape(self.sim.n).numpy().copy()
+        idx = np.flatnonzero(mask)
+        self.sim.reset(rng=self.rng, idx=idx)
+        self.goals[idx] = sample_goals(self.sim.xy[idx], self.task.goal_min, self.task.goal_max, self.rng)
+        self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
+        self.t[idx] = 0
+        zeros = np.zeros(self.sim.n, dtype=bool)
+        out = self._obs_td(zeros, zeros)
+        out.update(self._dones(zeros, zeros))
+        return out
+
+    def _dones(self, terminated: np.ndarray, truncated: np.ndarray) -> dict:
+        t = torch.from_numpy(terminated).unsqueeze(-1)
+        tr = torch.from_numpy(truncated).unsqueeze(-1)
+        return {"terminated": t, "truncated": tr, "done": t | tr}
+
+    def _step(self, tensordict: TensorDict) -> TensorDict:
+        self.sim.step(tensordict["action"].numpy())
+        self.t += 1
+        dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
+        success, flipped = dist < self.task.success_radius, self.sim.flipped
+        task = self.task
+        reward = task.progress_scale * (self.dist - dist) + task.success_bonus * success - task.flip_penalty * flipped
+        self.dist = dist
+        terminated = success | flipped
+        truncated = ~terminated & (self.t >= task.max_steps)
+        out = self._obs_td(success, flipped)
+        out["reward"] = torch.from_numpy(reward.astype(np.float32)).unsqueeze(-1)
+        out.update(self._dones(terminated, truncated))
+        return out

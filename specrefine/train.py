@@ -1,0 +1,337 @@
+"""Goal-conditioned PPO (TorchRL building blocks), CleanRL-style: one file, one config dataclass.
+
+    python -m specrefine.train --agent point --frames 400000 --out runs/point
+    python -m specrefine.train --agent ant --frames 10000000 --out runs/ant_train --resume
+    python -m specrefine.train --agent ant --evaluate data/policies/ant.pt --episodes 500
+
+Task: reach a goal sampled on the open floor (``specrefine.sim.GoalReachEnv``); the policy never
+sees a maze.  ``OUT/`` receives ``checkpoint.pt`` (everything needed to resume), ``policy.pt``
+(the shippable policy), ``log.jsonl`` (one line per batch) and ``curve.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+from tensordict.nn import TensorDictModule
+from torch import nn
+from tqdm.auto import tqdm
+
+from .errors import SpecrefineError
+from .policy import GoalPolicy, load_policy, mlp, save_policy
+from .sim import REACH_TASKS, BatchedSim, GoalReachEnv, sample_goals
+
+
+@dataclass
+class Config:
+    agent: str = "point"
+    frames: int = 300_000
+    seed: int = 0
+    num_envs: int = 64
+    steps_per_env: int = 32          # frames per batch = num_envs * steps_per_env
+    epochs: int = 4
+    minibatch: int = 1024            # large minibatches: the update is cheap per frame
+    lr: float = 3e-4
+    anneal_lr: bool = True
+    gamma: float = 0.99
+    gae_lambda: float = 0.95
+    clip_epsilon: float = 0.2
+    entropy_coef: float = 0.0
+    critic_coef: float = 0.5
+    max_grad_norm: float = 0.5
+    torch_threads: int = 1
+    sim_threads: int = 2
+    checkpoint_every_s: float = 120.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def frames_per_batch(self) -> int:
+        return self.num_envs * self.steps_per_env
+
+
+AGENT_DEFAULTS = {
+    "point": dict(num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
+    "ant": dict(num_envs=64, steps_per_env=64, epochs=5, minibatch=2048, gamma=0.99),
+}
+
+
+def make_config(agent: str, **overrides) -> Config:
+    if agent not in AGENT_DEFAULTS:
+        raise SpecrefineError(f"unknown agent {agent!r}; expected point or ant")
+    return replace(Config(agent=agent), **{**AGENT_DEFAULTS[agent], **overrides})
+
+
+# --- networks ---------------------------------------------------------------------------------
+def make_modules(policy: GoalPolicy, env: GoalReachEnv):
+    """TorchRL wrappers: a TanhNormal ``ProbabilisticActor`` around the policy, a ``ValueOperator``."""
+    from torchrl.modules import ProbabilisticActor, TanhNormal, ValueOperator
+
+    actor = ProbabilisticActor(
+        TensorDictModule(policy, in_keys=["observation"], out_keys=["loc", "scale"]),
+        in_keys=["loc", "scale"], spec=env.action_spec, distribution_class=TanhNormal,
+        distribution_kwargs={"low": -1.0, "high": 1.0}, return_log_prob=True)
+    critic = ValueOperator(nn.Sequential(policy.norm, mlp(policy.obs_dim, 1)), in_keys=["observation"])
+    return actor, critic
+
+
+# --- training ---------------------------------------------------------------------------------
+class Trainer:
+    def __init__(self, cfg: Config, out: str | Path, resume: bool = False, progress: bool = True):
+        from torchrl.collectors import Collector
+        from torchrl.objectives import ClipPPOLoss
+        from torchrl.objectives.value import GAE
+
+        self.cfg, self.out, self.progress = cfg, Path(out), progress
+        self.out.mkdir(parents=True, exist_ok=True)
+        torch.set_num_threads(cfg.torch_threads)
+        torch.manual_seed(cfg.seed)
+        self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads)
+        self.policy = GoalPolicy(cfg.agent)
+        self.actor, self.critic = make_modules(self.policy, self.env)
+        self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
+                                entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,
+                                loss_critic_type="l2", normalize_advantage=True)
+        self.gae = GAE(gamma=cfg.gamma, lmbda=cfg.gae_lambda, value_network=self.critic, average_gae=False)
+        self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg.lr, eps=1e-5)
+        self.frames, self.iteration, self.wall = 0, 0, 0.0
+        if resume and (self.out / "checkpoint.pt").is_file():
+            self._load_checkpoint(self.out / "checkpoint.pt")
+        self.collector = Collector(self.env, self.actor, frames_per_batch=cfg.frames_per_batch, total_frames=-1,
+                                   auto_register_policy_transforms=False)
+        self.ep_return = np.zeros(cfg.num_envs)
+
+    # checkpointing
+    def _load_checkpoint(self, path: Path) -> None:
+        ck = torch.load(path, map_location="cpu", weights_only=False)
+        self.loss.load_state_dict(ck["loss"])
+        self.optim.load_state_dict(ck["optim"])
+        self.frames, self.iteration, self.wall = ck["frames"], ck["iteration"], ck.get("wall", 0.0)
+        torch.set_rng_state(ck["torch_rng"])
+        self.env.rng = np.random.default_rng(self.cfg.seed + self.iteration)
+
+    def save_checkpoint(self) -> None:
+        tmp = self.out / "checkpoint.pt.tmp"
+        torch.save({"config": asdict(self.cfg), "loss": self.loss.state_dict(), "optim": self.optim.state_dict(),
+                    "frames": self.frames, "iteration": self.iteration, "wall": self.wall,
+                    "torch_rng": torch.get_rng_state()}, tmp)
+        tmp.replace(self.out / "checkpoint.pt")
+        save_policy(self.policy, self.out / "policy.pt", {"frames": self.frames, "config": asdict(self.cfg)})
+        plot_curve(self.out / "log.jsonl", self.out / "curve.png")
+
+    # one PPO update on a collected batch
+    def update(self, batch) -> dict:
+        cfg = self.cfg
+        if cfg.anneal_lr:
+            for g in self.optim.param_groups:
+                g["lr"] = cfg.lr * max(0.05, 1.0 - self.frames / cfg.frames)
+        with torch.no_grad():
+            self.gae(batch)
+        flat = batch.reshape(-1)
+        stats = []
+        for _ in range(cfg.epochs):
+            for idx in torch.randperm(flat.shape[0]).split(cfg.minibatch):
+                losses = self.loss(flat[idx])
+                total = losses["loss_objective"] + losses["loss_critic"] + losses.get("loss_entropy", 0.0)
+                self.optim.zero_grad()
+                total.backward()
+                nn.utils.clip_grad_norm_(self.loss.parameters(), cfg.max_grad_norm)
+                self.optim.step()
+                stats.append(total.item())
+        self.policy.norm.update(batch["observation"])  # after the update: stored log-probs stay valid
+        return {"loss": float(np.mean(stats))}
+
+    def episode_stats(self, batch) -> dict:
+        nxt = batch["next"]
+        done = nxt["done"].squeeze(-1).numpy()
+        rew = nxt["reward"].squeeze(-1).numpy()
+        returns = []
+        for t in range(done.shape[1]):
+            self.ep_return += rew[:, t]
+            returns.extend(self.ep_return[done[:, t]])
+            self.ep_return[done[:, t]] = 0.0
+        n_done = int(done.sum())
+        succ = int(nxt["success"].squeeze(-1).numpy()[done].sum())
+        flips = int(nxt["flipped"].squeeze(-1).numpy()[done].sum())
+        return {"episodes": n_done, "success_rate": succ / n_done if n_done else float("nan"),
+                "flip_rate": flips / n_done if n_done else float("nan"),
+                "return": float(np.mean(returns)) if returns else float("nan")}
+
+    def train(self) -> Path:
+        cfg = self.cfg
+        bar = tqdm(total=cfg.frames, initial=min(self.frames, cfg.frames), unit="frames",
+                   disable=not self.progress, dynamic_ncols=True)
+        last_ck = time.time()
+        log = (self.out / "log.jsonl").open("a")
+        t_batch = time.time()
+        for batch in self.collector:
+            if self.frames >= cfg.frames:
+                break
+            info = self.episode_stats(batch)
+            info.update(self.update(batch))
+            self.frames += batch.numel()
+            self.iteration += 1
+            now = time.time()
+            self.wall += now - t_batch
+            info.update(frames=self.frames, iteration=self.iteration, wall_s=round(self.wall, 2),
+                        fps=round(batch.numel() / (now - t_batch), 1))
+            t_batch = now
+            log.write(json.dumps(info) + "\n")
+            log.flush()
+            bar.update(batch.numel())
+            bar.set_postfix(success=f"{info['success_rate']:.2f}", ret=f"{info['return']:.2f}", fps=int(info["fps"]))
+            if now - last_ck > cfg.checkpoint_every_s:
+                self.save_checkpoint()
+                last_ck = now
+        self.collector.shutdown()
+        log.close()
+        bar.close()
+        self.save_checkpoint()
+        return self.out / "policy.pt"
+
+
+def train(agent: str, frames: int, out, resume: bool = False, progress: bool = True, **overrides) -> Path:
+    """Train (or continue) a policy; returns the path of ``OUT/policy.pt``."""
+    return Trainer(make_config(agent, frames=frames, **overrides), out, resume, progress).train()
+
+
+# --- evaluation ---------------------------------------------------------------------------------
+def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    if n == 0:
+        return (0.0, 1.0)
+    p = successes / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return (max(0.0, c - h), min(1.0, c + h))
+
+
+def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = None, hi: float | None = None,
+                   seed: int = 0, horizon: int | None = None, nthread: int | None = None) -> dict:
+    """Deterministic policy, open floor, goals at uniform distance in [lo, hi]: success within the horizon."""
+    task = REACH_TASKS[policy.agent]
+    lo = task.goal_min if lo is None else lo
+    hi = task.goal_max if hi is None else hi
+    rng = np.random.default_rng(seed)
+    sim = BatchedSim(policy.agent, None, episodes, nthread=nthread)
+    horizon = horizon or sim.default_horizon
+    sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
+    goals = sample_goals(sim.xy, lo, hi, rng)
+    dist0 = np.linalg.norm(goals - sim.xy, axis=1)
+    active = np.ones(episodes, dtype=bool)
+    success, flipped = np.zeros(episodes, bool), np.zeros(episodes, bool)
+    steps = np.full(episodes, horizon)
+    traj = np.zeros((episodes, horizon + 1, 2))
+    traj[:, 0] = sim.xy
+    for t in range(horizon):
+        sim.step(np.where(active[:, None], policy.act(sim.observe(goals)), 0.0))
+        xy = sim.xy
+        traj[:, t + 1] = np.where(active[:, None], xy, traj[:, t])
+        hit = active & (np.linalg.norm(goals - xy, axis=1) < task.success_radius)
+        flip = active & sim.flipped & ~hit
+        success |= hit
+        flipped |= flip
+        steps[hit | flip] = t + 1
+        active &= ~(hit | flip)
+        if not active.any():
+            break
+    sim.close()
+    k = int(success.sum())
+    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goal_range_m": [lo, hi], "horizon": horizon,
+            "success_radius_m": task.success_radius, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
+            "flip_rate": float(flipped.mean()), "mean_steps_success": float(steps[success].mean()) if k else None,
+            "distance": dist0, "success": success, "flipped": flipped, "steps": steps, "trajectories": traj,
+            "goals": goals}
+
+
+def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
+    lo, hi = result["goal_range_m"]
+    edges = np.linspace(lo, hi, bins + 1)
+    rows = []
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        m = (result["distance"] >= a) & (result["distance"] < b if b < hi else result["distance"] <= b)
+        k, n = int(result["success"][m].sum()), int(m.sum())
+        rows.append({"from_m": round(float(a), 3), "to_m": round(float(b), 3), "n": n,
+                     "success_rate": k / n if n else None, "ci95": wilson(k, n)})
+    return rows
+
+
+def summary(result: dict) -> dict:
+    keep = ("agent", "episodes", "seed", "goal_range_m", "horizon", "success_radius_m", "success_rate",
+            "success_ci95", "flip_rate", "mean_steps_success")
+    return {k: result[k] for k in keep} | {"by_distance": success_by_distance(result)}
+
+
+# --- plots ------------------------------------------------------------------------------------
+def read_log(path) -> list[dict]:
+    path = Path(path)
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()] if path.is_file() else []
+
+
+def plot_curve(log_path, png_path=None, window: int = 10):
+    """Success rate, return and frames/s against frames; saved to ``png_path`` when given."""
+    import matplotlib
+
+    if png_path is not None:
+        matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    rows = read_log(log_path)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.4))
+    if rows:
+        f = np.array([r["frames"] for r in rows])
+        for ax, key in zip(axes, ("success_rate", "return", "fps"), strict=True):
+            y = np.array([np.nan if r.get(key) is None else r[key] for r in rows], dtype=float)
+            ax.plot(f, y, alpha=0.3, color="C0")
+            if len(y) >= window:
+                ax.plot(f[window - 1:], np.convolve(np.nan_to_num(y), np.ones(window) / window, "valid"), color="C0")
+            ax.set_xlabel("frames")
+            ax.set_title(key)
+            ax.grid(alpha=0.3)
+    fig.tight_layout()
+    if png_path is not None:
+        fig.savefig(png_path, dpi=90)
+        plt.close(fig)
+    return fig
+
+
+# --- command line -----------------------------------------------------------------------------
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m specrefine.train", description=__doc__.splitlines()[0])
+    ap.add_argument("--agent", choices=["point", "ant"], required=True)
+    ap.add_argument("--frames", type=int, default=None, help="total frames (default: the config's)")
+    ap.add_argument("--out", default=None, help="run directory (checkpoint, log, curve)")
+    ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--evaluate", metavar="POLICY", help="only evaluate POLICY ('point', 'ant' or a path)")
+    ap.add_argument("--episodes", type=int, default=500)
+    ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
+    ap.add_argument("--no-progress", action="store_true")
+    args = ap.parse_args(argv)
+    try:
+        if args.evaluate:
+            lo, hi = args.goal_range or (None, None)
+            res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=args.seed)
+            print(json.dumps(summary(res)))
+            return 0
+        if not args.out:
+            raise SpecrefineError("--out DIR is required for training")
+        overrides = {"seed": args.seed} | ({"frames": args.frames} if args.frames else {})
+        cfg = make_config(args.agent, **overrides)
+        path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()
+        print(f"policy written to {path}")
+        return 0
+    except SpecrefineError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
