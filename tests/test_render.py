@@ -1,0 +1,60 @@
+"""Top-down pictures: every maze renders to a PNG of the requested size, with and without trajectories."""
+
+import io
+
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from specrefine.graph import TaskGraph
+from specrefine.mazes import benchmark_mazes, load_maze
+from specrefine.regions import Box, Disc
+from specrefine.render import render_graph_diagram, render_task, save_png, to_png
+from specrefine.spec import maze_task
+
+
+def decode(png: bytes) -> np.ndarray:
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    return imread(io.BytesIO(png), format="png")
+
+
+@pytest.mark.parametrize("name", sorted(benchmark_mazes()))
+def test_every_maze_renders_at_requested_size(name):
+    maze = load_maze(name)
+    img = decode(to_png(render_task(maze, maze_task(maze), title=name, size_px=512)))
+    assert max(img.shape[:2]) == 512 and min(img.shape[:2]) >= 0.3 * 512
+    rgb = img[..., :3]
+    assert (rgb.max(axis=-1) < 0.05).mean() > 0.05  # walls are black
+    cyan = (rgb[..., 0] < 0.5) & (rgb[..., 1] > 0.7) & (rgb[..., 2] > 0.75)
+    assert cyan.sum() > 20  # the start region is visible
+    assert rgb.std() > 0.1  # not a blank picture
+
+
+def test_trajectory_picture(tmp_path):
+    maze = load_maze("split_doorway").for_agent("ant")
+    rng = np.random.default_rng(0)
+    trajs = maze.start.centre() + np.cumsum(rng.normal(0, 0.3, (12, 50, 2)), axis=1)
+    success = np.arange(12) % 2 == 0
+    fig = render_task(maze, maze_task(maze), trajectories=trajs, success=success, lengths=np.full(12, 40),
+                      waypoints=[Box(-2, 12, 2, 16), Disc(8, -10, 1.5), (4.0, 8.0)], path=["S", "G"],
+                      title="split doorway (ant)", size_px=1024, edge_labels={("S", "G"): "p=0.50"})
+    out = tmp_path / "sub" / "traj.png"
+    save_png(fig, out)
+    img = decode(out.read_bytes())
+    assert max(img.shape[:2]) == 1024
+    rgb = img[..., :3]
+    red = (rgb[..., 0] > 0.7) & (rgb[..., 1] < 0.35) & (rgb[..., 2] < 0.35)
+    green = (rgb[..., 1] > 0.45) & (rgb[..., 0] < 0.3) & (rgb[..., 2] < 0.4)
+    assert red.sum() > 50 and green.sum() > 50
+
+
+def test_graph_diagram():
+    tg = TaskGraph("S")
+    for name, x in (("S", 0), ("a", 2), ("b", 2), ("G", 4)):
+        tg.add_vertex(name, Box(x, 0, x + 1, 1))
+    for u, v in (("S", "a"), ("S", "b"), ("a", "G"), ("b", "G"), ("S", "G")):
+        tg.add_edge(u, v, Box(10, 10, 11, 11))
+    tg.finals = {"G"}
+    img = decode(to_png(render_graph_diagram(tg, {("S", "a"): 0.9, ("a", "G"): 0.5}, path=["S", "a", "G"],
+                                             title="choices", size_px=400)))
+    assert img.shape[1] == 400 and img[..., :3].std() > 0.05
