@@ -239,6 +239,14 @@ def _litellm():
     return litellm
 
 
+def _priced(lt, model: str) -> bool:
+    try:
+        info = lt.get_model_info(model)
+    except Exception:  # noqa: BLE001 - unknown to LiteLLM
+        return False
+    return bool(info.get("input_cost_per_token") or info.get("output_cost_per_token"))
+
+
 def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("_") or "model"
 
@@ -322,7 +330,7 @@ class LiteLLMClient(VLMClient):
         self._json_ok = bool(json_mode) and "response_format" in params
         local = self.provider in _LOCAL_PROVIDERS or bool(api_base and re.search(r"//(localhost|127\.|\[::1\])",
                                                                                   api_base))
-        if local:  # local servers are free: register a zero price so cost lookups never fail
+        if local and not _priced(lt, model):  # a local model LiteLLM has no price for: register it as free
             try:
                 lt.register_model({model: {"input_cost_per_token": 0.0, "output_cost_per_token": 0.0,
                                            "litellm_provider": self.provider, "mode": "chat"}})
