@@ -273,6 +273,7 @@ class VLMProposer(Proposer):
         self.name = client.name if not isinstance(client, ReplayClient) else f"{client.name} (recorded {client.model})"
         self.reask = reask
         self.max_waypoints = max_waypoints
+        self.last_messages: list[dict] | None = None  # the latest request (see vlm.messages_to_text)
 
     @property
     def calls(self) -> int:
@@ -296,6 +297,7 @@ class VLMProposer(Proposer):
         self.queries += 1
         entry = {"kind": kind, "round": round_, "accepted": [], "rejected": [], "reasked": False}
         self.history.append(entry)
+        self.last_messages = messages
         texts = self.client.complete(messages, n=w)
         out, bad = self._parse_all(texts, parse, entry, kind)
         if bad and self.reask:

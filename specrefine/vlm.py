@@ -247,6 +247,14 @@ def _priced(lt, model: str) -> bool:
     return bool(info.get("input_cost_per_token") or info.get("output_cost_per_token"))
 
 
+def _safe_url(url: str | None) -> str | None:
+    """``url`` without any ``user:password@`` part or query string."""
+    if not url:
+        return url
+    url = re.sub(r"//[^/@]*@", "//", url)
+    return url.split("?", 1)[0]
+
+
 def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("_") or "model"
 
@@ -347,10 +355,12 @@ class LiteLLMClient(VLMClient):
             return
         missing = [k for k in env.get("missing_keys", []) if not k.endswith("_API_BASE")]  # bases have defaults
         if missing and not env.get("keys_in_environment", False):
-            if self.key_var in missing:
-                missing = [self.key_var] + [k for k in missing if k != self.key_var]
-            raise VLMConfigError(f"no API key for litellm:{self.model}: set {' or '.join(missing)} in the "
-                                 f"environment (keys are read from the environment only)")
+            if self.provider == "gemini":  # either name works
+                what = "GEMINI_API_KEY (or GOOGLE_API_KEY)"
+            else:
+                what = " and ".join(sorted(missing, key=lambda k: k != self.key_var))
+            raise VLMConfigError(f"no API key for litellm:{self.model}: set {what} in the environment "
+                                 f"(keys are read from the environment only)")
 
     # -- one request -------------------------------------------------------------------------
     def complete(self, messages: list[dict], n: int = 1) -> list[str]:
@@ -401,12 +411,13 @@ class LiteLLMClient(VLMClient):
                 self._record(kw, messages, key, text_key, None, 0.0, latency, attempt, error=one_line(exc))
                 if isinstance(exc, bad_request) and not isinstance(exc, (not_found, *auth)) and (
                         "n" in kw or "response_format" in kw):
-                    dropped = [p for p in ("n", "response_format") if p in kw]
-                    log.warning("VLM %s rejected %s (%s); retrying without", self.model, "/".join(dropped),
-                                one_line(exc, 120))
-                    self._n_ok = self._n_ok and "n" not in kw
-                    self._json_ok = False if "response_format" in kw else self._json_ok
-                    n = 1 if "n" in kw else n
+                    dropped = "response_format" if "response_format" in kw else "n"  # one at a time
+                    log.warning("VLM %s rejected the request (%s); retrying without %s", self.model,
+                                one_line(exc, 120), dropped)
+                    if dropped == "response_format":
+                        self._json_ok = False
+                    else:
+                        self._n_ok, n = False, 1
                     continue
                 if isinstance(exc, auth):
                     raise VLMConfigError(f"litellm:{self.model}: the provider rejected the API key "
@@ -424,7 +435,9 @@ class LiteLLMClient(VLMClient):
                     raise VLMUnavailable(f"litellm:{self.model}: rate-limited by the provider after {attempt} "
                                          f"attempts; wait and rerun, or lower -w / the number of edges") from None
                 if isinstance(exc, retryable):
-                    where = f" at {self.api_base}" if self.api_base else ""
+                    where = f" at {_safe_url(self.api_base)}" if self.api_base else ""
+                    if self.provider.startswith("ollama") and not self.api_base:
+                        where = " (is `ollama serve` running? set OLLAMA_API_BASE if it is not at localhost:11434)"
                     raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where} after "
                                          f"{attempt} attempts ({one_line(exc, 120)})") from None
                 raise VLMError(f"litellm:{self.model}: call failed: {one_line(exc, 160)}") from None
@@ -478,7 +491,7 @@ class LiteLLMClient(VLMClient):
         params = {k: v for k, v in kw.items() if k not in ("messages", "model", "api_base")}
         record = {"v": RECORD_VERSION, "time": datetime.now(UTC).isoformat(timespec="seconds"),
                   "model": self.model, "provider": self.provider, "key": key, "text_key": text_key,
-                  "request": {"params": params, "api_base": self.api_base},
+                  "request": {"params": params, "api_base": _safe_url(self.api_base)},
                   "response": response, "cost_usd": cost, "latency_s": round(latency, 3), "attempt": attempt,
                   "error": error}
         try:
