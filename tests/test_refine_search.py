@@ -270,4 +270,4 @@ def test_tau_decides_between_refinement_and_progress(p_split, accepted):
     assert (result.refinements == 1) == accepted
     step = next(s for s in result.steps if s["event"] in ("refine-accept", "refine-declined"))
     assert step["tau"] == pytest.approx(0.02)
-    assert step["kind"] == ("refine-accept" if accepted else "refine-declined")
+    assert step["event"] == ("refine-accept" if accepted else "refine-declined")
