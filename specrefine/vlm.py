@@ -80,7 +80,7 @@ _SECRET_FIELDS = {"api_key", "apikey", "authorization", "x-api-key", "x-goog-api
 
 
 def _secret_values() -> list[str]:
-    vals = {v for k, v in os.environ.items() if _SECRET_ENV.search(k) and isinstance(v, str) and len(v) >= 6}
+    vals = {v for k, v in os.environ.items() if _SECRET_ENV.search(k) and isinstance(v, str) and len(v) >= 8}
     return sorted(vals, key=len, reverse=True)
 
 

@@ -237,6 +237,7 @@ def test_retries_429_and_500_then_succeeds(srv, tmp_path, query, caplog):
     assert any("RateLimitError" in m and "retry 1/3" in m for m in msgs)
     assert any("InternalServerError" in m and "retry 2/3" in m for m in msgs)
     assert p.calls == 1 and p.client.attempts == 3
+    assert KEY not in caplog.text
     lines = [json.loads(s) for s in (tmp_path / "rec.jsonl").read_text().splitlines()]
     assert [bool(rec["error"]) for rec in lines] == [True, True, False]
 
