@@ -176,6 +176,8 @@ class Evaluator:
     it in cache keys; without one, results are cached in memory only).
     """
 
+    MIN_BATCH = 8  # running rollouts are compacted into batches of 8, 16, 32, ... (never below 8)
+
     def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
                  cache_dir=None, nthread: int | None = None):
         import mujoco
@@ -373,6 +375,12 @@ class Evaluator:
 
     # --- the hot loop --------------------------------------------------------------------------
     def _rollout(self, start, legs, n: int, seed) -> dict:
+        """Run n episodes through ``legs``; the core loop behind ``evaluate`` and ``run_path``.
+
+        Episodes live in rows of a BatchedSim.  When at most half of the rows are still running, the
+        running ones are moved (full physics states, bit-exact) into a smaller BatchedSim (a power of
+        two, at least ``MIN_BATCH``), so finished rollouts stop costing physics.
+        """
         rng = np.random.default_rng(seed)
         sim = self.sim(n)
         if isinstance(start, StartStates):
@@ -388,7 +396,6 @@ class Evaluator:
                 else self.sample_free(goal, n, rng)
         goals = [self.compiled(g) for g, _, _ in legs]
         avoids = [self.compiled(a) for _, a, _ in legs]
-        rows = np.arange(n)
         T = L * H + 1
         traj = np.empty((n, T, 2), dtype=np.float32)
         leg = np.zeros(n, dtype=np.int64)
@@ -398,13 +405,14 @@ class Evaluator:
         outcome = np.full(n, UNFINISHED, dtype=np.int8)
         end_states = np.zeros((n, sim.state_dim))
         end_xy = np.zeros((n, 2))
-        xy = sim.xy
+        episode = np.arange(n)  # episode held by each sim row (-1: padding)
+        row = np.arange(n)  # sim row of each episode (-1: not in the sim any more)
+        xy, flipped = sim.xy, sim.flipped
         traj[:, 0] = xy
         steps = 0
 
-        def check(t: int, xy: np.ndarray) -> None:
-            """Classify the active rollouts at time t (after the step that led there)."""
-            flipped = sim.flipped
+        def check(t: int) -> None:
+            """Classify the running episodes at time t (after the step that led there)."""
             idx = np.flatnonzero(active)
             for _ in range(L + 1):  # a point may lie in several consecutive goals: advance through all of them
                 if not len(idx):
@@ -429,27 +437,41 @@ class Evaluator:
                             outcome[done] = SUCCESS
                             active[done] = False
                             lengths[done] = t + 1
-                            end_states[done] = sim.get_state()[done]
+                            end_states[done] = sim.get_state()[row[done]]
                             end_xy[done] = xy[done]
                         advanced.append(g[leg[g] < L])
                 idx = np.concatenate(advanced) if advanced else idx[:0]
 
-        check(0, xy)
+        check(0)
         import torch
 
         with torch.inference_mode():
             for t in range(1, T):
-                if not active.any():
+                running = int(active.sum())
+                if not running:
                     break
-                obs = sim.observe(goal_pts[np.minimum(leg, L - 1), rows])
+                size = max(self.MIN_BATCH, 1 << (running - 1).bit_length())
+                if size <= sim.n // 2:  # compact: move the running episodes into a smaller batch
+                    ids = np.flatnonzero(active)
+                    states = sim.get_state()[row[ids]]
+                    states = np.concatenate([states, np.repeat(states[:1], size - len(ids), axis=0)])
+                    sim = self.sim(size)
+                    sim.reset(states=states)
+                    episode = np.concatenate([ids, np.full(size - len(ids), -1)])
+                    row[:] = -1
+                    row[ids] = np.arange(len(ids))
+                live = episode >= 0
+                ep = np.where(live, episode, episode[0])
+                obs = sim.observe(goal_pts[np.minimum(leg[ep], L - 1), ep])
                 act = np.asarray(self._act(obs), dtype=np.float64)
-                act[~active] = 0.0  # frozen rollouts stay still
+                act[~(live & active[ep])] = 0.0  # finished rollouts stay still
                 sim.step(act)
-                steps += n
-                xy = sim.xy
+                steps += sim.n
+                xy[episode[live]] = sim.xy[live]
+                flipped[episode[live]] = sim.flipped[live]
                 traj[:, t] = xy
                 t_leg[active] += 1
-                check(t, xy)
+                check(t)
                 late = active & (t_leg >= H)
                 if late.any():
                     outcome[late] = TIMEOUT
@@ -457,7 +479,7 @@ class Evaluator:
                     lengths[late] = t + 1
         used = int(lengths.max(initial=1))
         pad = np.minimum(np.arange(used)[None, :], lengths[:, None] - 1)
-        traj = traj[rows[:, None], pad]
+        traj = traj[np.arange(n)[:, None], pad]
         self.sim_steps += steps
         return {"legs_done": leg, "trajectories": traj, "lengths": lengths, "outcome": outcome,
                 "end_states": end_states, "end_xy": end_xy, "steps": steps}

@@ -251,3 +251,17 @@ def test_satisfies_respects_lengths_and_body_radius():
     near_x = poly((0.5, 0.5), (4.5, 0.5), (4.5, 3.5), (3.2, 3.2), (4.5, 4.5))  # passes 0.2 from X on A -> G
     assert check(near_x, r=0.0) == [True]
     assert check(near_x, r=0.3) == [False]
+
+
+def test_compaction_of_finished_rollouts_changes_nothing_but_cost(maze):
+    plain = make(maze, n=32, horizon=60)
+    plain.MIN_BATCH = 32  # never compact
+    compact = make(maze, n=32, horizon=60)
+    # mixed lengths: most reach the nearby cell quickly, the straight line to G hits the wall early or late
+    for goal in (maze.cell_box(3, 3), maze.goal):
+        a = plain.evaluate(maze.start, goal, maze.walls, seed=5)
+        b = compact.evaluate(maze.start, goal, maze.walls, seed=5)
+        np.testing.assert_array_equal(a.trajectories, b.trajectories)
+        np.testing.assert_array_equal(a.outcome, b.outcome)
+        np.testing.assert_array_equal(a.end_states.states, b.end_states.states)
+    assert compact.sim_steps < plain.sim_steps
