@@ -227,7 +227,7 @@ def test_chain_dp_picks_best_subsets():
             pg = p_of(("at", tuple(b.centre())), goal)
             best = max(best, pa * pb * pg)
     assert choice.p == pytest.approx(best)
-    assert choice.evaluations == 6 + 36 + 6  # (k+1) + (k+1)^2 (t-1) + (k+1)
+    assert choice.evaluations == 3 + 6 + 36 + 6  # unrefined chain, then (k+1) + (k+1)^2 (t-1) + (k+1)
 
 
 def test_vertex_refinement_only_search_improves_a_path_with_a_bad_subgoal():

@@ -5,7 +5,8 @@ the edge u -> v; each candidate is evaluated subtask by subtask.  In each of the
 follow-up rounds the proposer sees every earlier candidate's per-subtask success and
 rollouts, and the new candidates are tuned by the chain vertex refinement (Algorithm 2,
 line 10 of Algorithm 1).  The best of the d x w candidates by product of success
-probabilities is returned.
+probabilities is returned.  Rounds stop early once a candidate succeeded in every rollout:
+no later candidate could be selected over it.
 """
 
 from __future__ import annotations
@@ -54,6 +55,8 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
     outcome = SplitOutcome(best=None)
     avoid, goal = query.avoid, query.goal
     for round_ in range(d):
+        if outcome.candidates and max(c.p for c in outcome.candidates) >= 1.0:
+            break  # nothing can beat a candidate that never failed (max keeps the first of ties anyway)
         feedback = [CandidateFeedback(waypoints=c.waypoints, subtask_success=c.probabilities,
                                       image_png=picture(c) if picture else None) for c in outcome.candidates]
         proposals = proposer.propose_split(query, w, feedback) if round_ else proposer.propose_split(query, w)

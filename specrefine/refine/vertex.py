@@ -4,7 +4,9 @@ For a chain u -> x_1 -> ... -> x_t -> v whose inner vertices have in/out degree 
 I(x_j) may be replaced by one of k sampled subsets (or kept).  Layer by layer, the best
 path probability to every option is kept together with the end states of its successful
 rollouts, which start the next layer (DiRL's propagation).  That evaluates
-(k+1) + (k+1)^2 (t-1) + (k+1) subtasks instead of (k+1)^t whole paths.
+(k+1) + (k+1)^2 (t-1) + (k+1) subtasks instead of (k+1)^t whole paths.  The unrefined
+chain is evaluated first (those evaluations are among the DP's own); if it never failed,
+the DP is skipped, since no choice can beat it.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..regions import Box, Disc, Region
-from .common import UNREACHED, SubtaskEvaluator, start_of
+from .common import UNREACHED, Leg, SubtaskEvaluator, evaluate_path, start_of
 
 
 def sample_subsets(region: Region, k: int, rng: np.random.Generator, shrink=(0.3, 0.7)) -> list[Region]:
@@ -65,6 +67,12 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
         nonlocal calls
         calls += 1
         return evaluator.evaluate(start_, goal_, avoid_, goal_point=point)
+
+    unrefined = evaluate_path(evaluator, start, [Leg(x, a) for x, a in zip(inner, avoids)] + [Leg(goal, avoids[-1],
+                                                                                                 goal_point)])
+    calls += len(avoids)
+    if unrefined.p >= 1.0:  # the DP cannot beat a chain that never failed
+        return ChainChoice(regions=list(inner), results=unrefined.results, p=1.0, evaluations=calls)
 
     # one Path per option of the current layer: the best way found to reach it
     layer = [_Path(r.p, [r], [i]) for i, r in enumerate(run(start, opt, avoids[0]) for opt in options[0])]

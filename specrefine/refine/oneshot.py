@@ -1,0 +1,74 @@
+"""The one-shot VLM baseline (paper Sec. 5.1).
+
+The proposer refines the WHOLE input graph in one query (with a one-shot example and its
+reasoning in the prompt), w samples per query; each proposed graph is evaluated with the
+same lazy shortest-path search as DiRL (so Theorem 4.2 holds for it); a second round feeds
+the results back.  The best of the rounds x w graphs by predicted success is returned.
+Unlike our method nothing guarantees the output implies the input: whether it does is
+reported, through the same ``check_refines`` used everywhere.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..graph import check_refines, infer_parents
+from .search import SearchResult, shortest_path
+
+
+def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0, on_step=None) -> SearchResult:
+    from ..proposers import GraphFeedback, GraphQuery
+
+    steps: list[dict] = []
+
+    def log(event, **detail):
+        step = {"step": len(steps), "event": event, **detail}
+        steps.append(step)
+        if on_step:
+            on_step(step)
+
+    base = shortest_path(original, evaluator, seed=seed)
+    query = GraphQuery(maze=maze, agent=agent, graph=original, success=base.predicted_success, n=evaluator.n,
+                       image_png=_picture(maze, evaluator, original, base), edge_success=_edge_success(base),
+                       body_radius=evaluator.body_radius)
+    log("input-evaluated", predicted_success=base.predicted_success, path=base.path)
+    best, feedback = None, []
+    for round_ in range(rounds):
+        for graph in proposer.propose_graph(query, w, feedback):
+            graph = infer_parents(graph, original)
+            result = shortest_path(graph, evaluator, seed=seed)
+            problems = check_refines(graph, original)
+            log("candidate", round=round_ + 1, predicted_success=result.predicted_success, path=result.path,
+                refines_input=not problems, violations=[str(p) for p in problems[:5]], graph=graph.to_dict())
+            feedback.append(GraphFeedback(graph=graph, edge_success=_edge_success(result),
+                                          success=result.predicted_success,
+                                          image_png=_picture(maze, evaluator, graph, result)))
+            if best is None or result.predicted_success > best.predicted_success:
+                best = result
+    if best is None:  # every reply was rejected: the input graph is all there is
+        log("no-valid-candidate")
+        best = base
+    best.steps = steps
+    log("done", predicted_success=best.predicted_success, path=best.path)
+    return best
+
+
+def _edge_success(result: SearchResult) -> dict:
+    if not result.path:
+        return {}
+    return dict(zip(zip(result.path, result.path[1:]), result.edge_probabilities))
+
+
+def _picture(maze, evaluator, graph, result):
+    """The graph on the map with rollouts of its best path (from the graph's initial set)."""
+    from ..render import render_task, to_png
+
+    if not result.path or len(result.path) < 2:
+        return to_png(render_task(maze, graph))
+    from ..evaluate import path_legs
+
+    n = min(evaluator.n, 32)
+    pr = evaluator.run_path(graph.region(graph.initial), path_legs(graph, result.path), n=n, seed=evaluator.seed)
+    fig = render_task(maze, graph, trajectories=pr.trajectories, success=np.asarray(pr.success), lengths=pr.lengths,
+                      path=result.path, title=f"predicted success {result.predicted_success:.0%}")
+    return to_png(fig)
