@@ -1,0 +1,110 @@
+"""The paper's Figures 4-6 from a sweep table (``specrefine.sweep``'s results.csv).
+
+Each figure shows mean and population standard deviation over seeds (``np.std``, as in
+the paper) and names the proposer on every panel: results from the offline proposers
+are labelled as such and never as a VLM's.
+"""
+
+from __future__ import annotations
+
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .sweep import summarise  # noqa: E402
+
+METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
+METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6c00", "ours": "#1565c0"}
+CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
+_UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")
+
+
+def proposer_label(proposer: str, rows=()) -> str:
+    vlm = any(r.get("proposer") == proposer and r.get("proposer_is_vlm") for r in rows)
+    if proposer in ("geometric", "random"):
+        return f"proposer: {proposer} (offline, not a VLM)"
+    return f"proposer: {proposer}" + (" (VLM)" if vlm else "")
+
+
+def _proposers(rows) -> list[str]:
+    return sorted({r["proposer"] for r in rows if r.get("status") == "ok" and r["proposer"] != "none"})
+
+
+def _select(summary, maze, method, proposer):
+    prop = proposer if method in ("ours", "vlm-oneshot") else "none"
+    return next((s for s in summary if s["maze"] == maze and s["method"] == method and s["proposer"] == prop), None)
+
+
+def figure4(rows, tasks=None, metric="success"):
+    """Success (or graph size, metric='vertices') per task per method, one panel per proposer."""
+    summary = summarise(rows)
+    tasks = tasks or [t for t in CORE_TASKS if any(s["maze"] == t for s in summary)]
+    proposers = _proposers(rows) or ["none"]
+    fig, axes = plt.subplots(len(proposers), 1, figsize=(max(6, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
+                             squeeze=False)
+    width = 0.8 / len(METHOD_ORDER)
+    for ax, proposer in zip(axes[:, 0], proposers):
+        for i, method in enumerate(METHOD_ORDER):
+            stats = [_select(summary, t, method, proposer) for t in tasks]
+            mean = [s[f"{metric}_mean"] if s else np.nan for s in stats]
+            std = [s[f"{metric}_std"] if s else 0 for s in stats]
+            x = np.arange(len(tasks)) + (i - (len(METHOD_ORDER) - 1) / 2) * width
+            ax.bar(x, mean, width, yerr=std, capsize=2, label=method, color=METHOD_COLOURS[method])
+        ax.set_xticks(np.arange(len(tasks)), tasks, rotation=15)
+        ax.set_ylabel("success rate" if metric == "success" else "task-graph vertices")
+        if metric == "success":
+            ax.set_ylim(0, 1.05)
+        ax.set_title(proposer_label(proposer, rows), fontsize=10)
+        ax.grid(axis="y", alpha=0.3)
+    axes[0, 0].legend(ncol=len(METHOD_ORDER), fontsize=8, loc="upper left")
+    fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
+                 if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)")
+    fig.tight_layout()
+    return fig
+
+
+def figure6(rows, tasks=None):
+    return figure4(rows, tasks, metric="vertices")
+
+
+def figure5(rows):
+    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer."""
+    summary = summarise(rows)
+    proposers = _proposers(rows) or ["none"]
+    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
+    for ax, proposer in zip(axes[0], proposers):
+        for method in METHOD_ORDER:
+            for subgoals, style in ((False, "-"), (True, "--")):
+                prop = proposer if method in ("ours", "vlm-oneshot") else "none"
+                pts = _rooms(summary, method, prop, subgoals)
+                if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
+                    pts += [p for p in _rooms(summary, method, prop, False) if p[0] == 1]
+                if not pts:
+                    continue
+                pts.sort()
+                r, mu, sd = map(np.array, zip(*pts))
+                ax.errorbar(r, mu, yerr=sd, ls=style, marker="o", capsize=3, color=METHOD_COLOURS[method],
+                            label=f"{method} ({'with' if subgoals else 'no'} subgoals)")
+        ax.set_xlabel("rooms")
+        ax.set_ylabel("success rate")
+        ax.set_ylim(0, 1.05)
+        ax.set_xticks(range(1, 6))
+        ax.grid(alpha=0.3)
+        ax.set_title(proposer_label(proposer, rows), fontsize=10)
+        ax.legend(fontsize=7)
+    fig.suptitle("Figure 5: U-chain of 1-5 rooms (mean ± std over seeds)")
+    fig.tight_layout()
+    return fig
+
+
+def _rooms(summary, method, proposer, subgoals):
+    out = []
+    for s in summary:
+        m = _UCHAIN.match(s["maze"])
+        if m and bool(m.group(2)) == subgoals and s["method"] == method and s["proposer"] == proposer:
+            out.append((int(m.group(1)), s["success_mean"], s["success_std"]))
+    return out

@@ -1,0 +1,101 @@
+"""Sweeps: stable table schema, resume after a killed run, the Ray backend on a local head."""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from specrefine.sweep import COLUMNS, grid, read_table, run_sweep, summarise
+
+TINY = dict(agent="point", rollouts=8, episodes=16)
+
+
+def tiny_cells(seeds=(0, 1)):
+    return grid(["u_maze"], ["dirl"], ["geometric"], seeds, **TINY)
+
+
+def test_grid_gives_proposer_free_methods_one_cell_per_seed():
+    cells = grid(["u_maze", "x_maze"], ["dirl", "symbolic", "ours", "vlm-oneshot"], ["geometric", "random"], [0, 1])
+    assert len(cells) == 2 * (2 + 2 * 2) * 2
+    assert {c.proposer for c in cells if c.method in ("dirl", "symbolic")} == {"none"}
+    assert len({c.id for c in cells}) == len(cells)
+
+
+def test_table_schema_is_stable(tmp_path):
+    table = run_sweep(tiny_cells(seeds=(0,)), tmp_path, workers=1)
+    with table.open() as fh:
+        header = next(csv.reader(fh))
+    assert header == COLUMNS
+    (row,) = read_table(table)
+    assert row["status"] == "ok", row["error"]
+    assert 0.0 <= row["success_ci_low"] <= row["success_rate"] <= row["success_ci_high"] <= 1.0
+    assert row["episodes"] == 16 and row["proposer"] == "none" and row["proposer_is_vlm"] is False
+    assert (tmp_path / "cells" / row["cell"] / "result.json").exists()
+
+
+def test_failed_cell_is_recorded_and_retried(tmp_path):
+    bad = grid(["no_such_maze"], ["dirl"], ["geometric"], [0], **TINY)
+    table = run_sweep(bad, tmp_path, workers=1, retries=1)
+    rows = read_table(table)
+    assert [r["status"] for r in rows] == ["error", "error"]  # first try and one retry
+    assert "no_such_maze" in rows[0]["error"]
+
+
+def test_sweep_resumes_after_kill_without_redoing_finished_cells(tmp_path):
+    seeds = "0 1 2 3"
+    cmd = [sys.executable, "-m", "specrefine.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", *seeds.split(),
+           "--rollouts", "8", "--episodes", "16", "--workers", "1", "--out", str(tmp_path)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    table = tmp_path / "results.csv"
+    deadline = time.time() + 120
+    while time.time() < deadline and len(read_table(table)) < 1:
+        time.sleep(0.2)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    first = read_table(table)
+    assert 1 <= len(first) < 4, "the sweep should have been killed midway"
+    done_before = {r["cell"] for r in first}
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=300)
+    rows = read_table(table)
+    assert sorted(r["seed"] for r in rows) == [0, 1, 2, 3]  # every cell exactly once
+    assert {r["cell"] for r in rows[: len(first)]} == done_before  # finished rows kept, not redone
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.slow
+def test_ray_backend_runs_two_cells_on_a_local_head(tmp_path):
+    ray_bin = shutil.which("ray", path=str(Path(sys.executable).parent))
+    if ray_bin is None:
+        pytest.skip("ray is not installed")
+    port = _free_port()
+    env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
+    start = [ray_bin, "start", "--head", "--node-ip-address=127.0.0.1", f"--port={port}", "--num-cpus=2",
+             "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={tmp_path / 'ray'}"]
+    subprocess.run(start, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=180)
+    try:
+        table = run_sweep(tiny_cells(), tmp_path / "out", backend="ray", address=f"127.0.0.1:{port}")
+        rows = read_table(table)
+        assert sorted(r["seed"] for r in rows) == [0, 1]
+        assert all(r["status"] == "ok" for r in rows), [r["error"] for r in rows]
+        stats = summarise(rows)
+        assert stats[0]["runs"] == 2 and stats[0]["seeds"] == [0, 1]
+    finally:
+        import ray
+
+        ray.shutdown()
+        subprocess.run([ray_bin, "stop", "--force"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                       timeout=120)
