@@ -189,6 +189,15 @@ def test_compiled_region_matches_region():
     pts = np.random.default_rng(0).uniform(-3, 4, size=(500, 2))
     np.testing.assert_allclose(CompiledRegion(region).signed_distance(pts), region.signed_distance(pts))
     np.testing.assert_array_equal(CompiledRegion(region).contains(pts), region.contains(pts))
+    # the bucketed threshold test on a big wall set is exact, including points right at the threshold
+    walls = load_maze("xx_maze_h").walls
+    compiled = CompiledRegion(walls)
+    assert len(walls.parts()) >= CompiledRegion.BUCKET_MIN_PARTS
+    x0, y0, x1, y1 = walls.bounds()
+    pts = np.random.default_rng(1).uniform((x0, y0), (x1, y1), size=(5000, 2))
+    pts[:50, 1] = 0.5 + 0.1  # exactly 0.1 above a wall edge (rows end at half-integers)
+    for thr in (0.0, 0.1, 0.5):
+        np.testing.assert_array_equal(compiled.below(pts, thr), walls.signed_distance(pts) < thr)
 
 
 # --- the monitor on hand-made trajectories ---------------------------------------------------------

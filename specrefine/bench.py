@@ -1,0 +1,164 @@
+"""Throughput benchmarks.  ``python -m specrefine.bench evaluator --agent {point,ant} [--batch 32]``
+
+Prints ONE JSON line.  ``env_steps_per_s`` is measured through the evaluator's real code path
+(:meth:`specrefine.evaluate.Evaluator.evaluate`: start sampling, policy in the loop, observation,
+batched physics, region checks, bookkeeping), counting every simulated environment step.  In the
+same run it measures the raw ceiling of the same MuJoCo model: ``mujoco.rollout`` stepping the same
+batch with random controls, as one long call (``raw_rollout_steps_per_s``) and one call per
+control step (``raw_per_step_steps_per_s``, what any step-wise loop pays), and reports the ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .mazes import load_maze
+
+
+def open_room(agent: str, cells: int | None = None):
+    """A square room with walls only around it; S in the centre, G in the middle of the top row.
+
+    Rollouts of an untrained (or trained) policy neither hit walls nor reach G within the horizon, so
+    every batch runs full length: the loop's steady-state cost, not early exits, is measured.
+    """
+    from .mazes import parse_maze
+
+    cells = cells or {"point": 61, "ant": 31}[agent]  # 30 m (point, at most 5 m/s x 5 s) / 60 m (ant) to a wall
+    rows = ["#" * cells] + ["#" + "." * (cells - 2) + "#" for _ in range(cells - 2)] + ["#" * cells]
+    mid = cells // 2
+    rows[mid] = rows[mid][:mid] + "S" + rows[mid][mid + 1:]
+    rows[1] = rows[1][:mid] + "G" + rows[1][mid + 1:]
+    return parse_maze("\n".join(rows), "open_room").for_agent(agent)
+
+
+def _cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def _policy(agent: str):
+    from .policy import POLICY_DIR, GoalPolicy, load_policy
+
+    path = POLICY_DIR / f"{agent}.pt"
+    if path.exists():
+        return load_policy(agent), f"shipped {path.relative_to(POLICY_DIR.parent.parent)}"
+    return GoalPolicy(agent).eval(), "fresh GoalPolicy (untrained, 2x256)"
+
+
+def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) -> tuple[float, float]:
+    """Steps/s of mujoco.rollout on the same model: one long call, and one call per control step."""
+    import mujoco
+    from mujoco import rollout
+
+    datas = [mujoco.MjData(model) for _ in range(nthread)]
+    d = mujoco.MjData(model)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    s0 = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, d, s0, spec)
+    state0 = np.tile(s0, (n, 1))
+    models = [model] * n
+    lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
+    ctrl = np.repeat(rng.uniform(lo, hi, size=(n, steps, 1, model.nu)), frame_skip, axis=2).reshape(n, -1, model.nu)
+    with rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
+        out = np.zeros((n, steps * frame_skip, state0.shape[1]))
+        pool.rollout(models, datas, state0, ctrl[:, : 10 * frame_skip], nstep=10 * frame_skip, skip_checks=True)
+        t = time.perf_counter()
+        pool.rollout(models, datas, state0, ctrl, nstep=steps * frame_skip, state=out, skip_checks=True)
+        long_call = n * steps / (time.perf_counter() - t)
+        state = state0.copy()
+        out1 = np.zeros((n, frame_skip, state0.shape[1]))
+        t = time.perf_counter()
+        for k in range(steps):
+            c = np.ascontiguousarray(ctrl[:, k * frame_skip:(k + 1) * frame_skip])
+            pool.rollout(models, datas, state, c, nstep=frame_skip, state=out1, skip_checks=True)
+            state[:] = out1[:, -1]
+        per_step = n * steps / (time.perf_counter() - t)
+    return long_call, per_step
+
+
+def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0, horizon: int | None = None,
+                    torch_threads: int = 1, nthread: int | None = None, scenario: str = "open",
+                    rounds: int = 3) -> dict:
+    """Evaluator env steps/s and the raw mujoco.rollout ceiling, interleaved over ``rounds`` rounds (medians)."""
+    import mujoco
+    import torch
+
+    from .evaluate import Evaluator
+
+    torch.set_num_threads(torch_threads)
+    maze = open_room(agent) if scenario == "open" else load_maze(scenario).for_agent(agent)
+    policy, policy_note = _policy(agent)
+    ev = Evaluator(maze, agent, policy, n=batch, horizon=horizon, seed=0, nthread=nthread)
+    sim = ev.sim(batch)
+    ev.evaluate(maze.start, maze.goal, maze.walls, seed=10_000)  # warm-up: builds the sims, touches every path
+    rng = np.random.default_rng(0)
+    evals, raws, per_steps, outcomes, seed, total_steps, total_time = [], [], [], {}, 0, 0, 0.0
+    for _ in range(rounds):
+        ev.sim_steps = 0
+        t0 = time.perf_counter()
+        while True:
+            res = ev.evaluate(maze.start, maze.goal, maze.walls, seed=seed)
+            seed += 1
+            for k, v in res.counts().items():
+                outcomes[k] = outcomes.get(k, 0) + v
+            if time.perf_counter() - t0 >= seconds / rounds:
+                break
+        dt = time.perf_counter() - t0
+        evals.append(ev.sim_steps / dt)
+        total_steps, total_time = total_steps + ev.sim_steps, total_time + dt
+        raw_long, raw_step = _raw_rollout(sim.model, batch, sim.frame_skip, sim.nthread, min(ev.horizon, 200), rng)
+        raws.append(raw_long)
+        per_steps.append(raw_step)
+    env_sps, raw_long, raw_step = (float(np.median(x)) for x in (evals, raws, per_steps))
+    return {
+        "bench": "evaluator", "agent": agent, "batch": batch, "env_steps_per_s": round(env_sps, 1),
+        "raw_rollout_steps_per_s": round(raw_long, 1), "ratio_vs_raw_rollout": round(env_sps / raw_long, 3),
+        "raw_per_step_steps_per_s": round(raw_step, 1), "ratio_vs_raw_per_step": round(env_sps / raw_step, 3),
+        "rounds": rounds, "per_round_ratio": [round(e / r, 3) for e, r in zip(evals, raws, strict=True)],
+        "evaluations": seed, "env_steps": total_steps, "seconds": round(total_time, 2), "horizon": ev.horizon,
+        "scenario": maze.name, "outcomes": outcomes, "policy": policy_note,
+        "integrator": {0: "Euler", 1: "RK4"}.get(int(sim.model.opt.integrator), str(int(sim.model.opt.integrator))),
+        "timestep": float(sim.model.opt.timestep), "frame_skip": sim.frame_skip, "mujoco_nthread": sim.nthread,
+        "torch_threads": torch.get_num_threads(), "cpus": os.cpu_count(), "cpu": _cpu_name(),
+        "load_avg_1m": round(os.getloadavg()[0], 2), "mujoco": mujoco.__version__, "torch": torch.__version__,
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m specrefine.bench", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="what", required=True)
+    e = sub.add_parser("evaluator", help="env steps/s of the subtask evaluator vs raw mujoco.rollout")
+    e.add_argument("--agent", choices=("point", "ant"), default="point")
+    e.add_argument("--batch", type=int, default=32)
+    e.add_argument("--seconds", type=float, default=6.0, help="time spent in the evaluator measurement")
+    e.add_argument("--horizon", type=int, default=None)
+    e.add_argument("--torch-threads", type=int, default=1)
+    e.add_argument("--nthread", type=int, default=None, help="mujoco.rollout threads (default: up to 2)")
+    e.add_argument("--scenario", default="open",
+                   help="'open' (open room, full-length rollouts) or a maze name (S -> G, early exits)")
+    e.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    import warnings
+
+    warnings.filterwarnings("ignore")
+    out = bench_evaluator(args.agent, args.batch, args.seconds, args.horizon, args.torch_threads, args.nthread,
+                          args.scenario, args.rounds)
+    print(json.dumps(out), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
