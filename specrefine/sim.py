@@ -213,11 +213,12 @@ class ReachTask:
     progress_scale: float  # reward per metre of progress towards the goal
     success_bonus: float
     flip_penalty: float
+    step_cost: float = 0.0  # per control step: without it the point learns to idle just outside the radius
 
 
 REACH_TASKS = {
-    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0),
-    "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0),
+    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02),
+    "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0, 0.0),
 }
 
 
@@ -232,7 +233,7 @@ class GoalReachEnv(EnvBase):
     """TorchRL env, batch_size [n]: reach a goal on the open floor (training task).
 
     Reward = ``progress_scale`` x (metres closer to the goal) + ``success_bonus`` on reaching
-    it - ``flip_penalty`` on flipping.  Done on success, flip or ``max_steps``; finished
+    it - ``flip_penalty`` on flipping - ``step_cost`` per step.  Done on success, flip or ``max_steps``; finished
     envs are reset by TorchRL's partial ``_reset`` (the collector does it automatically).
     """
 
@@ -286,7 +287,8 @@ class GoalReachEnv(EnvBase):
         dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
         success, flipped = dist < self.task.success_radius, self.sim.flipped
         task = self.task
-        reward = task.progress_scale * (self.dist - dist) + task.success_bonus * success - task.flip_penalty * flipped
+        reward = (task.progress_scale * (self.dist - dist) + task.success_bonus * success
+                  - task.flip_penalty * flipped - task.step_cost)
         self.dist = dist
         terminated = success | flipped
         truncated = ~terminated & (self.t >= task.max_steps)
