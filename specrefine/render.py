@@ -219,7 +219,10 @@ def draw_waypoints(ax, waypoints, *, color=CANDIDATE, prefix="x", start_index=1,
             centre = np.asarray(w, dtype=float)
             r = radius if radius is not None else 0.15 * (ax.get_xlim()[1] - ax.get_xlim()[0]) / 20
             ax.add_patch(Circle(centre, r, facecolor=color, edgecolor="black", lw=0.6, zorder=4))
-        _label(ax, centre, f"{prefix}{i}", "#b35f00", zorder=6)
+        fs = _fs(ax)
+        ax.annotate(f"{prefix}{i}", centre, xytext=(0.7 * fs, 0.7 * fs), textcoords="offset points",
+                    fontsize=0.85 * fs, color="#b35f00", fontweight="bold", zorder=7,
+                    bbox=dict(boxstyle="round,pad=0.12", fc="white", ec="#b35f00", lw=0.5, alpha=0.85))
 
 
 def draw_points(ax, points, color="black", marker=".", size=None, label=None) -> None:
