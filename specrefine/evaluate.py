@@ -3,9 +3,9 @@
 ``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
 policy, started from ``start`` (uniform in a region where the body fits, or resampled end states of
 a preceding edge), reaches ``goal`` before entering ``avoid`` and before flipping, within
-``horizon`` control steps.  Entering means touching: ``avoid.signed_distance(xy) < avoid_radius``
-with ``avoid_radius`` = the agent's body radius + MuJoCo's contact margin (pass
-``Evaluator.avoid_radius`` to ``satisfies`` too).  The policy's goal point is ``goal_point`` if
+``horizon`` control steps.  Entering means touching: ``avoid.signed_distance(xy) < body_radius``
+where ``Evaluator.body_radius`` = the simulator's body radius + MuJoCo's contact margin (pass the
+same ``Evaluator.body_radius`` to ``satisfies``).  The policy's goal point is ``goal_point`` if
 given, else a point sampled uniformly from ``goal`` per rollout (the paper's "representative
 waypoint randomly sampled from the inclusion set of the subtask's goal vertex").
 
@@ -42,6 +42,7 @@ from .mazes import CELL_SIZE, Maze
 from .regions import Box, Disc, Region
 
 CACHE_VERSION = 1
+_TINY = float(np.nextafter(0.0, 1.0))  # sd <= 0  <=>  sd < _TINY
 SUCCESS, AVOID, FLIPPED, TIMEOUT, UNFINISHED = 0, 1, 2, 3, 4
 OUTCOMES = ("success", "avoid", "flipped", "timeout", "unfinished")
 
@@ -168,7 +169,10 @@ class CompiledRegion:
         return self._rest_sd(pts, out)
 
     def contains(self, pts: np.ndarray) -> np.ndarray:
-        return self.signed_distance(pts) <= 0.0
+        """``signed_distance(pts) <= 0`` (= below the smallest positive float), exactly."""
+        if len(self.bc) < self.BUCKET_MIN_PARTS:
+            return self.signed_distance(pts) <= 0.0
+        return self.below(pts, _TINY)
 
     def _grid(self, thr: float):
         """Bucket grid: for every bucket the boxes whose bounding box grown by ``thr`` meets it."""
@@ -239,15 +243,16 @@ class Evaluator:
         self.maze, self.agent, self.policy = maze, agent, policy
         self.n, self.seed, self.nthread = int(n), seed, nthread
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon
-        self.body_radius = float(spec.body_radius)
+        self.agent_radius = float(spec.body_radius)  # BatchedSim.body_radius
         model = build_model(agent, maze)
         names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
         wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
         agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
         #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
         self.contact_margin = float(wall_margin + agent_margin)
-        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < avoid_radius
-        self.avoid_radius = self.body_radius + self.contact_margin
+        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < body_radius
+        self.body_radius = self.agent_radius + self.contact_margin
+        self.avoid_radius = self.body_radius  # alias
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
@@ -291,7 +296,7 @@ class Evaluator:
         chunks, got = [], 0
         for _ in range(64):
             pts = region.sample(max(2 * (k - got), 16), rng)
-            ok = pts[~self._walls.below(pts, self.avoid_radius)]
+            ok = pts[~self._walls.below(pts, self.body_radius)]
             chunks.append(ok[: k - got])
             got += len(chunks[-1])
             if got >= k:
@@ -310,7 +315,7 @@ class Evaluator:
                     for g, a, p in legs]
         body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
                 "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
-                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.avoid_radius}
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius}
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
@@ -435,7 +440,7 @@ class Evaluator:
             sim.reset(states=start.states[rng.integers(len(start), size=n)])
         else:
             sim.reset(xy=self.sample_free(start, n, rng), rng=rng)
-        L, H, r = len(legs), self.horizon, self.avoid_radius
+        L, H, r = len(legs), self.horizon, self.body_radius
         goal_pts = np.empty((L, n, 2))
         for k, (goal, _, point) in enumerate(legs):
             goal_pts[k] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) if point is not None \
@@ -555,10 +560,15 @@ def satisfies(graph, trajectories, lengths=None, body_radius: float = 0.0) -> np
     flat = traj.reshape(-1, 2)
     g = graph.g
     order = list(_topological(graph))
-    in_v = {v: CompiledRegion(graph.region(v)).contains(flat).reshape(n, T) for v in order}
+    def chunked(fn, *args):  # bounded memory for long trajectories x many boxes
+        return np.concatenate([fn(flat[i:i + 32768], *args) for i in range(0, len(flat), 32768)]).reshape(n, T)
+
+    compiled: dict = {}
+    comp = lambda region: compiled.setdefault(region, CompiledRegion(region))  # noqa: E731
+    in_v = {v: chunked(comp(graph.region(v)).contains) for v in order}
     bad = {}
     for u, v in graph.edges():
-        bad[(u, v)] = CompiledRegion(graph.avoid(u, v)).signed_distance(flat).reshape(n, T) < body_radius
+        bad[(u, v)] = chunked(comp(graph.avoid(u, v)).below, body_radius)
     active = {e: np.zeros(n, dtype=bool) for e in bad}
     accepted = np.zeros(n, dtype=bool)
     finals = set(graph.finals)

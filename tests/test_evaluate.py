@@ -80,9 +80,9 @@ def test_wall_contact_ends_rollout_as_failure(maze):
     assert np.all(res.outcome == AVOID)
     assert np.all(res.lengths < 81)  # ended early, not by the horizon
     last = res.trajectories[np.arange(res.n), res.lengths - 1]
-    assert np.all(maze.walls.signed_distance(last) < ev.avoid_radius)
+    assert np.all(maze.walls.signed_distance(last) < ev.body_radius)
     before = res.trajectories[np.arange(res.n), res.lengths - 2]
-    assert np.all(maze.walls.signed_distance(before) >= ev.avoid_radius)
+    assert np.all(maze.walls.signed_distance(before) >= ev.body_radius)
     # frozen after the failure: the padded tail repeats the last point
     np.testing.assert_array_equal(res.trajectories[:, -1], last)
 
@@ -168,7 +168,7 @@ def test_run_path_and_monitor_agree(maze):
     res = ev.run_path(maze.start, legs, seed=3)
     assert res.n == 24 and res.legs_done.max() <= 3
     assert res.successes > 0
-    ok = satisfies(graph, res.trajectories, res.lengths, ev.avoid_radius)
+    ok = satisfies(graph, res.trajectories, res.lengths, ev.body_radius)
     np.testing.assert_array_equal(ok, res.success)  # reaching G without touching walls = the original task
     assert len(res.leg_success) == 3
     # the direct single edge with a straight-line controller runs into the wall
@@ -196,8 +196,10 @@ def test_compiled_region_matches_region():
     x0, y0, x1, y1 = walls.bounds()
     pts = np.random.default_rng(1).uniform((x0, y0), (x1, y1), size=(5000, 2))
     pts[:50, 1] = 0.5 + 0.1  # exactly 0.1 above a wall edge (rows end at half-integers)
+    pts[50:100, 0] = np.round(pts[50:100, 0] * 2) / 2  # exactly on vertical cell edges
     for thr in (0.0, 0.1, 0.5):
         np.testing.assert_array_equal(compiled.below(pts, thr), walls.signed_distance(pts) < thr)
+    np.testing.assert_array_equal(compiled.contains(pts), walls.contains(pts))
 
 
 # --- the monitor on hand-made trajectories ---------------------------------------------------------
