@@ -252,6 +252,8 @@ class GoalReachEnv(EnvBase):
             shape=bs)
         self.action_spec = Bounded(-1.0, 1.0, (*bs, self.sim.act_dim), dtype=torch.float32)
         self.reward_spec = Unbounded((*bs, 1), dtype=torch.float32)
+        flag = Categorical(2, (*bs, 1), dtype=torch.bool)
+        self.done_spec = Composite(done=flag.clone(), terminated=flag.clone(), truncated=flag.clone(), shape=bs)
 
     def _set_seed(self, seed: int | None):
         self.rng = np.random.default_rng(seed)

@@ -1,0 +1,112 @@
+"""Batched MuJoCo simulation: shapes, seeding, walls, flips, state round trip, TorchRL env."""
+
+import numpy as np
+import pytest
+import torch
+
+from specrefine.errors import SpecrefineError
+from specrefine.mazes import parse_maze
+from specrefine.sim import BatchedSim, GoalReachEnv
+
+CORRIDOR = parse_maze("#####\n#S.G#\n#####", "corridor")
+
+
+@pytest.mark.parametrize("agent,obs_dim,act_dim", [("point", 4, 2), ("ant", 29, 8)])
+def test_shapes_and_spaces(agent, obs_dim, act_dim):
+    sim = BatchedSim(agent, CORRIDOR, 3, nthread=1)
+    assert (sim.obs_dim, sim.act_dim) == (obs_dim, act_dim)
+    assert sim.dt == pytest.approx(0.05) and sim.default_horizon > 0 and sim.body_radius > 0
+    obs = sim.observe(np.zeros((3, 2)))
+    assert obs.shape == (3, obs_dim) and obs.dtype == np.float32
+    sim.step(np.zeros((3, act_dim)))
+    assert sim.xy.shape == (3, 2) and sim.flipped.shape == (3,) and sim.get_state().shape == (3, sim.state_dim)
+
+
+def test_relative_goal_in_observation():
+    sim = BatchedSim("point", None, 2, nthread=1)
+    sim.reset(xy=np.array([[0.0, 0.0], [1.0, -1.0]]))
+    obs = sim.observe(np.array([[2.0, 0.5], [1.0, 1.0]]))
+    np.testing.assert_allclose(obs[:, 2:], [[2.0, 0.5], [0.0, 2.0]], atol=1e-6)
+
+
+@pytest.mark.parametrize("agent", ["point", "ant"])
+def test_seeded_runs_reproduce(agent):
+    def run(seed):
+        sim = BatchedSim(agent, None, 4, nthread=2)
+        rng = np.random.default_rng(seed)
+        sim.reset(xy=rng.uniform(-1, 1, (4, 2)), rng=rng)
+        for _ in range(20):
+            sim.step(rng.uniform(-1, 1, (4, sim.act_dim)))
+        return sim.get_state()
+
+    np.testing.assert_array_equal(run(3), run(3))
+    assert not np.array_equal(run(3), run(4))
+
+
+def test_walls_block_the_point():
+    maze = CORRIDOR.for_agent("point")
+    sim = BatchedSim("point", maze, 1, nthread=1)
+    start = maze.cell_to_xy(1, 1)
+    sim.reset(xy=start[None])
+    for _ in range(60):  # push full force into the wall above the start cell
+        sim.step(np.array([[0.0, 1.0]]))
+    wall_y = start[1] + maze.cell_size / 2
+    assert sim.xy[0, 1] < wall_y and sim.xy[0, 1] > wall_y - 0.2  # pressed against it, not through
+    open_sim = BatchedSim("point", None, 1, nthread=1)
+    open_sim.reset(xy=start[None])
+    for _ in range(60):
+        open_sim.step(np.array([[0.0, 1.0]]))
+    assert open_sim.xy[0, 1] > wall_y + 5
+
+
+def test_flipped_ant_is_detected():
+    sim = BatchedSim("ant", None, 2, nthread=1)
+    state = sim.get_state()
+    qw = slice(4, 8)  # state = [time, x, y, z, qw, qx, qy, qz, ...]
+    state[1, qw] = [0.0, 1.0, 0.0, 0.0]  # rotated 180 degrees about x: upside down
+    sim.reset(states=state)
+    assert sim.flipped.tolist() == [False, True]
+    sim.step(np.zeros((2, 8)))
+    assert sim.flipped.tolist() == [False, True]
+
+
+@pytest.mark.parametrize("agent", ["point", "ant"])
+def test_state_round_trip(agent):
+    rng = np.random.default_rng(0)
+    a = BatchedSim(agent, None, 3, nthread=1)
+    a.reset(xy=rng.uniform(-2, 2, (3, 2)), rng=rng)
+    for _ in range(5):
+        a.step(rng.uniform(-1, 1, (3, a.act_dim)))
+    b = BatchedSim(agent, None, 3, nthread=1)
+    b.reset(states=a.get_state())
+    acts = rng.uniform(-1, 1, (10, 3, a.act_dim))
+    for u in acts:
+        a.step(u)
+        b.step(u)
+    np.testing.assert_array_equal(a.get_state(), b.get_state())
+
+
+def test_bad_input_is_one_line_error():
+    with pytest.raises(SpecrefineError, match="unknown agent"):
+        BatchedSim("humanoid", None, 2)
+    sim = BatchedSim("point", None, 2, nthread=1)
+    with pytest.raises(SpecrefineError, match=r"xy must have shape \(2, 2\)"):
+        sim.reset(xy=np.zeros((3, 2)))
+
+
+def test_torchrl_env_partial_reset_and_termination():
+    from torchrl.envs.utils import check_env_specs
+
+    env = GoalReachEnv("point", 4, seed=0, nthread=1)
+    check_env_specs(env)
+    td = env.reset()
+    assert td["observation"].shape == (4, 4)
+    goals_before = env.goals.copy()
+    env.goals[0] = env.sim.xy[0]  # env 0 is already at its goal -> success on the next step
+    td["action"] = torch.zeros(4, 2)
+    out, nxt = env.step_and_maybe_reset(td)
+    assert bool(out["next", "success"][0]) and bool(out["next", "terminated"][0])
+    assert not out["next", "done"][1:].any()
+    assert out["next", "reward"][0].item() > 0.5  # success bonus
+    assert not np.allclose(env.goals[0], env.sim.xy[0])  # env 0 was reset with a new goal
+    np.testing.assert_array_equal(env.goals[1:], goals_before[1:])

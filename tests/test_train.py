@@ -1,0 +1,88 @@
+"""PPO training (tiny seeded point run), policy checkpoints, one-line errors on bad files."""
+
+import numpy as np
+import pytest
+import torch
+
+from specrefine.errors import SpecrefineError
+from specrefine.policy import GoalPolicy, PolicyError, load_policy, save_policy
+from specrefine.train import Trainer, evaluate_reach, make_config, read_log
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("point_run")
+    cfg = make_config("point", frames=61_440, seed=0, checkpoint_every_s=1e9)
+    path = Trainer(cfg, out, progress=False).train()
+    return out, path
+
+
+def test_tiny_training_run_improves_success(tiny_run):
+    out, path = tiny_run
+    torch.manual_seed(0)
+    untrained = evaluate_reach(GoalPolicy("point"), episodes=200, seed=5)
+    trained = evaluate_reach(load_policy(path), episodes=200, seed=5)
+    assert trained["success_rate"] >= untrained["success_rate"] + 0.3, (untrained["success_rate"],
+                                                                          trained["success_rate"])
+    rows = read_log(out / "log.jsonl")
+    assert rows[-1]["frames"] >= 61_440 and all(r["fps"] > 0 for r in rows)
+    assert (out / "curve.png").stat().st_size > 1000 and (out / "checkpoint.pt").is_file()
+
+
+def test_resume_continues_from_checkpoint(tiny_run, tmp_path):
+    out, _ = tiny_run
+    import shutil
+
+    run = tmp_path / "run"
+    shutil.copytree(out, run)
+    before = read_log(run / "log.jsonl")[-1]["frames"]
+    trainer = Trainer(make_config("point", frames=before + 2048, seed=0), run, resume=True, progress=False)
+    assert trainer.frames == before
+    trainer.train()
+    assert read_log(run / "log.jsonl")[-1]["frames"] == before + 2048
+
+
+def test_checkpoint_round_trip(tmp_path):
+    torch.manual_seed(1)
+    pol = GoalPolicy("ant")
+    pol.norm.update(torch.randn(100, 29) * 3 + 1)
+    save_policy(pol, tmp_path / "ant.pt", {"note": "x"})
+    back = load_policy(tmp_path / "ant.pt")
+    assert back.agent == "ant" and back.fingerprint == pol.fingerprint and back.meta == {"note": "x"}
+    obs = np.random.default_rng(0).normal(size=(5, 29)).astype(np.float32)
+    np.testing.assert_array_equal(back.act(obs), pol.act(obs))
+    assert (tmp_path / "ant.pt").stat().st_size < 1_000_000
+    pol.net[0].bias.data += 1
+    assert pol.fingerprint != back.fingerprint
+
+
+def _one_line_error(path, match):
+    with pytest.raises(PolicyError, match=match) as e:
+        load_policy(path)
+    assert "\n" not in str(e.value) and isinstance(e.value, SpecrefineError)
+
+
+def test_corrupt_truncated_or_wrong_files_fail_in_one_line(tmp_path):
+    good = tmp_path / "good.pt"
+    save_policy(GoalPolicy("point"), good)
+    data = good.read_bytes()
+    (tmp_path / "truncated.pt").write_bytes(data[: len(data) // 2])
+    _one_line_error(tmp_path / "truncated.pt", "not a readable policy file")
+    (tmp_path / "garbage.pt").write_bytes(b"\x00garbage" * 50)
+    _one_line_error(tmp_path / "garbage.pt", "not a readable policy file")
+    torch.save({"weights": torch.zeros(3)}, tmp_path / "other.pt")
+    _one_line_error(tmp_path / "other.pt", "not a specrefine policy file")
+    blob = torch.load(good, weights_only=True)
+    blob["state_dict"]["net.0.weight"] = torch.zeros(256, 7)
+    torch.save(blob, tmp_path / "shape.pt")
+    _one_line_error(tmp_path / "shape.pt", "weights do not fit")
+    blob["version"] = 99
+    torch.save(blob, tmp_path / "version.pt")
+    _one_line_error(tmp_path / "version.pt", "version 99")
+    _one_line_error(tmp_path / "missing.pt", "not found")
+
+
+def test_shipped_point_policy_loads():
+    pol = load_policy("point")
+    assert pol.agent == "point" and len(pol.fingerprint) == 12
+    assert np.abs(pol.act(np.zeros((3, 4), np.float32))).max() <= 1.0
