@@ -32,6 +32,7 @@ import json
 import math
 import os
 import warnings
+from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -227,6 +228,7 @@ class Evaluator:
     """
 
     MIN_BATCH = 8  # running rollouts are compacted into batches of 8, 16, 32, ... (never below 8)
+    MEMO_SIZE = 512  # results kept in memory (least recently used dropped; the disk cache keeps everything)
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
                  cache_dir=None, nthread: int | None = None):
@@ -259,7 +261,7 @@ class Evaluator:
         self.cache_hits = 0
         self._act = policy.act if hasattr(policy, "act") else policy
         self._sims: dict[int, object] = {}
-        self._memo: dict[str, EdgeResult] = {}
+        self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
         self._compiled: dict[Region, CompiledRegion] = {}
         self._walls = self.compiled(maze.walls)
         grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
@@ -373,7 +375,9 @@ class Evaluator:
         if hit is None:
             hit = self._load(key, text)
             if hit is not None:
-                self._memo[key] = replace(hit, cached=False)
+                self._remember(key, replace(hit, cached=False))
+        else:
+            self._memo.move_to_end(key)
         if hit is not None:
             self.cache_hits += 1
             return replace(hit, cached=True)
@@ -390,9 +394,16 @@ class Evaluator:
                          end_states=StartStates(out["end_states"][success], out["end_xy"][success]),
                          steps=out["steps"], outcome=out["outcome"])
         self.evaluations += 1
-        self._memo[key] = res
+        self._remember(key, res)
         self._store(key, text, res)
         return res
+
+    def _remember(self, key: str, res: EdgeResult) -> None:
+        for a in (res.success, res.trajectories, res.lengths, res.outcome, res.end_states.states, res.end_states.xy):
+            a.flags.writeable = False  # shared with the cache: read-only
+        self._memo[key] = res
+        while len(self._memo) > self.MEMO_SIZE:
+            self._memo.popitem(last=False)
 
     def evaluate_edge(self, graph, u: str, v: str, start: Region | StartStates | None = None, seed=None,
                       n: int | None = None) -> EdgeResult:
