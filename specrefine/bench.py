@@ -6,6 +6,9 @@ batched physics, region checks, bookkeeping), counting every simulated environme
 same run it measures the raw ceiling of the same MuJoCo model: ``mujoco.rollout`` stepping the same
 batch with random controls, as one long call (``raw_rollout_steps_per_s``) and one call per
 control step (``raw_per_step_steps_per_s``, what any step-wise loop pays), and reports the ratios.
+The two are interleaved over a few rounds (medians reported).  Because wall-clock rates swing when
+other jobs share the cores, the same work is also reported per CPU-second of this process
+(``*_per_cpu_s``, ``cpu_ratio_vs_raw_rollout``).
 """
 
 from __future__ import annotations
@@ -58,8 +61,8 @@ def _policy(agent: str):
     return GoalPolicy(agent).eval(), "fresh GoalPolicy (untrained, 2x256)"
 
 
-def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) -> tuple[float, float]:
-    """Steps/s of mujoco.rollout on the same model: one long call, and one call per control step."""
+def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) -> tuple[float, float, float]:
+    """Steps/s of mujoco.rollout on the same model: one long call (wall and CPU time), and one call per step."""
     import mujoco
     from mujoco import rollout
 
@@ -75,9 +78,10 @@ def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) 
     with rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
         out = np.zeros((n, steps * frame_skip, state0.shape[1]))
         pool.rollout(models, datas, state0, ctrl[:, : 10 * frame_skip], nstep=10 * frame_skip, skip_checks=True)
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         pool.rollout(models, datas, state0, ctrl, nstep=steps * frame_skip, state=out, skip_checks=True)
         long_call = n * steps / (time.perf_counter() - t)
+        long_cpu = n * steps / (time.process_time() - c)
         state = state0.copy()
         out1 = np.zeros((n, frame_skip, state0.shape[1]))
         t = time.perf_counter()
@@ -86,7 +90,7 @@ def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) 
             pool.rollout(models, datas, state, c, nstep=frame_skip, state=out1, skip_checks=True)
             state[:] = out1[:, -1]
         per_step = n * steps / (time.perf_counter() - t)
-    return long_call, per_step
+    return long_call, per_step, long_cpu
 
 
 def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0, horizon: int | None = None,
@@ -106,9 +110,10 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
     ev.evaluate(maze.start, maze.goal, maze.walls, seed=10_000)  # warm-up: builds the sims, touches every path
     rng = np.random.default_rng(0)
     evals, raws, per_steps, outcomes, seed, total_steps, total_time = [], [], [], {}, 0, 0, 0.0
+    evals_cpu, raws_cpu = [], []
     for _ in range(rounds):
         ev.sim_steps = 0
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         while True:
             res = ev.evaluate(maze.start, maze.goal, maze.walls, seed=seed)
             seed += 1
@@ -118,15 +123,22 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
                 break
         dt = time.perf_counter() - t0
         evals.append(ev.sim_steps / dt)
+        evals_cpu.append(ev.sim_steps / (time.process_time() - c0))
         total_steps, total_time = total_steps + ev.sim_steps, total_time + dt
-        raw_long, raw_step = _raw_rollout(sim.model, batch, sim.frame_skip, sim.nthread, min(ev.horizon, 200), rng)
+        raw_long, raw_step, raw_cpu = _raw_rollout(sim.model, batch, sim.frame_skip, sim.nthread,
+                                                   min(ev.horizon, 200), rng)
         raws.append(raw_long)
+        raws_cpu.append(raw_cpu)
         per_steps.append(raw_step)
-    env_sps, raw_long, raw_step = (float(np.median(x)) for x in (evals, raws, per_steps))
+    env_sps, raw_long, raw_step, env_cpu, raw_cpu = (float(np.median(x)) for x in
+                                                     (evals, raws, per_steps, evals_cpu, raws_cpu))
     return {
         "bench": "evaluator", "agent": agent, "batch": batch, "env_steps_per_s": round(env_sps, 1),
         "raw_rollout_steps_per_s": round(raw_long, 1), "ratio_vs_raw_rollout": round(env_sps / raw_long, 3),
         "raw_per_step_steps_per_s": round(raw_step, 1), "ratio_vs_raw_per_step": round(env_sps / raw_step, 3),
+        # per CPU-second of this process (all threads): robust when other jobs share the cores
+        "env_steps_per_cpu_s": round(env_cpu, 1), "raw_rollout_steps_per_cpu_s": round(raw_cpu, 1),
+        "cpu_ratio_vs_raw_rollout": round(env_cpu / raw_cpu, 3),
         "rounds": rounds, "per_round_ratio": [round(e / r, 3) for e, r in zip(evals, raws, strict=True)],
         "evaluations": seed, "env_steps": total_steps, "seconds": round(total_time, 2), "horizon": ev.horizon,
         "scenario": maze.name, "outcomes": outcomes, "policy": policy_note,
