@@ -167,7 +167,9 @@ def draw_graph(ax, graph, *, path=None, edge_labels=None, regions=True, alpha=0.
     fs = _fs(ax)
     if regions:
         for v in graph.vertices():
-            draw_region(ax, graph.region(v), _vertex_colour(graph, v), alpha=alpha, zorder=1.2, edge=True, lw=0.8)
+            region = graph.region(v)  # outline single shapes only (a union's inner seams would show)
+            draw_region(ax, region, _vertex_colour(graph, v), alpha=alpha, zorder=1.2, edge=len(region.parts()) == 1,
+                        lw=0.8)
     on_path = set(zip(path, path[1:], strict=False)) if path else set()
     pts = {v: _vertex_point(graph, v) for v in graph.vertices()}
     for u, v in graph.edges():
