@@ -103,6 +103,9 @@ class PathResult:
 
     n_legs: int = 1
 
+    def counts(self) -> dict[str, int]:
+        return {name: int(np.sum(self.outcome == i)) for i, name in enumerate(OUTCOMES) if np.any(self.outcome == i)}
+
     @property
     def leg_success(self) -> list[float | None]:
         """Empirical success probability of each leg among the episodes that started it (None: none did)."""
