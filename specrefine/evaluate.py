@@ -33,6 +33,7 @@ import math
 import os
 import warnings
 from collections import OrderedDict
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -440,6 +441,11 @@ class Evaluator:
 
     # --- the hot loop --------------------------------------------------------------------------
     def _rollout(self, start, legs, n: int, seed) -> dict:
+        # small-batch inference is fastest on one torch thread; more threads only contend with MuJoCo's
+        with _torch_threads(1):
+            return self._rollout_batches(start, legs, n, seed)
+
+    def _rollout_batches(self, start, legs, n: int, seed) -> dict:
         """Run n episodes through ``legs``; the core loop behind ``evaluate`` and ``run_path``.
 
         Episodes live in rows of a BatchedSim.  When at most half of the rows are still running, the
@@ -553,6 +559,18 @@ class Evaluator:
 def path_legs(graph, path: list[str]) -> list[tuple[Region, Region, np.ndarray | None]]:
     """Legs ``(I(v), O(u, v), point(v))`` for consecutive vertices of a path in a task graph."""
     return [(graph.region(v), graph.avoid(u, v), graph.goal_point(v)) for u, v in zip(path, path[1:], strict=False)]
+
+
+@contextmanager
+def _torch_threads(k: int):
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(k)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 # --- the monitor --------------------------------------------------------------------------------------
