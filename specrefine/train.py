@@ -345,6 +345,7 @@ def main(argv=None) -> int:
     ap.add_argument("--evaluate", metavar="POLICY", help="only evaluate POLICY ('point', 'ant' or a path)")
     ap.add_argument("--episodes", type=int, default=500)
     ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
+    ap.add_argument("--plot", metavar="PNG", help="with --evaluate: save the success-vs-distance plot here")
     ap.add_argument("--no-progress", action="store_true")
     args = ap.parse_args(argv)
     try:
@@ -352,6 +353,8 @@ def main(argv=None) -> int:
             lo, hi = args.goal_range or (None, None)
             res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=args.seed)
             print(json.dumps(summary(res)))
+            if args.plot:
+                plot_success_by_distance(res).savefig(args.plot, dpi=90)
             return 0
         if not args.out:
             raise SpecrefineError("--out DIR is required for training")
