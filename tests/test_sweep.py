@@ -9,6 +9,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -51,8 +52,8 @@ def test_failed_cell_is_recorded_and_retried(tmp_path):
 
 
 def test_sweep_resumes_after_kill_without_redoing_finished_cells(tmp_path):
-    seeds = "0 1 2 3"
-    cmd = [sys.executable, "-m", "specrefine.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", *seeds.split(),
+    cmd = [sys.executable, "-m", "specrefine.sweep", "--mazes", "u_maze", "--methods", "dirl",
+           "--seeds", "0", "1", "2", "3",
            "--rollouts", "8", "--episodes", "16", "--workers", "1", "--out", str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     table = tmp_path / "results.csv"
@@ -82,9 +83,10 @@ def test_ray_backend_runs_two_cells_on_a_local_head(tmp_path):
     if ray_bin is None:
         pytest.skip("ray is not installed")
     port = _free_port()
+    temp_dir = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # short: Ray's unix socket paths have a length limit
     env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
     start = [ray_bin, "start", "--head", "--node-ip-address=127.0.0.1", f"--port={port}", "--num-cpus=2",
-             "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={tmp_path / 'ray'}"]
+             "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={temp_dir}"]
     subprocess.run(start, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=180)
     try:
         table = run_sweep(tiny_cells(), tmp_path / "out", backend="ray", address=f"127.0.0.1:{port}")
@@ -99,3 +101,4 @@ def test_ray_backend_runs_two_cells_on_a_local_head(tmp_path):
         ray.shutdown()
         subprocess.run([ray_bin, "stop", "--force"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                        timeout=120)
+        shutil.rmtree(temp_dir, ignore_errors=True)
