@@ -16,7 +16,7 @@ import json
 import math
 import sys
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +50,6 @@ class Config:
     torch_threads: int = 1
     sim_threads: int = 2
     checkpoint_every_s: float = 120.0
-    extra: dict = field(default_factory=dict)
 
     @property
     def frames_per_batch(self) -> int:
@@ -58,8 +57,8 @@ class Config:
 
 
 AGENT_DEFAULTS = {
-    "point": dict(num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
-    "ant": dict(num_envs=64, steps_per_env=64, epochs=5, minibatch=2048, gamma=0.99),
+    "point": dict(frames=200_000, num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
+    "ant": dict(frames=10_000_000, num_envs=64, steps_per_env=64, epochs=5, minibatch=2048),
 }
 
 
