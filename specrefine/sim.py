@@ -12,6 +12,8 @@ Physics (the same for training and evaluation; the model is built here and nowhe
 * point: Gymnasium-Robotics ``point.xml`` (sphere r = 0.1 m, gear 100, no gravity), Euler
   integrator, timestep 0.01 s, frame_skip 5 -> control period ``dt`` = 0.05 s.  As in
   ``PointEnv`` the planar velocity is clipped to [-5, 5] m/s (here once per control step).
+  Unlike ``PointEnv`` the action is clipped to the unit disc, not the unit square: with a
+  per-axis bound, diagonal thrust is free and a learned policy swings wide arcs that hit walls.
   Cell 1 m.  Observation (4) = velocity (2) + (goal - xy) (2).
 * ant: Gymnasium ``ant.xml``, RK4 integrator, timestep 0.01 s, frame_skip 5 -> ``dt`` = 0.05 s
   (the AntMaze settings).  Cell 4 m.  Observation (29) = qpos without x, y (13) + qvel (14) +
@@ -186,6 +188,8 @@ class BatchedSim:
 
     def step(self, actions: np.ndarray) -> None:
         ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)
+        if self.agent == "point":  # force bounded in norm, not per axis: then straight is the fastest way to a goal
+            ctrl /= np.maximum(np.linalg.norm(ctrl, axis=-1, keepdims=True), 1.0)
         ctrl = np.ascontiguousarray(np.broadcast_to(ctrl, (self.n, self.frame_skip, self.act_dim)))
         self._pool.rollout(self._models, self._datas, self._state, ctrl, nstep=self.frame_skip,
                            state=self._out, skip_checks=True)
@@ -216,10 +220,13 @@ class ReachTask:
     success_bonus: float
     flip_penalty: float
     step_cost: float = 0.0  # per control step: without it the point learns to idle just outside the radius
+    arrive_speed: float | None = None  # success also needs a planar speed below this (m/s): arrive under control
+    lateral_cost: float = 0.0  # per metre moved across the line to the goal: keeps paths straight in corridors
 
 
 REACH_TASKS = {
-    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02),
+    # the point (up to 5 m/s in 1 m corridors) must arrive slowly, or the next subtask starts by hitting a wall
+    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02, arrive_speed=1.0, lateral_cost=0.5),
     "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0, 0.0),
 }
 
@@ -285,14 +292,24 @@ class GoalReachEnv(EnvBase):
         tr = torch.from_numpy(truncated).unsqueeze(-1)
         return {"terminated": t, "truncated": tr, "done": t | tr}
 
+    def _sideways(self, before: np.ndarray) -> np.ndarray:
+        """Distance moved across the line from the previous position to the goal, this step."""
+        to_goal = self.goals - before
+        unit = to_goal / np.maximum(np.linalg.norm(to_goal, axis=1, keepdims=True), 1e-9)
+        moved = self.sim.xy - before
+        return np.abs(moved[:, 0] * unit[:, 1] - moved[:, 1] * unit[:, 0])
+
     def _step(self, tensordict: TensorDict) -> TensorDict:
+        before = self.sim.xy.copy()
         self.sim.step(tensordict["action"].numpy())
         self.t += 1
         dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
         success, flipped = dist < self.task.success_radius, self.sim.flipped
         task = self.task
+        if task.arrive_speed is not None:
+            success &= np.linalg.norm(self.sim.qvel[:, :2], axis=1) < task.arrive_speed
         reward = (task.progress_scale * (self.dist - dist) + task.success_bonus * success
-                  - task.flip_penalty * flipped - task.step_cost)
+                  - task.flip_penalty * flipped - task.step_cost - task.lateral_cost * self._sideways(before))
         self.dist = dist
         terminated = success | flipped
         truncated = ~terminated & (self.t >= task.max_steps)
