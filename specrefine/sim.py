@@ -59,9 +59,13 @@ class AgentSpec:
 
 
 def _asset(module: str, *parts: str) -> Path:
-    import importlib
+    """A file shipped inside an installed package, found without importing it (gymnasium_robotics warns at import)."""
+    import importlib.util
 
-    return Path(importlib.import_module(module).__file__).parent.joinpath(*parts)
+    spec = importlib.util.find_spec(module)
+    if spec is None or spec.origin is None:
+        raise SpecrefineError(f"package {module!r} is not installed; it provides the agent's MuJoCo model")
+    return Path(spec.origin).parent.joinpath(*parts)
 
 
 def agent_spec(agent: str) -> AgentSpec:
