@@ -231,24 +231,8 @@ def test_chain_dp_picks_best_subsets():
 
 
 def test_vertex_refinement_only_search_improves_a_path_with_a_bad_subgoal():
-    g = TaskGraph("S")
-    g.add_vertex("S", box_at(0, 0))
-    g.add_vertex("a", Box(3, -2, 7, 2))
-    g.add_vertex("G", box_at(10, 0))
-    g.add_edge("S", "a", WALLS)
-    g.add_edge("a", "G", WALLS)
-    g.finals = {"G"}
-
-    def p_of(start, goal):
-        if goal.centre()[0] == 10:  # from a, success falls with the size of the region we left from
-            return 0.9 if start[1][1] < 8 else 0.2
-        return 0.9
-
-    class Ev(TableEvaluator):
-        def evaluate(self, start, goal_, avoid, goal_point=None, seed=None):
-            return _Arrive(self.p_of(start, goal_), at=(0.0, goal_.area))
-
-    result = RefinementSearch(g, Ev(p_of), config=SearchConfig(edge_refinement=False, k=5, seed=1)).run()
+    g = _bad_subgoal_graph()
+    result = RefinementSearch(g, _SmallIsBetter(), config=SearchConfig(edge_refinement=False, k=5, seed=1)).run()
     assert result.refinements >= 1
     assert result.predicted_success == pytest.approx(0.81)
     assert result.graph.region("a").area < 8
@@ -271,3 +255,45 @@ def test_tau_decides_between_refinement_and_progress(p_split, accepted):
     step = next(s for s in result.steps if s["event"] in ("refine-accept", "refine-declined"))
     assert step["tau"] == pytest.approx(0.02)
     assert step["event"] == ("refine-accept" if accepted else "refine-declined")
+
+
+def _bad_subgoal_graph():
+    g = TaskGraph("S")
+    g.add_vertex("S", box_at(0, 0))
+    g.add_vertex("a", Box(3, -2, 7, 2))
+    g.add_vertex("G", box_at(10, 0))
+    g.add_edge("S", "a", WALLS)
+    g.add_edge("a", "G", WALLS)
+    g.finals = {"G"}
+    return g
+
+
+class _SmallIsBetter(TableEvaluator):
+    """From a small region the next subtask is easy; from a big one it is hard."""
+
+    def __init__(self):
+        super().__init__(lambda start, goal: 0.9 if goal.centre()[0] != 10 else (0.9 if start[1][1] < 8 else 0.2))
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
+        return _Arrive(self.p_of(start, goal), at=(0.0, goal.area))
+
+
+def test_every_accepted_refinement_is_checked(monkeypatch):
+    import specrefine.refine.search as search_module
+
+    calls = []
+    real = search_module.assert_refines
+    monkeypatch.setattr(search_module, "assert_refines", lambda g, o: calls.append(1) or real(g, o))
+    result = RefinementSearch(_bad_subgoal_graph(), _SmallIsBetter(),
+                              config=SearchConfig(edge_refinement=False, seed=1)).run()
+    assert result.refinements >= 1 and len(calls) == result.refinements
+
+
+def test_an_invalid_refinement_is_a_bug_not_a_warning(monkeypatch):
+    """A vertex 'subset' that leaves I(v) must stop the search (Theorem 4.1 would not hold)."""
+    import specrefine.refine.vertex as vertex_module
+    from specrefine.errors import InvalidRefinement
+
+    monkeypatch.setattr(vertex_module, "sample_subsets", lambda region, k, rng, shrink=None: [Box(20, 20, 21, 21)] * k)
+    with pytest.raises(InvalidRefinement, match="not a subset"):
+        RefinementSearch(_bad_subgoal_graph(), _SmallIsBetter(), config=SearchConfig(edge_refinement=False)).run()
