@@ -230,7 +230,7 @@ class ReachTask:
 
 REACH_TASKS = {
     # the point (up to 5 m/s in 1 m corridors) must arrive slowly, or the next subtask starts by hitting a wall
-    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02, arrive_speed=1.0, lateral_cost=0.5),
+    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02, arrive_speed=1.0, lateral_cost=2.0),
     "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0, 0.0),
 }
 
