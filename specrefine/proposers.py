@@ -47,12 +47,19 @@ from .vlm import (
 log = logging.getLogger(__name__)
 
 #: what the prompt says about each agent, and its body radius in metres (as in ``specrefine.sim``)
+# (description, body radius in m, reach in m: the goal distance the pretrained policy was trained and checked on)
 AGENT_INFO = {
     "point": ("a point mass (a small ball driven by a 2-D force, as in Gymnasium-Robotics PointMaze); it is fast "
-              "and agile but can overshoot a target and slide along walls", 0.1),
+              "and agile but can overshoot a target and slide along walls", 0.1, 3.0),
     "ant": ("the MuJoCo Ant, a four-legged walking robot (as in Gymnasium-Robotics AntMaze); it is slow to turn, "
-            "can catch its legs on corners and can flip over", 0.5),
+            "can catch its legs on corners and can flip over", 0.5, 6.0),
 }
+
+
+def reach_cells(maze, agent: str) -> int:
+    """How many cells one subtask should span at most: the policy's reach, at least one cell."""
+    reach = AGENT_INFO.get(agent, (None, None, None))[2]
+    return 6 if reach is None else max(1, int(reach // maze.cell_size))
 
 
 # --------------------------------------------------------------------------------------------
@@ -124,9 +131,12 @@ def _rj(region: Region) -> str:
 
 def environment_text(maze, agent: str, body_radius: float | None = None) -> str:
     """The environment description in every prompt: maze geometry and frame, agent, body size."""
-    desc, default_r = AGENT_INFO.get(agent, (f"the {agent} agent", None))
+    desc, default_r, reach = AGENT_INFO.get(agent, (f"the {agent} agent", None, None))
     r = body_radius if body_radius is not None else default_r
     lines = [maze.describe(), f"Agent: {agent}, {desc}."]
+    if reach is not None:
+        lines.append(f"Policy: a goal-conditioned policy pretrained on an open floor to reach goal points up to "
+                     f"{reach:g} m away; it knows nothing about walls (they are the task graph's job).")
     if r is not None:
         lines.append(f"Body size: the agent's position is its centre; it counts as touching a wall when its centre "
                      f"comes within {r:g} m of one, so keep waypoints at least that far from walls.")
@@ -449,7 +459,8 @@ class _GridProposer(Proposer):
                 out.append(cand)
         return out
 
-    def _split_for(self, maze, start: Region, goal: Region, j: int, rng) -> list[Region]:  # pragma: no cover
+    def _split_for(self, maze, start: Region, goal: Region, j: int, rng,
+                   agent: str = "") -> list[Region]:  # pragma: no cover
         raise NotImplementedError
 
     def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
@@ -460,7 +471,7 @@ class _GridProposer(Proposer):
             if feedback:
                 cand = self._adapt(q, list(feedback), j, self.rng)
             for _ in range(6):  # distinct samples
-                cand = cand or self._split_for(q.maze, q.start, q.goal, j, self.rng)
+                cand = cand or self._split_for(q.maze, q.start, q.goal, j, self.rng, q.agent)
                 if self._dedupe(out + [cand]) == out + [cand]:
                     break
                 cand = None
@@ -491,7 +502,7 @@ class _GridProposer(Proposer):
                 g = q.graph.copy()
                 targets = g.edges()
             for u, v in targets:
-                wps = self._split_for(q.maze, g.region(u), g.region(v), j, self.rng)
+                wps = self._split_for(q.maze, g.region(u), g.region(v), j, self.rng, q.agent)
                 splice(g, u, v, wps)
             out.append(g)
         self.history.append({"kind": "task graph", "round": 1 + bool(feedback),
@@ -553,13 +564,17 @@ class GeometricProposer(_GridProposer):
             inner = [len(pts) // 2]
         return [pts[i] for i in inner]
 
-    def _split_for(self, maze, start: Region, goal: Region, j: int, rng) -> list[Region]:
+    def _split_for(self, maze, start: Region, goal: Region, j: int, rng, agent: str = "") -> list[Region]:
         a, b = np.asarray(start.centre(), float), np.asarray(goal.centre(), float)
+        reach = reach_cells(maze, agent)
         if j == 0:
-            margin, max_leg, jitter, fixed_r = 0.35, 6, 0.0, 0.4
+            margin, max_leg, jitter, fixed_r = 0.35, reach, 0.0, 0.4
         else:
-            margin, max_leg, jitter, fixed_r = rng.uniform(0.2, 0.45), int(rng.integers(3, 8)), 0.12, None
+            margin, max_leg, jitter, fixed_r = rng.uniform(0.2, 0.45), int(rng.integers(1, 2 * reach + 2)), 0.12, None
         pts = self._route_points(maze, a, b, j, rng, margin, max_leg)
+        while len(pts) > self.max_waypoints and max_leg < 4 * reach + 8:  # too many: longer legs, turns kept
+            max_leg += 1
+            pts = self._route_points(maze, a, b, j, rng, margin, max_leg)
         pts = [p for p in pts if not (bool(start.contains(p)) or bool(goal.contains(p)))]
         if j and len(pts) > 1:  # drop redundant waypoints (neighbours still see each other) now and then
             kept = []
@@ -606,7 +621,7 @@ class GeometricProposer(_GridProposer):
                [np.asarray(q.goal.centre(), float)]
         a, b = ends[leg], ends[leg + 1]
         if j % 2 == 0:
-            new = self._route_points(maze, a, b, 0, rng, 0.35, 6)
+            new = self._route_points(maze, a, b, 0, rng, 0.35, reach_cells(maze, q.agent))
         else:
             cells = grid_path(maze, _nearest_free_cell(maze, a), _nearest_free_cell(maze, b))
             new = [maze.cell_to_xy(*cells[len(cells) // 2])] if len(cells) >= 3 else []
@@ -633,7 +648,7 @@ class RandomProposer(_GridProposer):
     spec = "random"
     name = "random (offline ablation, not a VLM)"
 
-    def _split_for(self, maze, start: Region, goal: Region, j: int, rng) -> list[Region]:
+    def _split_for(self, maze, start: Region, goal: Region, j: int, rng, agent: str = "") -> list[Region]:
         k = int(rng.integers(1, 5))
         out = []
         while len(out) < k:
