@@ -44,7 +44,7 @@ def figure4(rows, tasks=None, metric="success"):
     summary = summarise(rows)
     tasks = tasks or [t for t in CORE_TASKS if any(s["maze"] == t for s in summary)]
     proposers = _proposers(rows) or ["none"]
-    fig, axes = plt.subplots(len(proposers), 1, figsize=(max(6, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
+    fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
                              squeeze=False)
     width = 0.8 / len(METHOD_ORDER)
     for ax, proposer in zip(axes[:, 0], proposers):
@@ -62,7 +62,8 @@ def figure4(rows, tasks=None, metric="success"):
         ax.grid(axis="y", alpha=0.3)
     axes[0, 0].legend(ncol=len(METHOD_ORDER), fontsize=8, loc="upper left")
     fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
-                 if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)")
+                 if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
+                 fontsize=11)
     fig.tight_layout()
     return fig
 
@@ -108,3 +109,38 @@ def _rooms(summary, method, proposer, subgoals):
         if m and bool(m.group(2)) == subgoals and s["method"] == method and s["proposer"] == proposer:
             out.append((int(m.group(1)), s["success_mean"], s["success_std"]))
     return out
+
+
+def markdown_table(rows, by=("maze", "method", "proposer")) -> str:
+    """Mean ± population std of success (and graph size) over seeds, as a markdown table."""
+    lines = ["| maze | method | proposer | runs | success (mean ± std) | graph vertices |", "|---|---|---|---|---|---|"]
+    for s in summarise(rows, by):
+        lines.append(f"| {s['maze']} | {s['method']} | {s['proposer']} | {s['runs']} | "
+                     f"{s['success_mean']:.3f} ± {s['success_std']:.3f} | {s['vertices_mean']:.1f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    import argparse
+    from pathlib import Path
+
+    from .sweep import read_table
+
+    p = argparse.ArgumentParser(prog="python -m specrefine.figures", description="Figures 4-6 from a sweep table")
+    p.add_argument("table", help="results.csv written by specrefine.sweep")
+    p.add_argument("--out", default=None, help="folder for figure4/5/6.png and summary.md (default: the table's)")
+    args = p.parse_args(argv)
+    rows = read_table(args.table)
+    out = Path(args.out or Path(args.table).parent)
+    out.mkdir(parents=True, exist_ok=True)
+    for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
+        fig = make(rows)
+        fig.savefig(out / f"{name}.png", dpi=110)
+        plt.close(fig)
+    (out / "summary.md").write_text(markdown_table(rows) + "\n")
+    print(f"{len(rows)} rows -> {out}/figure4.png, figure5.png, figure6.png, summary.md")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
