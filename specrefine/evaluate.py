@@ -263,6 +263,7 @@ class Evaluator:
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
         self.cache_hits = 0
+        self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
         self._act = policy.act if hasattr(policy, "act") else policy
         self._sims: dict[int, object] = {}
         self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
@@ -379,6 +380,7 @@ class Evaluator:
         if hit is None:
             hit = self._load(key, text)
             if hit is not None:
+                self.disk_hits += 1
                 self._remember(key, replace(hit, cached=False))
         else:
             self._memo.move_to_end(key)

@@ -185,7 +185,9 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "success_rate": measured.rate, "success_ci": list(wilson_ci(n_ok, n)), "episodes": n,
         "path_success_rate": float(measured.path_result.p) if measured.path_result else 0.0,
         "predicted_success": search.predicted_success, "edge_probabilities": search.edge_probabilities,
-        "evaluations": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
+        # evaluations the result rests on: simulated now, or by an earlier run of the same --out (resume)
+        "evaluations": evaluator.evaluations + getattr(evaluator, "disk_hits", 0),
+        "evaluations_simulated": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
         "sim_steps": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
         "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,

@@ -5,8 +5,8 @@ I(x_j) may be replaced by one of k sampled subsets (or kept).  Layer by layer, t
 path probability to every option is kept together with the end states of its successful
 rollouts, which start the next layer (DiRL's propagation).  That evaluates
 (k+1) + (k+1)^2 (t-1) + (k+1) subtasks instead of (k+1)^t whole paths.  The unrefined
-chain is evaluated first (those evaluations are among the DP's own); if it never failed,
-the DP is skipped, since no choice can beat it.
+chain is evaluated first: if it never failed the DP is skipped, and otherwise its
+probability bounds the DP (a partial path that is already less likely is not extended).
 """
 
 from __future__ import annotations
@@ -75,11 +75,14 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
         return ChainChoice(regions=list(inner), results=unrefined.results, p=1.0, evaluations=calls)
 
     # one Path per option of the current layer: the best way found to reach it
+    bound = unrefined.p
     layer = [_Path(r.p, [r], [i]) for i, r in enumerate(run(start, opt, avoids[0]) for opt in options[0])]
     for j in range(1, len(inner)):
-        layer = [_best_extension(layer, i, lambda last, o=opt, a=avoids[j]: run(start_of(last), o, a))
+        layer = [_best_extension(layer, i, lambda last, o=opt, a=avoids[j]: run(start_of(last), o, a), bound)
                  for i, opt in enumerate(options[j])]
-    best = _best_extension(layer, None, lambda last: run(start_of(last), goal, avoids[-1], goal_point))
+    best = _best_extension(layer, None, lambda last: run(start_of(last), goal, avoids[-1], goal_point), bound)
+    if best.p <= bound:  # nothing beat the chain as proposed
+        return ChainChoice(regions=list(inner), results=unrefined.results, p=unrefined.p, evaluations=calls)
     chosen = [options[j][i] for j, i in enumerate(best.choices)]
     return ChainChoice(regions=chosen, results=best.results, p=best.p, evaluations=calls)
 
@@ -91,11 +94,15 @@ class _Path:
     choices: list[int]
 
 
-def _best_extension(layer: list[_Path], option: int | None, extend) -> _Path:
-    """max over previous options l of p_l * p(l -> option); options nobody reached keep p = 0."""
+def _best_extension(layer: list[_Path], option: int | None, extend, bound: float = 0.0) -> _Path:
+    """max over previous options l of p_l * p(l -> option); options nobody reached keep p = 0.
+
+    A partial path no more likely than ``bound`` is not extended: probabilities only shrink along a
+    path, so it cannot end above the bound (branch and bound; the result is unchanged).
+    """
     best = None
     for prev in layer:
-        if prev.p <= 0 or start_of(prev.results[-1]) is None:
+        if prev.p <= bound or start_of(prev.results[-1]) is None:
             continue
         step = extend(prev.results[-1])
         if best is None or prev.p * step.p > best.p:
