@@ -161,21 +161,27 @@ def _image_digest(url: str) -> str | None:
     return None
 
 
-def _canonical(messages: list[dict], images: bool) -> list[dict]:
+def _map_parts(messages: list[dict], image_part, other_part) -> list[dict]:
+    """A copy of ``messages`` with each image part replaced by ``image_part(url)``, any other by ``other_part(p)``."""
     out = []
     for msg in messages:
         content = msg.get("content")
         if isinstance(content, list):
-            parts = []
-            for p in content:
-                if p.get("type") == "image_url":
-                    url = p["image_url"]["url"] if isinstance(p.get("image_url"), dict) else p.get("image_url")
-                    parts.append({"type": "image_url", "image": (_image_digest(url) or url) if images else "image"})
-                else:
-                    parts.append({"type": p.get("type"), "text": p.get("text")})
-            content = parts
+            content = [image_part(_image_url(p)) if p.get("type") == "image_url" else other_part(p) for p in content]
         out.append({"role": msg.get("role"), "content": content})
     return out
+
+
+def _image_url(part: dict) -> str:
+    url = part.get("image_url")
+    return url["url"] if isinstance(url, dict) else url
+
+
+def _canonical(messages: list[dict], images: bool) -> list[dict]:
+    return _map_parts(
+        messages,
+        lambda url: {"type": "image_url", "image": (_image_digest(url) or url) if images else "image"},
+        lambda p: {"type": p.get("type"), "text": p.get("text")})
 
 
 def request_hash(messages: list[dict], images: bool = True) -> str:
@@ -271,27 +277,19 @@ class Recorder:
         self.image_dir = self.path.with_suffix("").with_name(self.path.stem + ".images")
 
     def _store_messages(self, messages: list[dict]) -> list[dict]:
-        out = []
-        for msg in messages:
-            content = msg.get("content")
-            if isinstance(content, list):
-                parts = []
-                for p in content:
-                    if p.get("type") == "image_url":
-                        url = p["image_url"]["url"]
-                        digest = _image_digest(url)
-                        if digest:
-                            self.image_dir.mkdir(parents=True, exist_ok=True)
-                            target = self.image_dir / f"{digest.split(':', 1)[1]}.png"
-                            if not target.exists():
-                                target.write_bytes(base64.b64decode(url.split(";base64,", 1)[1]))
-                            url = digest
-                        parts.append({"type": "image_url", "image_url": {"url": url}})
-                    else:
-                        parts.append(dict(p))
-                content = parts
-            out.append({"role": msg.get("role"), "content": content})
-        return out
+        """Messages as recorded: each image stored once as a PNG file and referred to by its digest."""
+        return _map_parts(messages, lambda url: {"type": "image_url", "image_url": {"url": self._store_image(url)}},
+                          dict)
+
+    def _store_image(self, url: str) -> str:
+        digest = _image_digest(url)
+        if not digest:
+            return url
+        self.image_dir.mkdir(parents=True, exist_ok=True)
+        target = self.image_dir / f"{digest.split(':', 1)[1]}.png"
+        if not target.exists():
+            target.write_bytes(base64.b64decode(url.split(";base64,", 1)[1]))
+        return digest
 
     def write(self, record: dict, messages: list[dict]) -> None:
         record = dict(record)
