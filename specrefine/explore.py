@@ -52,8 +52,11 @@ def draw_step(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: 
     graph = graph_at(steps, input_graph, i)
     edge = step.get("edge")
     highlight = [edge[0], edge[1]] if edge and all(v in graph.g for v in edge) else step.get("path")
-    title = describe(step) + f"\nopen {step.get('open', [])}  closed {step.get('closed', [])}"
-    return render_task(maze, graph, path=highlight, title=title, size_px=size_px)
+    fig = render_task(maze, graph, path=highlight, title=describe(step), size_px=size_px, legend=False)
+    fig.axes[0].text(0.01, 0.01, f"open {step.get('open', [])}   closed {step.get('closed', [])}",
+                     transform=fig.axes[0].transAxes, fontsize=8, va="bottom",
+                     bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "none"})
+    return fig
 
 
 def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int = 640):
