@@ -314,7 +314,7 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0 - top / h))
     ax.set_xlim(-0.5, n_cols - 0.5)
     ax.set_ylim(-n_rows / 2, n_rows / 2)
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")
     ax.axis("off")
     if title:
         fig.suptitle(title, fontsize=fs, y=1 - 0.4 * fs / h, va="top")
