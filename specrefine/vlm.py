@@ -773,7 +773,7 @@ def parse_graph(text: str | None, maze, original, *, max_vertices: int = 40):
     intermediates joins original vertices ``u -> v`` that the original links, ``parent=(u, v)``.
     No refinement guarantee is implied (the paper's baseline has none).
     """
-    from .graph import TaskGraph
+    from .graph import TaskGraph, infer_parents
     from .regions import union
 
     data = parse_json(text)
@@ -844,22 +844,12 @@ def parse_graph(text: str | None, maze, original, *, max_vertices: int = 40):
         raise ProposalRejected("the edges contain a cycle (a task graph must be acyclic)")
     tg.initial = initial
 
-    def anchor(v, forward: bool):
-        """The original vertex a chain of intermediates through v starts (or ends) at."""
-        seen = set()
-        while tg.g.nodes[v]["refines"] is None:
-            nxt = list(probe.predecessors(v) if not forward else probe.successors(v)) if v in probe else []
-            if len(nxt) != 1 or v in seen:
-                return None
-            seen.add(v)
-            v = nxt[0]
-        return tg.g.nodes[v]["refines"]
-
     for a, b in pairs:
-        ua, vb = anchor(a, False), anchor(b, True)
-        parent = (ua, vb) if ua is not None and vb is not None and og.has_edge(ua, vb) else None
-        avoid = og.edges[parent]["avoid"] if parent else all_avoid
-        tg.add_edge(a, b, avoid, parent=parent)
+        tg.add_edge(a, b, all_avoid)
+    infer_parents(tg, original)  # the original edge each chain of new waypoints implements
+    for _, _, d in tg.g.edges(data=True):
+        if og.has_edge(*d["parent"]):
+            d["avoid"] = og.edges[d["parent"]]["avoid"]
     reach = nx.descendants(tg.g, initial) | {initial}
     if not finals & reach:
         raise ProposalRejected("no final vertex is reachable from the initial vertex")

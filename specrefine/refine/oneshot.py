@@ -5,14 +5,15 @@ reasoning in the prompt), w samples per query; each proposed graph is evaluated 
 same lazy shortest-path search as DiRL (so Theorem 4.2 holds for it); a second round feeds
 the results back.  The best of the rounds x w graphs by predicted success is returned.
 Unlike our method nothing guarantees the output implies the input: whether it does is
-reported, through the same ``check_refines`` used everywhere.
+reported, through the same ``check_refines`` used everywhere (proposals arrive with edge
+provenance: ``vlm.parse_graph`` infers it with ``graph.infer_parents``, offline proposers splice).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..graph import check_refines, infer_parents
+from ..graph import check_refines
 from .search import SearchResult, shortest_path
 
 
@@ -35,7 +36,6 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
     best, feedback = None, []
     for round_ in range(rounds):
         for graph in proposer.propose_graph(query, w, feedback):
-            graph = infer_parents(graph, original)
             result = shortest_path(graph, evaluator, seed=seed)
             problems = check_refines(graph, original)
             log("candidate", round=round_ + 1, predicted_success=result.predicted_success, path=result.path,
