@@ -10,7 +10,6 @@ so an interrupted run keeps what it computed and a rerun resumes from the cache.
 from __future__ import annotations
 
 import json
-import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -219,6 +218,4 @@ def _jsonable(obj):
         return obj.item()
     if isinstance(obj, np.ndarray):
         return obj.tolist()
-    if isinstance(obj, float) and math.isinf(obj):
-        return None
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
