@@ -13,9 +13,10 @@ import sys
 from pathlib import Path
 
 from .errors import SpecrefineError
+from .mazes import CELL_SIZE
 
 METHODS = ("ours", "vlm-oneshot", "symbolic", "dirl")
-AGENTS = ("point", "ant")
+AGENTS = tuple(CELL_SIZE)  # the agents a maze can be scaled for
 
 
 def proposer_arg(text: str) -> str:
