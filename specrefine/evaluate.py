@@ -238,7 +238,7 @@ class Evaluator:
                  cache_dir=None, nthread: int | None = None):
         import mujoco
 
-        from .sim import agent_spec, build_model
+        from .sim import agent_spec, build_model, footprint_radius
 
         if agent not in CELL_SIZE:
             raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(CELL_SIZE)}")
@@ -259,6 +259,8 @@ class Evaluator:
         #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < body_radius
         self.body_radius = self.agent_radius + self.contact_margin
         self.avoid_radius = self.body_radius  # alias
+        #: fresh starts (default pose) keep this far from walls: the body radius, or the legs' reach if larger
+        self.spawn_radius = max(self.body_radius, footprint_radius(model) + self.contact_margin)
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
@@ -295,15 +297,17 @@ class Evaluator:
         fp = getattr(self.policy, "fingerprint", None)
         return str(fp) if fp is not None else None
 
-    def sample_free(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
-        """``k`` points uniform in ``region`` where the agent's body fits (wall distance >= body radius).
+    def sample_free(self, region: Region, k: int, rng: np.random.Generator, clearance: float | None = None
+                    ) -> np.ndarray:
+        """``k`` points uniform in ``region`` at least ``clearance`` (default: the body radius) from walls.
 
         Falls back to plain uniform samples if the region has (almost) no such points.
         """
+        clearance = self.body_radius if clearance is None else clearance
         chunks, got = [], 0
         for _ in range(64):
             pts = region.sample(max(2 * (k - got), 16), rng)
-            ok = pts[~self._walls.below(pts, self.body_radius)]
+            ok = pts[~self._walls.below(pts, clearance)]
             chunks.append(ok[: k - got])
             got += len(chunks[-1])
             if got >= k:
@@ -311,6 +315,16 @@ class Evaluator:
         warnings.warn(f"region {region.to_dict()} has almost no room for the agent's body; sampling it plainly",
                       stacklevel=2)
         return np.concatenate(chunks + [region.sample(k - got, rng)])
+
+    def spawn_points(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
+        """Fresh start positions in ``region``: clear of walls by ``spawn_radius`` where the region allows it."""
+        if self.spawn_radius > self.body_radius and not self._has_room(region, self.spawn_radius, rng):
+            return self.sample_free(region, k, rng)  # a tight start region: the body still fits, the legs may not
+        return self.sample_free(region, k, rng, self.spawn_radius)
+
+    def _has_room(self, region: Region, clearance: float, rng: np.random.Generator) -> bool:
+        probe = region.sample(256, np.random.default_rng(rng.integers(2**32)))
+        return bool((~self._walls.below(probe, clearance)).mean() > 0.01)
 
     def _key(self, kind: str, start, legs, n: int, seed) -> tuple[str, str]:
         if isinstance(start, StartStates):
@@ -322,7 +336,8 @@ class Evaluator:
                     for g, a, p in legs]
         body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
                 "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
-                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius}
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius,
+                "spawn": self.spawn_radius}
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
@@ -461,7 +476,7 @@ class Evaluator:
                 raise SpecrefineError("empty start distribution (no successful rollouts to start from)")
             sim.reset(states=start.states[rng.integers(len(start), size=n)])
         else:
-            sim.reset(xy=self.sample_free(start, n, rng), rng=rng)
+            sim.reset(xy=self.spawn_points(start, n, rng), rng=rng)
         L, H, r = len(legs), self.horizon, self.body_radius
         goal_pts = np.empty((L, n, 2))
         for k, (goal, _, point) in enumerate(legs):

@@ -80,6 +80,24 @@ def agent_spec(agent: str) -> AgentSpec:
     raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(AGENTS)}")
 
 
+def footprint_radius(model: mujoco.MjModel) -> float:
+    """Horizontal reach of the agent's geoms from its root in the default pose (Ant: leg tips, 1.21 m).
+
+    Spawning closer than this to a wall puts a leg inside it; MuJoCo then pushes it out violently and
+    the Ant flips in its first half second.
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    root = data.qpos[:2]
+    reach = 0.0
+    for i in np.flatnonzero(model.geom_bodyid > 0):
+        centre, axis, size = data.geom_xpos[i], data.geom_xmat[i].reshape(3, 3)[:, 2], model.geom_size[i]
+        half = size[1] if model.geom_type[i] == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0
+        for end in (centre - half * axis, centre + half * axis):
+            reach = max(reach, float(np.hypot(*(end[:2] - root))) + float(size[0]))
+    return reach
+
+
 def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
     """The agent's MJCF plus one static box geom per wall part of ``maze``."""
     spec_ = agent_spec(agent)
@@ -228,6 +246,7 @@ class ReachTask:
     step_cost: float = 0.0  # per control step: without it the point learns to idle just outside the radius
     arrive_speed: float | None = None  # success also needs a planar speed below this (m/s): arrive under control
     lateral_cost: float = 0.0  # per metre moved across the line to the goal: keeps paths straight in corridors
+    goals_per_episode: int = 1  # > 1: on success a new goal is drawn from where the agent is, without a reset
 
 
 REACH_TASKS = {
@@ -249,7 +268,9 @@ class GoalReachEnv(EnvBase):
 
     Reward = ``progress_scale`` x (metres closer to the goal) + ``success_bonus`` on reaching
     it - ``flip_penalty`` on flipping - ``step_cost`` per step.  Done on success, flip or ``max_steps``; finished
-    envs are reset by TorchRL's partial ``_reset`` (the collector does it automatically).
+    envs are reset by TorchRL's partial ``_reset`` (the collector does it automatically).  With
+    ``task.goals_per_episode`` = m > 1, the first m - 1 successes draw a new goal from the current (moving)
+    state instead, as a compositional policy switches subtasks, and ``max_steps`` counts per goal.
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None):
@@ -260,6 +281,7 @@ class GoalReachEnv(EnvBase):
         self.goals = np.zeros((n, 2))
         self.dist = np.zeros(n)
         self.t = np.zeros(n, dtype=np.int64)
+        self.goal_index = np.zeros(n, dtype=np.int64)  # goals reached so far in this episode
         bs = self.batch_size
         self.observation_spec = Composite(
             observation=Unbounded((*bs, self.sim.obs_dim), dtype=torch.float32),
@@ -288,6 +310,7 @@ class GoalReachEnv(EnvBase):
         self.goals[idx] = sample_goals(self.sim.xy[idx], self.task.goal_min, self.task.goal_max, self.rng)
         self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
         self.t[idx] = 0
+        self.goal_index[idx] = 0
         zeros = np.zeros(self.sim.n, dtype=bool)
         out = self._obs_td(zeros, zeros)
         out.update(self._dones(zeros, zeros))
@@ -317,7 +340,13 @@ class GoalReachEnv(EnvBase):
         reward = (task.progress_scale * (self.dist - dist) + task.success_bonus * success
                   - task.flip_penalty * flipped - task.step_cost - task.lateral_cost * self._sideways(before))
         self.dist = dist
-        terminated = success | flipped
+        more = success & ~flipped & (self.goal_index + 1 < task.goals_per_episode)
+        if more.any():  # chained goals: the next one starts from here, at whatever speed the agent has
+            self.goal_index[more] += 1
+            self.t[more] = 0
+            self.goals[more] = sample_goals(self.sim.xy[more], task.goal_min, task.goal_max, self.rng)
+            self.dist[more] = np.linalg.norm(self.goals[more] - self.sim.xy[more], axis=1)
+        terminated = (success & ~more) | flipped
         truncated = ~terminated & (self.t >= task.max_steps)
         out = self._obs_td(success, flipped)
         out["reward"] = torch.from_numpy(reward.astype(np.float32)).unsqueeze(-1)

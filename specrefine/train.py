@@ -50,6 +50,8 @@ class Config:
     torch_threads: int = 1
     sim_threads: int = 2
     checkpoint_every_s: float = 120.0
+    goals_per_episode: int = 1       # > 1: chained goals without a reset (see GoalReachEnv)
+    init: str | None = None          # fine-tune: actor + critic weights from this trainer checkpoint.pt
 
     @property
     def frames_per_batch(self) -> int:
@@ -92,7 +94,8 @@ class Trainer:
         self.out.mkdir(parents=True, exist_ok=True)
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
-        self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads)
+        task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode)
+        self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
         self.actor, self.critic = make_modules(self.policy, self.env)
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
@@ -103,6 +106,8 @@ class Trainer:
         self.frames, self.iteration, self.wall = 0, 0, 0.0
         if resume and (self.out / "checkpoint.pt").is_file():
             self._load_checkpoint(self.out / "checkpoint.pt")
+        elif cfg.init:
+            self._load_weights(Path(cfg.init))
         self.collector = Collector(self.env, self.actor, frames_per_batch=cfg.frames_per_batch, total_frames=-1,
                                    auto_register_policy_transforms=False)
         self.ep_return = np.zeros(cfg.num_envs)
@@ -115,6 +120,14 @@ class Trainer:
         self.frames, self.iteration, self.wall = ck["frames"], ck["iteration"], ck.get("wall", 0.0)
         torch.set_rng_state(ck["torch_rng"])
         self.env.rng = np.random.default_rng(self.cfg.seed + self.iteration)
+
+    def _load_weights(self, path: Path) -> None:
+        """Start from another run's actor, critic and observation statistics (frames and optimiser start afresh)."""
+        try:
+            ck = torch.load(path, map_location="cpu", weights_only=False)
+            self.loss.load_state_dict(ck["loss"])
+        except (OSError, KeyError, RuntimeError, EOFError) as e:
+            raise SpecrefineError(f"--init {path}: not a trainer checkpoint of this agent ({type(e).__name__})") from e
 
     def save_checkpoint(self) -> None:
         tmp = self.out / "checkpoint.pt.tmp"
@@ -346,6 +359,10 @@ def main(argv=None) -> int:
     ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
     ap.add_argument("--plot", metavar="PNG", help="with --evaluate: save the success-vs-distance plot here")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--goals-per-episode", type=int, default=1,
+                    help="chain this many goals per episode, each drawn where the last was reached (no reset)")
+    ap.add_argument("--init", metavar="CHECKPOINT", help="fine-tune from another run's OUT/checkpoint.pt")
+    ap.add_argument("--lr", type=float, default=None, help="learning rate (default: the config's)")
     args = ap.parse_args(argv)
     try:
         if args.evaluate:
@@ -357,7 +374,8 @@ def main(argv=None) -> int:
             return 0
         if not args.out:
             raise SpecrefineError("--out DIR is required for training")
-        overrides = {"seed": args.seed} | ({"frames": args.frames} if args.frames else {})
+        overrides = {"seed": args.seed, "goals_per_episode": args.goals_per_episode, "init": args.init}
+        overrides |= ({"frames": args.frames} if args.frames else {}) | ({"lr": args.lr} if args.lr else {})
         cfg = make_config(args.agent, **overrides)
         path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()
         print(f"policy written to {path}")

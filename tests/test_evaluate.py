@@ -276,3 +276,24 @@ def test_compaction_of_finished_rollouts_changes_nothing_but_cost(maze):
         np.testing.assert_array_equal(a.outcome, b.outcome)
         np.testing.assert_array_equal(a.end_states.states, b.end_states.states)
     assert compact.sim_steps < plain.sim_steps
+
+
+def test_ant_starts_clear_of_walls_by_its_legs_reach(maze):
+    ant_maze = maze.for_agent("ant")
+    ev = Evaluator(ant_maze, "ant", Constant([0.0] * 8), n=8)
+    assert ev.spawn_radius > 2 * ev.body_radius  # legs reach further than the torso
+    walls = CompiledRegion(ant_maze.walls)
+    rng = np.random.default_rng(0)
+    start = maze_task(ant_maze).region("S")
+    pts = ev.spawn_points(start, 200, rng)
+    assert walls.signed_distance(pts).min() >= ev.spawn_radius - 1e-9
+    assert walls.signed_distance(ev.sample_free(start, 200, rng)).min() < ev.spawn_radius  # goals: the torso only
+    x0, y0, x1, y1 = start.bounds()
+    tight = Box(x0, y0 + 1.0, x0 + 0.9, y1 - 1.0)  # a strip along the wall: no room for the legs, fall back
+    tight_pts = ev.spawn_points(tight, 50, rng)
+    assert len(tight_pts) == 50 and walls.signed_distance(tight_pts).min() >= ev.body_radius - 1e-9
+
+
+def test_point_spawns_where_its_body_fits(maze):
+    ev = Evaluator(maze, "point", Constant([0.0, 0.0]), n=8)
+    assert ev.spawn_radius == ev.body_radius

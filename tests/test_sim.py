@@ -110,3 +110,47 @@ def test_torchrl_env_partial_reset_and_termination():
     assert out["next", "reward"][0].item() > 0.5  # success bonus
     assert not np.allclose(env.goals[0], env.sim.xy[0])  # env 0 was reset with a new goal
     np.testing.assert_array_equal(env.goals[1:], goals_before[1:])
+
+
+def test_chained_goals_continue_without_reset_until_the_last():
+    from dataclasses import replace
+
+    from specrefine.sim import REACH_TASKS
+
+    env = GoalReachEnv("point", 2, seed=0, nthread=1, task=replace(REACH_TASKS["point"], goals_per_episode=2))
+    td = env.reset()
+    td["action"] = torch.zeros(2, 2)
+    env.goals[0] = env.sim.xy[0]  # goal 1 of 2 reached on the next step
+    xy = env.sim.xy[0].copy()
+    out, td = env.step_and_maybe_reset(td)
+    assert bool(out["next", "success"][0]) and not bool(out["next", "done"][0])
+    assert env.goal_index[0] == 1 and not np.allclose(env.goals[0], xy)  # a new goal, drawn from here
+    np.testing.assert_allclose(env.sim.xy[0], xy, atol=1e-6)  # no reset: still where goal 1 was reached
+    env.goals[0] = env.sim.xy[0]  # goal 2 of 2: now the episode ends
+    td["action"] = torch.zeros(2, 2)
+    out, _ = env.step_and_maybe_reset(td)
+    assert bool(out["next", "terminated"][0]) and env.goal_index[0] == 0  # done, and reset for the next episode
+
+
+def test_ant_spawned_at_its_footprint_radius_does_not_touch_a_wall():
+    import mujoco
+
+    from specrefine.sim import build_model, footprint_radius
+
+    maze = parse_maze("###\n#S#\n#G#\n###", name="t").for_agent("ant")
+    model = build_model("ant", maze)
+    reach = footprint_radius(model)
+    assert reach > 2 * 0.5  # the legs reach much further than the torso's body radius
+
+    cell = maze.cell_box(1, 1)  # S; its left neighbour is a wall
+
+    def wall_contacts(gap):  # torso `gap` metres right of the wall
+        data = mujoco.MjData(model)
+        data.qpos[:2] = [cell.xmin + gap, (cell.ymin + cell.ymax) / 2]
+        mujoco.mj_forward(model, data)
+        names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or "" for c in data.contact[:data.ncon]
+                 for g in (c.geom1, c.geom2)]
+        return sum(nm.startswith("wall_") for nm in names)
+
+    assert wall_contacts(reach + 0.02) == 0
+    assert wall_contacts(0.6) > 0
