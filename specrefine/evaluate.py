@@ -384,13 +384,50 @@ class Evaluator:
             warnings.warn(f"could not write cache entry {path}: {e}", stacklevel=3)
 
     # --- public API ----------------------------------------------------------------------------
+    MAX_EPISODES = 2048  # evaluate_many simulates at most this many episodes side by side
+
     def evaluate(self, start: Region | StartStates, goal: Region, avoid: Region, goal_point=None, seed=None,
                  n: int | None = None) -> EdgeResult:
         """Success probability of the subtask start -> goal avoiding ``avoid`` (see the module docstring)."""
+        return self.evaluate_many([(start, goal, avoid, goal_point)], seed=seed, n=n)[0]
+
+    def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
+        """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
+
+        The same numbers as one ``evaluate`` call each (every subtask is seeded on its own), in far
+        fewer, larger simulator steps.
+        """
         n = int(n or self.n)
         seed = self.seed if seed is None else seed
-        legs = [(goal, avoid, goal_point)]
-        key, text = self._key("edge", start, legs, n, seed)
+        results: list[EdgeResult | None] = [None] * len(subtasks)
+        todo: dict[str, tuple] = {}  # key -> (text, task, positions)
+        for i, (start, goal, avoid, goal_point) in enumerate(subtasks):
+            legs = [(goal, avoid, goal_point)]
+            key, text = self._key("edge", start, legs, n, seed)
+            if key in todo:  # asked twice in one batch: simulated once, the second is a cache hit
+                todo[key][2].append(i)
+            elif (hit := self._lookup(key, text)) is not None:
+                results[i] = hit
+            elif isinstance(start, StartStates) and len(start) == 0:
+                results[i] = _unreached_result(start)  # nothing reached the start: p = 0, nothing run
+            else:
+                todo[key] = (text, (start, legs, n, seed), [i])
+        batch = max(1, self.MAX_EPISODES // n)
+        pending = list(todo.items())
+        for lo in range(0, len(pending), batch):
+            chunk = pending[lo:lo + batch]
+            for (key, (text, _, positions)), out in zip(chunk, self._rollout_many([t for _, (_, t, _) in chunk])):
+                res = _edge_result(out, n)
+                self.evaluations += 1
+                self._remember(key, res)
+                self._store(key, text, res)
+                results[positions[0]] = res
+                for i in positions[1:]:
+                    self.cache_hits += 1
+                    results[i] = replace(res, cached=True)
+        return results
+
+    def _lookup(self, key: str, text: str) -> EdgeResult | None:
         hit = self._memo.get(key)
         if hit is None:
             hit = self._load(key, text)
@@ -399,25 +436,10 @@ class Evaluator:
                 self._remember(key, replace(hit, cached=False))
         else:
             self._memo.move_to_end(key)
-        if hit is not None:
-            self.cache_hits += 1
-            return replace(hit, cached=True)
-        if isinstance(start, StartStates) and len(start) == 0:  # nothing reached the start: p = 0, nothing run
-            sdim = start.states.shape[1] if start.states.ndim == 2 else 0
-            return EdgeResult(0.0, (0.0, 1.0), 0, 0, np.zeros(0, bool), np.zeros((0, 1, 2), np.float32),
-                              np.zeros(0, np.int64), StartStates(np.zeros((0, sdim)), np.zeros((0, 2))), 0,
-                              outcome=np.zeros(0, np.int8))
-        out = self._rollout(start, legs, n, seed)
-        success = out["legs_done"] == 1
-        k = int(success.sum())
-        res = EdgeResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
-                         trajectories=out["trajectories"], lengths=out["lengths"],
-                         end_states=StartStates(out["end_states"][success], out["end_xy"][success]),
-                         steps=out["steps"], outcome=out["outcome"])
-        self.evaluations += 1
-        self._remember(key, res)
-        self._store(key, text, res)
-        return res
+        if hit is None:
+            return None
+        self.cache_hits += 1
+        return replace(hit, cached=True)
 
     def _remember(self, key: str, res: EdgeResult) -> None:
         for a in (res.success, res.trajectories, res.lengths, res.outcome, res.end_states.states, res.end_states.xy):
@@ -458,46 +480,76 @@ class Evaluator:
 
     # --- the hot loop --------------------------------------------------------------------------
     def _rollout(self, start, legs, n: int, seed) -> dict:
+        return self._rollout_many([(start, legs, n, seed)])[0]
+
+    def _rollout_many(self, tasks: list[tuple]) -> list[dict]:
+        """Run several ``(start, legs, n, seed)`` tasks side by side in one batch; one result dict per task."""
         # small-batch inference is fastest on one torch thread; more threads only contend with MuJoCo's
         with _torch_threads(1):
-            return self._rollout_batches(start, legs, n, seed)
+            return self._rollout_batches(tasks)
 
-    def _rollout_batches(self, start, legs, n: int, seed) -> dict:
-        """Run n episodes through ``legs``; the core loop behind ``evaluate`` and ``run_path``.
-
-        Episodes live in rows of a BatchedSim.  When at most half of the rows are still running, the
-        running ones are moved (full physics states, bit-exact) into a smaller BatchedSim (a power of
-        two, at least ``MIN_BATCH``), so finished rollouts stop costing physics.
-        """
-        rng = np.random.default_rng(seed)
-        sim = self.sim(n)
+    def _start_rows(self, sim, rows: np.ndarray, start, n: int, rng: np.random.Generator) -> None:
         if isinstance(start, StartStates):
             if len(start) == 0:
                 raise SpecrefineError("empty start distribution (no successful rollouts to start from)")
-            sim.reset(states=start.states[rng.integers(len(start), size=n)])
+            sim.reset(states=start.states[rng.integers(len(start), size=n)], idx=rows)
         else:
-            sim.reset(xy=self.spawn_points(start, n, rng), rng=rng)
-        L, H, r = len(legs), self.horizon, self.body_radius
-        goal_pts = np.empty((L, n, 2))
-        for k, (goal, _, point) in enumerate(legs):
-            goal_pts[k] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) if point is not None \
-                else self.sample_free(goal, n, rng)
-        goals = [self.compiled(g) for g, _, _ in legs]
-        avoids = [self.compiled(a) for _, a, _ in legs]
+            sim.reset(xy=self.spawn_points(start, n, rng), rng=rng, idx=rows)
+
+    def _rollout_batches(self, tasks: list[tuple]) -> list[dict]:
+        """Run every task's n episodes through its legs; the core loop behind ``evaluate`` and ``run_path``.
+
+        Episodes of all tasks live in rows of one BatchedSim (each task seeded on its own, so a task's
+        start states and goal points do not depend on its neighbours).  When at most half of the rows
+        are still running, the running ones are moved (full physics states, bit-exact) into a smaller
+        BatchedSim (a power of two, at least ``MIN_BATCH``), so finished rollouts stop costing physics.
+        """
+        counts = np.array([n for _, _, n, _ in tasks])
+        first = np.concatenate([[0], np.cumsum(counts)])
+        N, n_legs = int(first[-1]), np.array([len(legs) for _, legs, _, _ in tasks])
+        L = int(n_legs.max())
+        task_of = np.repeat(np.arange(len(tasks)), counts)
+        L_of = n_legs[task_of]
+        sim = self.sim(-(-N // self.MIN_BATCH) * self.MIN_BATCH)
+        goal_pts = np.zeros((L, N, 2))
+        goal_id = np.zeros((len(tasks), L), dtype=np.int64)  # (task, leg) -> index into goals / avoids
+        avoid_id = np.zeros((len(tasks), L), dtype=np.int64)
+        goals, avoids = [], []
+        for j, (start, legs, n, seed) in enumerate(tasks):
+            rng = np.random.default_rng(seed)
+            rows = np.arange(first[j], first[j + 1])
+            self._start_rows(sim, rows, start, n, rng)
+            for k, (goal, avoid, point) in enumerate(legs):
+                goal_pts[k, rows] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) \
+                    if point is not None else self.sample_free(goal, n, rng)
+                goal_id[j, k] = _index_of(goals, self.compiled(goal))
+                avoid_id[j, k] = _index_of(avoids, self.compiled(avoid))
+        if sim.n > N:  # padding rows: copies of row 0, never checked
+            sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
+        H, r = self.horizon, self.body_radius
         T = L * H + 1
-        traj = np.empty((n, T, 2), dtype=np.float32)
-        leg = np.zeros(n, dtype=np.int64)
-        t_leg = np.zeros(n, dtype=np.int64)
-        active = np.ones(n, dtype=bool)
-        lengths = np.full(n, T, dtype=np.int64)
-        outcome = np.full(n, UNFINISHED, dtype=np.int8)
-        end_states = np.zeros((n, sim.state_dim))
-        end_xy = np.zeros((n, 2))
-        episode = np.arange(n)  # episode held by each sim row (-1: padding)
-        row = np.arange(n)  # sim row of each episode (-1: not in the sim any more)
-        xy, flipped = sim.xy, sim.flipped
+        traj = np.empty((N, T, 2), dtype=np.float32)
+        leg = np.zeros(N, dtype=np.int64)
+        t_leg = np.zeros(N, dtype=np.int64)
+        active = np.ones(N, dtype=bool)
+        lengths = np.full(N, T, dtype=np.int64)
+        outcome = np.full(N, UNFINISHED, dtype=np.int8)
+        end_states = np.zeros((N, sim.state_dim))
+        end_xy = np.zeros((N, 2))
+        episode = np.concatenate([np.arange(N), np.full(sim.n - N, -1)])  # episode held by each sim row (-1: padding)
+        row = np.arange(N)  # sim row of each episode (-1: not in the sim any more)
+        xy, flipped = sim.xy[:N], sim.flipped[:N]
         traj[:, 0] = xy
-        steps = 0
+        steps = np.zeros(len(tasks), dtype=np.int64)  # rows held by each task's episodes, per step
+        padding_steps = 0
+
+        def classify(sel, ids, regions, test):
+            """test(region, points) for the episodes ``sel``, grouped by the region each one is in."""
+            out = np.zeros(len(sel), dtype=bool)
+            for i in np.unique(ids):
+                m = ids == i
+                out[m] = test(regions[i], xy[sel[m]])
+            return out
 
         def check(t: int) -> None:
             """Classify the running episodes at time t (after the step that led there)."""
@@ -505,30 +557,25 @@ class Evaluator:
             for _ in range(L + 1):  # a point may lie in several consecutive goals: advance through all of them
                 if not len(idx):
                     break
-                advanced = []
-                for k in (np.unique(leg[idx]) if L > 1 else (0,)):
-                    sel = idx[leg[idx] == k] if L > 1 else idx
-                    p = xy[sel]
-                    bad = avoids[k].below(p, r) | flipped[sel]
-                    reached = ~bad & goals[k].contains(p)
-                    if bad.any():
-                        b = sel[bad]
-                        outcome[b] = np.where(flipped[b], FLIPPED, AVOID)
-                        active[b] = False
-                        lengths[b] = t + 1
-                    if reached.any():
-                        g = sel[reached]
-                        leg[g] += 1
-                        t_leg[g] = 0
-                        done = g[leg[g] == L]
-                        if len(done):
-                            outcome[done] = SUCCESS
-                            active[done] = False
-                            lengths[done] = t + 1
-                            end_states[done] = sim.get_state()[row[done]]
-                            end_xy[done] = xy[done]
-                        advanced.append(g[leg[g] < L])
-                idx = np.concatenate(advanced) if advanced else idx[:0]
+                task, k = task_of[idx], leg[idx]
+                bad = classify(idx, avoid_id[task, k], avoids, lambda a, p: a.below(p, r)) | flipped[idx]
+                reached = ~bad & classify(idx, goal_id[task, k], goals, lambda g, p: g.contains(p))
+                if bad.any():
+                    b = idx[bad]
+                    outcome[b] = np.where(flipped[b], FLIPPED, AVOID)
+                    active[b] = False
+                    lengths[b] = t + 1
+                g = idx[reached]
+                leg[g] += 1
+                t_leg[g] = 0
+                done = g[leg[g] == L_of[g]]
+                if len(done):
+                    outcome[done] = SUCCESS
+                    active[done] = False
+                    lengths[done] = t + 1
+                    end_states[done] = sim.get_state()[row[done]]
+                    end_xy[done] = xy[done]
+                idx = g[leg[g] < L_of[g]]
 
         check(0)
         import torch
@@ -550,11 +597,12 @@ class Evaluator:
                     row[ids] = np.arange(len(ids))
                 live = episode >= 0
                 ep = np.where(live, episode, episode[0])
-                obs = sim.observe(goal_pts[np.minimum(leg[ep], L - 1), ep])
+                obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep])
                 act = np.asarray(self._act(obs), dtype=np.float64)
                 act[~(live & active[ep])] = 0.0  # finished rollouts stay still
                 sim.step(act)
-                steps += sim.n
+                steps += np.bincount(task_of[episode[live]], minlength=len(tasks))
+                padding_steps += int((~live).sum())
                 xy[episode[live]] = sim.xy[live]
                 flipped[episode[live]] = sim.flipped[live]
                 traj[:, t] = xy
@@ -565,12 +613,45 @@ class Evaluator:
                     outcome[late] = TIMEOUT
                     active[late] = False
                     lengths[late] = t + 1
+        self.sim_steps += int(steps.sum()) + padding_steps
+        if len(tasks) == 1:
+            steps[0] += padding_steps
+        return [self._task_output(slice(first[j], first[j + 1]), traj, lengths, leg, outcome, end_states, end_xy,
+                                  int(steps[j])) for j in range(len(tasks))]
+
+    @staticmethod
+    def _task_output(rows: slice, traj, lengths, leg, outcome, end_states, end_xy, steps: int) -> dict:
+        lengths = lengths[rows]
+        n = len(lengths)
         used = int(lengths.max(initial=1))
         pad = np.minimum(np.arange(used)[None, :], lengths[:, None] - 1)
-        traj = traj[np.arange(n)[:, None], pad]
-        self.sim_steps += steps
-        return {"legs_done": leg, "trajectories": traj, "lengths": lengths, "outcome": outcome,
-                "end_states": end_states, "end_xy": end_xy, "steps": steps}
+        return {"legs_done": leg[rows], "trajectories": traj[rows][np.arange(n)[:, None], pad], "lengths": lengths,
+                "outcome": outcome[rows], "end_states": end_states[rows], "end_xy": end_xy[rows], "steps": steps}
+
+
+def _edge_result(out: dict, n: int) -> EdgeResult:
+    success = out["legs_done"] == 1
+    k = int(success.sum())
+    return EdgeResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                      trajectories=out["trajectories"], lengths=out["lengths"],
+                      end_states=StartStates(out["end_states"][success], out["end_xy"][success]),
+                      steps=out["steps"], outcome=out["outcome"])
+
+
+def _unreached_result(start: StartStates) -> EdgeResult:
+    sdim = start.states.shape[1] if start.states.ndim == 2 else 0
+    return EdgeResult(0.0, (0.0, 1.0), 0, 0, np.zeros(0, bool), np.zeros((0, 1, 2), np.float32),
+                      np.zeros(0, np.int64), StartStates(np.zeros((0, sdim)), np.zeros((0, 2))), 0,
+                      outcome=np.zeros(0, np.int8))
+
+
+def _index_of(items: list, item) -> int:
+    """Position of ``item`` (by identity) in ``items``, appending it if new."""
+    for i, x in enumerate(items):
+        if x is item:
+            return i
+    items.append(item)
+    return len(items) - 1
 
 
 def path_legs(graph, path: list[str]) -> list[tuple[Region, Region, np.ndarray | None]]:

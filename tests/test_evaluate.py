@@ -297,3 +297,25 @@ def test_ant_starts_clear_of_walls_by_its_legs_reach(maze):
 def test_point_spawns_where_its_body_fits(maze):
     ev = Evaluator(maze, "point", Constant([0.0, 0.0]), n=8)
     assert ev.spawn_radius == ev.body_radius
+
+
+def test_evaluate_many_equals_one_evaluate_per_subtask(maze):
+    from specrefine.policy import load_policy
+
+    task, policy = maze_task(maze), load_policy("point")
+    S, G, walls = task.region("S"), task.region("G"), maze.walls
+    corner = Disc(1, -1, 0.4)
+    alone = Evaluator(maze, "point", policy, n=32, seed=0)
+    first = alone.evaluate(S, corner, walls)
+    subtasks = [(S, corner, walls, None), (S, G, walls, None), (first.end_states, Disc(1, 1, 0.4), walls, None),
+                (S, corner, walls, (1.0, -1.0)), (S, corner, walls, None)]
+    expected = [first] + [alone.evaluate(*s) for s in subtasks[1:4]]
+    together = Evaluator(maze, "point", policy, n=32, seed=0)
+    got = together.evaluate_many(subtasks)
+    for want, res in zip(expected, got[:4], strict=True):
+        assert res.p == want.p and np.array_equal(res.success, want.success)
+        np.testing.assert_array_equal(res.trajectories, want.trajectories)
+        np.testing.assert_array_equal(res.end_states.states, want.end_states.states)
+    assert got[4].cached and got[4].p == got[0].p  # asked twice: simulated once
+    assert together.evaluations == 4 and together.cache_hits == 1
+    assert [r.cached for r in together.evaluate_many(subtasks)] == [True] * 5 and together.evaluations == 4

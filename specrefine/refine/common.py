@@ -17,6 +17,13 @@ class SubtaskEvaluator(Protocol):
     def evaluate(self, start, goal: Region, avoid: Region, goal_point=None, seed=None): ...
 
 
+def evaluate_all(evaluator: SubtaskEvaluator, subtasks: list[tuple]) -> list:
+    """``evaluate`` each ``(start, goal, avoid, goal_point)``, simulated side by side where the evaluator can."""
+    if hasattr(evaluator, "evaluate_many"):
+        return evaluator.evaluate_many(subtasks)
+    return [evaluator.evaluate(start, goal, avoid, goal_point=point) for start, goal, avoid, point in subtasks]
+
+
 def weight(p: float, n: int) -> float:
     """Edge weight -log p, with p = 0 guarded by half a success in n rollouts."""
     return -math.log(max(p, 0.5 / max(n, 1)))

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..regions import Box, Disc, Region
-from .common import UNREACHED, Leg, SubtaskEvaluator, evaluate_path, start_of
+from .common import UNREACHED, Leg, SubtaskEvaluator, evaluate_all, evaluate_path, start_of
 
 
 def sample_subsets(region: Region, k: int, rng: np.random.Generator, shrink=(0.3, 0.7)) -> list[Region]:
@@ -61,26 +61,22 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
     if len(avoids) != len(inner) + 1:
         raise ValueError("refine_chain needs one avoid set per subtask")
     options = [[region] + sample_subsets(region, k, rng) for region in inner]
-    calls = 0
-
-    def run(start_, goal_, avoid_, point=None):
-        nonlocal calls
-        calls += 1
-        return evaluator.evaluate(start_, goal_, avoid_, goal_point=point)
-
     unrefined = evaluate_path(evaluator, start, [Leg(x, a) for x, a in zip(inner, avoids)] + [Leg(goal, avoids[-1],
                                                                                                  goal_point)])
-    calls += len(avoids)
+    calls = len(avoids)
     if unrefined.p >= 1.0:  # the DP cannot beat a chain that never failed
         return ChainChoice(regions=list(inner), results=unrefined.results, p=1.0, evaluations=calls)
 
     # one Path per option of the current layer: the best way found to reach it
     bound = unrefined.p
-    layer = [_Path(r.p, [r], [i]) for i, r in enumerate(run(start, opt, avoids[0]) for opt in options[0])]
+    first = evaluate_all(evaluator, [(start, opt, avoids[0], None) for opt in options[0]])
+    calls += len(first)
+    layer = [_Path(r.p, [r], [i]) for i, r in enumerate(first)]
     for j in range(1, len(inner)):
-        layer = [_best_extension(layer, i, lambda last, o=opt, a=avoids[j]: run(start_of(last), o, a), bound)
-                 for i, opt in enumerate(options[j])]
-    best = _best_extension(layer, None, lambda last: run(start_of(last), goal, avoids[-1], goal_point), bound)
+        layer, asked = _next_layer(evaluator, layer, [(opt, avoids[j], None) for opt in options[j]], bound)
+        calls += asked
+    (best,), asked = _next_layer(evaluator, layer, [(goal, avoids[-1], goal_point)], bound, last=True)
+    calls += asked
     if best.p <= bound:  # nothing beat the chain as proposed
         return ChainChoice(regions=list(inner), results=unrefined.results, p=unrefined.p, evaluations=calls)
     chosen = [options[j][i] for j, i in enumerate(best.choices)]
@@ -94,21 +90,21 @@ class _Path:
     choices: list[int]
 
 
-def _best_extension(layer: list[_Path], option: int | None, extend, bound: float = 0.0) -> _Path:
-    """max over previous options l of p_l * p(l -> option); options nobody reached keep p = 0.
+def _next_layer(evaluator, layer: list[_Path], targets: list[tuple], bound: float, last: bool = False
+                ) -> tuple[list[_Path], int]:
+    """For every target (goal, avoid, point): max over previous options l of p_l * p(l -> target).
 
-    A partial path no more likely than ``bound`` is not extended: probabilities only shrink along a
-    path, so it cannot end above the bound (branch and bound; the result is unchanged).
+    All extensions of a layer are evaluated in one batch.  A partial path no more likely than
+    ``bound`` is not extended: probabilities only shrink along a path, so it cannot end above the
+    bound (branch and bound; the result is unchanged).  Targets nobody reached keep p = 0.
     """
-    best = None
-    for prev in layer:
-        if prev.p <= bound or start_of(prev.results[-1]) is None:
-            continue
-        step = extend(prev.results[-1])
-        if best is None or prev.p * step.p > best.p:
-            tail = [option] if option is not None else []
-            best = _Path(prev.p * step.p, prev.results + [step], prev.choices + tail)
-    if best is None:
-        base = layer[0]
-        best = _Path(0.0, base.results + [UNREACHED], base.choices + ([option] if option is not None else []))
-    return best
+    alive = [prev for prev in layer if prev.p > bound and start_of(prev.results[-1]) is not None]
+    asked = [(prev, i, (start_of(prev.results[-1]), *target)) for i, target in enumerate(targets) for prev in alive]
+    results = evaluate_all(evaluator, [subtask for _, _, subtask in asked])
+    best: list[_Path | None] = [None] * len(targets)
+    for (prev, i, _), step in zip(asked, results, strict=True):
+        if best[i] is None or prev.p * step.p > best[i].p:
+            best[i] = _Path(prev.p * step.p, prev.results + [step], prev.choices + ([] if last else [i]))
+    base = layer[0]
+    return [b if b is not None else _Path(0.0, base.results + [UNREACHED], base.choices + ([] if last else [i]))
+            for i, b in enumerate(best)], len(asked)
