@@ -3,6 +3,7 @@
     python -m specrefine.train --agent point --frames 400000 --out runs/point
     python -m specrefine.train --agent ant --frames 10000000 --out runs/ant_train --resume
     python -m specrefine.train --agent ant --evaluate data/policies/ant.pt --episodes 500
+    python -m specrefine.train --agent ant --evaluate ant --chain 8 --goal-range 3 5   # goals in a row
 
 Task: reach a goal sampled on the open floor (``specrefine.sim.GoalReachEnv``); the policy never
 sees a maze.  ``OUT/`` receives ``checkpoint.pt`` (everything needed to resume), ``policy.pt``
@@ -263,6 +264,48 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
             "goals": goals}
 
 
+def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
+                   hi: float | None = None, seed: int = 0, horizon: int | None = None) -> dict:
+    """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
+
+    This is how a compositional policy uses the goal policy (the next subtask starts from a moving
+    state); per goal it reports how many episodes got there and how many flipped on the way.
+    """
+    task = REACH_TASKS[policy.agent]
+    lo = task.goal_min if lo is None else lo
+    hi = task.goal_max if hi is None else hi
+    rng = np.random.default_rng(seed)
+    sim = BatchedSim(policy.agent, None, episodes)
+    horizon = horizon or sim.default_horizon
+    sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
+    goal = sample_goals(sim.xy, lo, hi, rng)
+    index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
+    alive = np.ones(episodes, dtype=bool)
+    reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
+    with torch.inference_mode():
+        while alive.any():
+            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal)), 0.0))
+            t += 1
+            flip = alive & sim.flipped
+            np.add.at(flips, index[flip], 1)
+            alive &= ~flip
+            hit = alive & (np.linalg.norm(sim.xy - goal, axis=1) < task.success_radius)
+            np.add.at(reached, index[hit], 1)
+            index[hit] += 1
+            t[hit] = 0
+            goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
+            alive &= index < goals
+            late = alive & (t >= horizon)
+            np.add.at(timeouts, index[late], 1)
+            alive &= ~late
+    sim.close()
+    k = int(reached[-1])
+    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
+            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
+            "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
+            "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
+
+
 def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
     lo, hi = result["goal_range_m"]
     edges = np.linspace(lo, hi, bins + 1)
@@ -359,12 +402,19 @@ def main(argv=None) -> int:
     ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
     ap.add_argument("--plot", metavar="PNG", help="with --evaluate: save the success-vs-distance plot here")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--chain", type=int, default=None, metavar="K",
+                    help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain)")
     ap.add_argument("--goals-per-episode", type=int, default=1,
                     help="chain this many goals per episode, each drawn where the last was reached (no reset)")
     ap.add_argument("--init", metavar="CHECKPOINT", help="fine-tune from another run's OUT/checkpoint.pt")
     ap.add_argument("--lr", type=float, default=None, help="learning rate (default: the config's)")
     args = ap.parse_args(argv)
     try:
+        if args.evaluate and args.chain:
+            lo, hi = args.goal_range or (None, None)
+            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=args.seed)
+            print(json.dumps(res))
+            return 0
         if args.evaluate:
             lo, hi = args.goal_range or (None, None)
             res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=args.seed)

@@ -86,3 +86,14 @@ def test_shipped_point_policy_loads():
     pol = load_policy("point")
     assert pol.agent == "point" and len(pol.fingerprint) == 12
     assert np.abs(pol.act(np.zeros((3, 4), np.float32))).max() <= 1.0
+
+
+def test_chained_goal_evaluation_accounts_for_every_episode():
+    from specrefine.train import evaluate_chain
+
+    res = evaluate_chain(load_policy("point"), episodes=64, goals=4, seed=3)
+    arrived = [res["episodes"]] + res["reached"][:-1]  # episodes that set out for each goal
+    for i in range(4):
+        assert res["reached"][i] + res["flipped"][i] + res["timed_out"][i] == arrived[i]
+    assert res["flipped"] == [0, 0, 0, 0]  # a point mass cannot flip
+    assert res["success_rate"] == res["reached"][-1] / 64 >= 0.9  # the shipped point policy chains goals
