@@ -191,11 +191,16 @@ class BatchedSim:
         return self._state[:, 1:3].copy()
 
     @property
-    def flipped(self) -> np.ndarray:
+    def up(self) -> np.ndarray:
+        """z-component of the torso's z axis: 1 upright, 0 on its side, < 0 upside down (point: always 1)."""
         if self.agent != "ant":
-            return np.zeros(self.n, dtype=bool)
+            return np.ones(self.n)
         _, qx, qy, _ = self.qpos[:, 3:7].T
-        return 1.0 - 2.0 * (qx * qx + qy * qy) < 0.0  # z-component of the torso's z axis
+        return 1.0 - 2.0 * (qx * qx + qy * qy)
+
+    @property
+    def flipped(self) -> np.ndarray:
+        return self.up < 0.0
 
     def _yaw(self) -> np.ndarray:
         w, x, y, z = self.qpos[:, 3:7].T
@@ -247,6 +252,7 @@ class ReachTask:
     arrive_speed: float | None = None  # success also needs a planar speed below this (m/s): arrive under control
     lateral_cost: float = 0.0  # per metre moved across the line to the goal: keeps paths straight in corridors
     goals_per_episode: int = 1  # > 1: on success a new goal is drawn from where the agent is, without a reset
+    tilt_cost: float = 0.0  # per step x (1 - the torso's up-vector z): a dense warning long before a flip
 
 
 REACH_TASKS = {
@@ -338,7 +344,8 @@ class GoalReachEnv(EnvBase):
         if task.arrive_speed is not None:
             success &= np.linalg.norm(self.sim.qvel[:, :2], axis=1) < task.arrive_speed
         reward = (task.progress_scale * (self.dist - dist) + task.success_bonus * success
-                  - task.flip_penalty * flipped - task.step_cost - task.lateral_cost * self._sideways(before))
+                  - task.flip_penalty * flipped - task.step_cost - task.lateral_cost * self._sideways(before)
+                  - task.tilt_cost * (1.0 - self.sim.up))
         self.dist = dist
         more = success & ~flipped & (self.goal_index + 1 < task.goals_per_episode)
         if more.any():  # chained goals: the next one starts from here, at whatever speed the agent has

@@ -53,6 +53,8 @@ class Config:
     checkpoint_every_s: float = 120.0
     goals_per_episode: int = 1       # > 1: chained goals without a reset (see GoalReachEnv)
     init: str | None = None          # fine-tune: actor + critic weights from this trainer checkpoint.pt
+    tilt_cost: float | None = None   # None: the agent's ReachTask value
+    flip_penalty: float | None = None
 
     @property
     def frames_per_batch(self) -> int:
@@ -96,6 +98,7 @@ class Trainer:
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode)
+        task = replace(task, **{k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None})
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
         self.actor, self.critic = make_modules(self.policy, self.env)
@@ -408,6 +411,8 @@ def main(argv=None) -> int:
                     help="chain this many goals per episode, each drawn where the last was reached (no reset)")
     ap.add_argument("--init", metavar="CHECKPOINT", help="fine-tune from another run's OUT/checkpoint.pt")
     ap.add_argument("--lr", type=float, default=None, help="learning rate (default: the config's)")
+    ap.add_argument("--tilt-cost", type=float, default=None, help="reward -= this x (1 - torso up z) per step")
+    ap.add_argument("--flip-penalty", type=float, default=None, help="reward -= this on flipping")
     args = ap.parse_args(argv)
     try:
         if args.evaluate and args.chain:
@@ -424,7 +429,8 @@ def main(argv=None) -> int:
             return 0
         if not args.out:
             raise SpecrefineError("--out DIR is required for training")
-        overrides = {"seed": args.seed, "goals_per_episode": args.goals_per_episode, "init": args.init}
+        overrides = {"seed": args.seed, "goals_per_episode": args.goals_per_episode, "init": args.init,
+                     "tilt_cost": args.tilt_cost, "flip_penalty": args.flip_penalty}
         overrides |= ({"frames": args.frames} if args.frames else {}) | ({"lr": args.lr} if args.lr else {})
         cfg = make_config(args.agent, **overrides)
         path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()

@@ -154,3 +154,23 @@ def test_ant_spawned_at_its_footprint_radius_does_not_touch_a_wall():
 
     assert wall_contacts(reach + 0.02) == 0
     assert wall_contacts(0.6) > 0
+
+
+def test_tilt_cost_charges_an_ant_on_its_side():
+    from dataclasses import replace
+
+    from specrefine.sim import REACH_TASKS
+
+    rewards = {}
+    for tilt in (0.0, 0.5):
+        env = GoalReachEnv("ant", 2, seed=0, nthread=1, task=replace(REACH_TASKS["ant"], tilt_cost=tilt))
+        td = env.reset()
+        state = env.sim.get_state()
+        state[1, 4:8] = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # 90 degrees about x: on its side
+        env.sim.reset(states=state)
+        td["action"] = torch.zeros(2, 8)
+        out, _ = env.step_and_maybe_reset(td)
+        rewards[tilt] = out["next", "reward"].squeeze(-1).numpy()
+        assert env.sim.up[0] > 0.9 and abs(env.sim.up[1]) < 0.4  # after one step of falling
+    extra = rewards[0.0] - rewards[0.5]
+    assert extra[1] > 0.3 and extra[0] < 0.05  # about tilt_cost x 1 on its side, next to nothing upright
