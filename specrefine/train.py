@@ -127,10 +127,12 @@ class Trainer:
 
     def _load_weights(self, path: Path) -> None:
         """Start from another run's actor, critic and observation statistics (frames and optimiser start afresh)."""
+        import pickle
+
         try:
             ck = torch.load(path, map_location="cpu", weights_only=False)
             self.loss.load_state_dict(ck["loss"])
-        except (OSError, KeyError, RuntimeError, EOFError) as e:
+        except (OSError, KeyError, TypeError, RuntimeError, EOFError, pickle.UnpicklingError) as e:
             raise SpecrefineError(f"--init {path}: not a trainer checkpoint of this agent ({type(e).__name__})") from e
 
     def save_checkpoint(self) -> None:

@@ -97,3 +97,13 @@ def test_chained_goal_evaluation_accounts_for_every_episode():
         assert res["reached"][i] + res["flipped"][i] + res["timed_out"][i] == arrived[i]
     assert res["flipped"] == [0, 0, 0, 0]  # a point mass cannot flip
     assert res["success_rate"] == res["reached"][-1] / 64 >= 0.9  # the shipped point policy chains goals
+
+
+def test_init_starts_from_another_runs_weights(tiny_run, tmp_path):
+    out, path = tiny_run
+    trainer = Trainer(make_config("point", frames=2048, seed=1, init=str(out / "checkpoint.pt")), tmp_path / "ft",
+                      progress=False)
+    assert trainer.frames == 0 and trainer.policy.fingerprint == load_policy(path).fingerprint
+    (tmp_path / "junk.pt").write_bytes(b"not a checkpoint")
+    with pytest.raises(SpecrefineError, match="--init .*junk.pt: not a trainer checkpoint"):
+        Trainer(make_config("point", frames=2048, init=str(tmp_path / "junk.pt")), tmp_path / "ft2", progress=False)
