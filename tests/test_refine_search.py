@@ -229,6 +229,18 @@ def test_chain_dp_picks_best_subsets():
     assert choice.p == pytest.approx(best)
     assert choice.evaluations == 3 + 6 + 36 + 6  # unrefined chain, then (k+1) + (k+1)^2 (t-1) + (k+1)
 
+    class Batched(Ev):  # an evaluator that can run many subtasks at once gets each DP layer in one call
+        batches = []
+
+        def evaluate_many(self, subtasks):
+            self.batches.append(len(subtasks))
+            return [self.evaluate(start, goal_, avoid, point) for start, goal_, avoid, point in subtasks]
+
+    batched = Batched(p_of)
+    same = refine_chain(batched, Box(-1, -1, 0, 0), inner, goal, [WALLS] * 3, k=5, rng=np.random.default_rng(0))
+    assert same.p == choice.p and same.regions == choice.regions and same.evaluations == choice.evaluations
+    assert batched.batches == [6, 36, 6]
+
 
 def test_vertex_refinement_only_search_improves_a_path_with_a_bad_subgoal():
     g = _bad_subgoal_graph()
