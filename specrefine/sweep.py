@@ -73,11 +73,16 @@ def run_cell(cell: Cell, out_root: str) -> dict:
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
-    d = result.data
-    lo, hi = d["success_ci"]
-    row.update({k: d[k] for k in COLUMNS if k in d and k not in row})
-    row.update(status="ok", error="", success_ci_low=lo, success_ci_high=hi,
-               proposer_is_vlm=d["proposer_is_vlm"] if cell.proposer != "none" else False)
+    return result_row(result.data, row) | {"proposer_is_vlm": result.data["proposer_is_vlm"]
+                                           if cell.proposer != "none" else False}
+
+
+def result_row(data: dict, row: dict | None = None) -> dict:
+    """A results-table row (``COLUMNS``) from a run's ``result.json`` dict; ``row`` fields take precedence."""
+    row = dict(row or {})
+    lo, hi = data["success_ci"]
+    row.update({k: data[k] for k in COLUMNS if k in data and k not in row})
+    row.update(status="ok", error="", success_ci_low=lo, success_ci_high=hi)
     return row
 
 
