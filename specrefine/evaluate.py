@@ -1,17 +1,19 @@
 """Subtask evaluation: batched rollouts of the goal policy on a reach-avoid edge, and the monitor.
 
 ``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
-policy, started from ``start`` (uniform in a region where the body fits, or resampled end states of
-a preceding edge), reaches ``goal`` before entering ``avoid`` and before flipping, within
-``horizon`` control steps.  Entering means touching: ``avoid.signed_distance(xy) < body_radius``
-where ``Evaluator.body_radius`` = the simulator's body radius + MuJoCo's contact margin (pass the
-same ``Evaluator.body_radius`` to ``satisfies``).  The policy's goal point is ``goal_point`` if
-given, else a point sampled uniformly from ``goal`` per rollout (the paper's "representative
-waypoint randomly sampled from the inclusion set of the subtask's goal vertex").
+policy, started from ``start`` (uniform in a region where the agent fits: ``spawn_radius`` from
+walls, for the Ant the reach of its legs; or resampled end states of a preceding edge), reaches
+``goal`` before entering ``avoid`` and before flipping, within ``horizon`` control steps. Entering
+means touching: ``avoid.signed_distance(xy) < body_radius`` where ``Evaluator.body_radius`` = the
+simulator's body radius + MuJoCo's contact margin (pass the same ``Evaluator.body_radius`` to
+``satisfies``). The policy's goal point is ``goal_point`` if given, else a point sampled uniformly
+from ``goal`` per rollout (the paper's "representative waypoint randomly sampled from the inclusion
+set of the subtask's goal vertex").
 
-All ``n`` rollouts of a call run in one :class:`~specrefine.sim.BatchedSim` (one per batch size,
-built lazily and reused); a rollout that has finished is frozen (zero action, excluded from the
-checks, its trajectory padded with its last point) and the loop stops once all have finished.
+All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
+:class:`~specrefine.sim.BatchedSim` (one per batch size, built lazily and reused); a rollout that
+has finished is frozen (zero action, excluded from the checks, its trajectory padded with its last
+point) and the loop stops once all have finished.
 
 Reproducible: the seed fixes start states, goal points and (through them) the deterministic policy
 and physics, so the same seed gives identical numbers.  Results are cached in memory and, with
