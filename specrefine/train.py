@@ -97,8 +97,8 @@ class Trainer:
         self.out.mkdir(parents=True, exist_ok=True)
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
-        task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode)
-        task = replace(task, **{k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None})
+        optional = {k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None}
+        task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode, **optional)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
         self.actor, self.critic = make_modules(self.policy, self.env)
@@ -231,17 +231,21 @@ def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, c - h), min(1.0, c + h))
 
 
-def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = None, hi: float | None = None,
-                   seed: int = 0, horizon: int | None = None, nthread: int | None = None) -> dict:
-    """Deterministic policy, open floor, goals at uniform distance in [lo, hi]: success within the horizon."""
+def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
+    """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
     task = REACH_TASKS[policy.agent]
     lo = task.goal_min if lo is None else lo
     hi = task.goal_max if hi is None else hi
     rng = np.random.default_rng(seed)
     sim = BatchedSim(policy.agent, None, episodes, nthread=nthread)
-    horizon = horizon or sim.default_horizon
     sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
-    goals = sample_goals(sim.xy, lo, hi, rng)
+    return task, lo, hi, rng, sim, horizon or sim.default_horizon, sample_goals(sim.xy, lo, hi, rng)
+
+
+def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = None, hi: float | None = None,
+                   seed: int = 0, horizon: int | None = None, nthread: int | None = None) -> dict:
+    """Deterministic policy, open floor, goals at uniform distance in [lo, hi]: success within the horizon."""
+    task, lo, hi, rng, sim, horizon, goals = _open_floor(policy, episodes, lo, hi, seed, horizon, nthread)
     dist0 = np.linalg.norm(goals - sim.xy, axis=1)
     active = np.ones(episodes, dtype=bool)
     success, flipped = np.zeros(episodes, bool), np.zeros(episodes, bool)
@@ -276,14 +280,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     This is how a compositional policy uses the goal policy (the next subtask starts from a moving
     state); per goal it reports how many episodes got there and how many flipped on the way.
     """
-    task = REACH_TASKS[policy.agent]
-    lo = task.goal_min if lo is None else lo
-    hi = task.goal_max if hi is None else hi
-    rng = np.random.default_rng(seed)
-    sim = BatchedSim(policy.agent, None, episodes)
-    horizon = horizon or sim.default_horizon
-    sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
-    goal = sample_goals(sim.xy, lo, hi, rng)
+    task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
     index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
     alive = np.ones(episodes, dtype=bool)
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
