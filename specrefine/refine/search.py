@@ -130,6 +130,8 @@ class RefinementSearch:
 
     def _relax(self, u: str, v: str) -> None:
         f = self.f
+        if v in f.closed:  # Dijkstra: a closed vertex's cost is final (weights are >= 0)
+            return
         result = self.results.get((u, v))
         if result is None:
             result = self._evaluate(f.arrivals[u], v, (u, v))
