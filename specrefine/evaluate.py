@@ -16,11 +16,15 @@ has finished is frozen (zero action, excluded from the checks, its trajectory pa
 point) and the loop stops once all have finished.
 
 Reproducible: the seed fixes start states, goal points and (through them) the deterministic policy
-and physics, so the same seed gives identical numbers.  Results are cached in memory and, with
-``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the canonical
-JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon, seed, agent,
-maze, body radius, code version), written atomically (a run interrupted midway keeps every entry it
-finished); an unreadable or mismatching entry is ignored with a warning and recomputed.
+and physics, so the same seed gives the same numbers: bit for bit when the same call runs again on
+one machine (or is read back from the cache); through another batch shape (``evaluate_many``, the
+compaction of finished rollouts), thread count or CPU, the same successes (barring a rollout that
+ends within rounding of a boundary), with floats equal to a tolerance. Results are cached in memory
+and, with ``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the
+canonical JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon,
+seed, agent, maze, body radius, code version), written atomically (a run interrupted midway keeps
+every entry it finished); an unreadable or mismatching entry is ignored with a warning and
+recomputed.
 
 ``run_path`` runs a compositional policy (a sequence of legs, the goal switching when a leg's goal
 region is reached) end to end; ``satisfies`` is a monitor that checks trajectories against a task
@@ -396,8 +400,9 @@ class Evaluator:
     def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
         """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
 
-        The same numbers as one ``evaluate`` call each (every subtask is seeded on its own), in far
-        fewer, larger simulator steps.
+        The same successes as one ``evaluate`` call each (every subtask is seeded on its own), in far
+        fewer, larger simulator steps; trajectories agree to float tolerance (the policy sees another
+        batch shape).
         """
         n = int(n or self.n)
         seed = self.seed if seed is None else seed

@@ -22,6 +22,10 @@ from specrefine.mazes import load_maze
 from specrefine.regions import Box, Disc, union
 from specrefine.spec import maze_task
 
+# Floats computed through different batch shapes, thread counts or CPUs agree only to a tolerance
+# (batched matrix products may round differently); discrete outcomes are compared exactly.
+FLOAT_ATOL = 1e-4
+
 # u_maze at point scale:   #####
 #                          #G..#    G = cell (1, 1) centred at (-1, 1)
 #                          ###.#
@@ -272,9 +276,9 @@ def test_compaction_of_finished_rollouts_changes_nothing_but_cost(maze):
     for goal in (maze.cell_box(3, 3), maze.goal):
         a = plain.evaluate(maze.start, goal, maze.walls, seed=5)
         b = compact.evaluate(maze.start, goal, maze.walls, seed=5)
-        np.testing.assert_array_equal(a.trajectories, b.trajectories)
-        np.testing.assert_array_equal(a.outcome, b.outcome)
-        np.testing.assert_array_equal(a.end_states.states, b.end_states.states)
+        np.testing.assert_array_equal(a.outcome, b.outcome)  # compaction changes the policy's batch shape
+        np.testing.assert_allclose(a.trajectories, b.trajectories, atol=FLOAT_ATOL)
+        np.testing.assert_allclose(a.end_states.states, b.end_states.states, atol=FLOAT_ATOL)
     assert compact.sim_steps < plain.sim_steps
 
 
@@ -312,10 +316,10 @@ def test_evaluate_many_equals_one_evaluate_per_subtask(maze):
     expected = [first] + [alone.evaluate(*s) for s in subtasks[1:4]]
     together = Evaluator(maze, "point", policy, n=32, seed=0)
     got = together.evaluate_many(subtasks)
-    for want, res in zip(expected, got[:4], strict=True):
+    for want, res in zip(expected, got[:4], strict=True):  # outcomes exactly; floats to a tolerance (batch shapes)
         assert res.p == want.p and np.array_equal(res.success, want.success)
-        np.testing.assert_array_equal(res.trajectories, want.trajectories)
-        np.testing.assert_array_equal(res.end_states.states, want.end_states.states)
+        np.testing.assert_allclose(res.trajectories, want.trajectories, atol=FLOAT_ATOL)
+        np.testing.assert_allclose(res.end_states.states, want.end_states.states, atol=FLOAT_ATOL)
     assert got[4].cached and got[4].p == got[0].p  # asked twice: simulated once
     assert together.evaluations == 4 and together.cache_hits == 1
     assert [r.cached for r in together.evaluate_many(subtasks)] == [True] * 5 and together.evaluations == 4
