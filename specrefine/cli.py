@@ -1,7 +1,7 @@
 """The ``specrefine`` command line.
 
     specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl}
-        --proposer {geometric,random,replay:PATH,litellm:MODEL} --seed N --out DIR
+        --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from .errors import SpecrefineError
 from .mazes import CELL_SIZE
+from .pipeline import METHODS
 
-METHODS = ("ours", "vlm-oneshot", "symbolic", "dirl")
 AGENTS = tuple(CELL_SIZE)  # the agents a maze can be scaled for
 
 
@@ -25,8 +25,16 @@ def proposer_arg(text: str) -> str:
         return text
     if kind in ("replay", "litellm") and rest:
         return text
+    if kind == "imperfect" and rest:
+        from .imperfect import parse_imperfect
+
+        try:
+            parse_imperfect(rest)
+        except SpecrefineError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
     raise argparse.ArgumentTypeError(
-        f"invalid proposer {text!r}: use geometric, random, replay:PATH or litellm:MODEL")
+        f"invalid proposer {text!r}: use geometric, random, imperfect:PRESET, replay:PATH or litellm:MODEL")
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -45,13 +53,13 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("maze", metavar="MAZE_FILE", help="a .maze file (or the name of one in data/mazes/)")
     r.add_argument("--agent", choices=AGENTS, default="point",
                    help="point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells (default: point)")
-    r.add_argument("--method", choices=METHODS, default="ours",
-                   help="ours: A* with VLM edge splits + vertex subsets (Alg. 3); vlm-oneshot: whole-graph "
-                        "refinement in one query + one feedback round; symbolic: A* with vertex subsets only; "
-                        "dirl: no refinement, Dijkstra on the input graph (default: ours)")
+    r.add_argument("--method", choices=list(METHODS), default="ours",
+                   help="; ".join(f"{m}: {what}" for m, (_, what) in METHODS.items()) + " (default: ours)")
     r.add_argument("--proposer", type=proposer_arg, default="geometric",
                    help="who proposes edge splits: geometric (offline shortest-path waypoints, NOT a VLM), "
-                        "random (random free-space waypoints, ablation), replay:PATH (recorded VLM replies), "
+                        "random (random free-space waypoints, ablation), imperfect:PRESET or imperfect:key=value,... "
+                        "(VLM-like error model, offline, NOT a VLM; presets mild, moderate, severe), "
+                        "replay:PATH (recorded VLM replies), "
                         "litellm:MODEL (any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; "
                         "keys from the environment) (default: geometric)")
     r.add_argument("--seed", type=int, default=0, help="random seed for rollouts and proposers (default: 0)")

@@ -397,6 +397,11 @@ class Evaluator:
         """Success probability of the subtask start -> goal avoiding ``avoid`` (see the module docstring)."""
         return self.evaluate_many([(start, goal, avoid, goal_point)], seed=seed, n=n)[0]
 
+    def fresh_copy(self, cache_dir=None) -> Evaluator:
+        """The same evaluator (maze, agent, policy, n, horizon, seed) with zero counters and its own cache."""
+        return Evaluator(self.maze, self.agent, self.policy, n=self.n, horizon=self.horizon, seed=self.seed,
+                         cache_dir=cache_dir, nthread=self.nthread)
+
     def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
         """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
 

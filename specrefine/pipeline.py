@@ -23,6 +23,19 @@ from .spec import maze_task
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
 
+#: every method: whether it asks a proposer, and what it is (the paper's Sec. 5.1, plus controls)
+METHODS = {
+    "ours": (True, "Alg. 3: Dijkstra-order search with proposer edge splits and vertex subsets"),
+    "ours-novertex": (True, "control: ours without vertex refinement (edge splits only)"),
+    "ours-d1": (True, "control: ours with d = 1 (no feedback round in an edge split)"),
+    "vlm-oneshot": (True, "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w"),
+    "vlm-oneshot-matched": (True, "control: one-shot best-of-N, spending what ours spent (proposer calls, "
+                                  "subtask evaluations) on the same task and seed"),
+    "symbolic": (False, "baseline: the search with vertex subsets only"),
+    "dirl": (False, "baseline: no refinement, Dijkstra on the input graph"),
+}
+PROPOSER_METHODS = tuple(m for m, (asks, _) in METHODS.items() if asks)
+
 
 @dataclass
 class RunResult:
@@ -37,8 +50,8 @@ class RunResult:
                 f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
                 f"subtasks; refines input: {d['refines_input']}\n"
-                f"  {d['evaluations']} subtask evaluations, {d['sim_steps']} sim steps, {d['vlm_calls']} "
-                f"proposer calls ({'VLM' if d['proposer_is_vlm'] else 'offline, not a VLM'}), "
+                f"  {d['evaluations']} subtask evaluations, {d['sim_steps']} sim steps, "
+                f"{d['proposer_calls']} proposer calls ({'VLM' if d['proposer_is_vlm'] else 'offline, not a VLM'}), "
                 f"{d['wall_seconds']:.1f} s\n  -> {self.out / 'result.json'}")
 
 
@@ -71,7 +84,7 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
 
 
 def _make_proposer(spec: str, method: str, seed: int, out: Path):
-    if method not in ("ours", "vlm-oneshot"):
+    if method not in PROPOSER_METHODS:
         return None
     from .proposers import make_proposer
 
@@ -86,16 +99,30 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
     if method == "symbolic":
         cfg = SearchConfig(k=k, edge_refinement=False, seed=seed)
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
-    if method == "ours":
-        cfg = SearchConfig(w=w, d=d, k=k, seed=seed)
+    if method.startswith("ours"):
+        cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
+                           vertex_refinement=method != "ours-novertex")
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
                                 query_for=edge_query_builder(maze, agent), picture=candidate_picture(maze)).run()
-    if method == "vlm-oneshot":
+    if method.startswith("vlm-oneshot"):
         from .refine.oneshot import oneshot
 
+        budget = budget_of_ours(original, evaluator, proposer.spec, maze, agent, seed, w, d, k) \
+            if method == "vlm-oneshot-matched" else None
         return oneshot(original, evaluator, proposer, maze=maze, agent=agent, w=w, rounds=d, seed=seed,
-                       on_step=on_step)
+                       on_step=on_step, budget=budget)
     raise SpecrefineError(f"unknown method {method!r}")
+
+
+def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, k) -> tuple[int, int]:
+    """(proposer calls, subtask evaluations) that ``ours`` spends on this task and seed (run here, on its own cache)."""
+    from .proposers import make_proposer
+
+    cache = evaluator.cache_dir.parent / "budget_cache" if evaluator.cache_dir is not None else None
+    twin = evaluator.fresh_copy(cache_dir=cache)
+    proposer = make_proposer(proposer_spec, seed=seed)
+    _search("ours", original, twin, proposer, maze, agent, seed, w, d, k, on_step=None)
+    return proposer.proposer_calls, twin.evaluations + twin.disk_hits
 
 
 def edge_query_builder(maze, agent):
@@ -188,6 +215,7 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "evaluations": evaluator.evaluations + getattr(evaluator, "disk_hits", 0),
         "evaluations_simulated": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
         "sim_steps": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
+        "proposer_calls": int(getattr(proposer, "proposer_calls", 0) or 0),
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
         "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,
         "refines_input": not check_refines(graph, original), "path": search.path,

@@ -256,6 +256,11 @@ class Proposer:
     def cost_usd(self) -> float:
         return 0.0
 
+    @property
+    def proposer_calls(self) -> int:
+        """Calls to whoever proposes (a VLM's completion calls, re-asks included; an offline proposer's queries)."""
+        return self.queries
+
     def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         raise NotImplementedError  # pragma: no cover
 
@@ -265,7 +270,7 @@ class Proposer:
     def describe(self) -> dict:
         """What a result file should say about the proposer."""
         return {"proposer": self.spec, "name": self.name, "is_vlm": self.is_vlm, "queries": self.queries,
-                "vlm_calls": self.calls, "cost_usd": round(self.cost_usd, 6)}
+                "proposer_calls": self.proposer_calls, "vlm_calls": self.calls, "cost_usd": round(self.cost_usd, 6)}
 
     def __repr__(self):
         return f"<{type(self).__name__} {self.name}>"
@@ -292,6 +297,10 @@ class VLMProposer(Proposer):
     @property
     def cost_usd(self) -> float:
         return self.client.cost_usd
+
+    @property
+    def proposer_calls(self) -> int:
+        return self.client.calls
 
     def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         messages = split_messages(q, feedback)
@@ -364,8 +373,11 @@ def _nearest_free_cell(maze, xy) -> tuple[int, int]:
 
 
 def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.Generator | None = None,
-              noise: float = 0.0) -> list[tuple[int, int]]:
-    """Shortest 8-connected free-cell path (no corner cutting); ``noise`` > 0 randomises step costs."""
+              noise: float = 0.0, cell_cost=None) -> list[tuple[int, int]]:
+    """Shortest 8-connected free-cell path (no corner cutting); ``noise`` > 0 randomises step costs.
+
+    ``cell_cost(cell)`` (optional) multiplies the cost of every step into ``cell``.
+    """
     dist = {src: 0.0}
     prev: dict = {}
     heap = [(0.0, src)]
@@ -389,6 +401,8 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
                 if key not in costs:
                     costs[key] = 1.0 + noise * rng.random()
                 step *= costs[key]
+            if cell_cost is not None:
+                step *= cell_cost(nb)
             nd = d + step
             if nd < dist.get(nb, math.inf):
                 dist[nb], prev[nb] = nd, cell
@@ -543,9 +557,9 @@ class GeometricProposer(_GridProposer):
     spec = "geometric"
     name = "geometric (offline stand-in, not a VLM)"
 
-    def _route_points(self, maze, a_xy, b_xy, j, rng, margin_cells, max_leg) -> list[np.ndarray]:
+    def _route_points(self, maze, a_xy, b_xy, j, rng, margin_cells, max_leg, cell_cost=None) -> list[np.ndarray]:
         src, dst = _nearest_free_cell(maze, a_xy), _nearest_free_cell(maze, b_xy)
-        path = grid_path(maze, src, dst, rng, noise=0.0 if j == 0 else 0.6)
+        path = grid_path(maze, src, dst, rng, noise=0.0 if j == 0 else 0.6, cell_cost=cell_cost)
         if not path:
             return []
         cells = np.array(path)
@@ -670,9 +684,14 @@ def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = 
         proposer = RandomProposer(seed=seed)
     elif kind == "replay" and rest:
         proposer = VLMProposer(ReplayClient(rest), spec=spec)
+    elif kind == "imperfect" and rest:
+        from .imperfect import ImperfectProposer, parse_imperfect
+
+        proposer = ImperfectProposer(parse_imperfect(rest), spec=spec, seed=seed)
     elif kind == "litellm" and rest:
         proposer = VLMProposer(LiteLLMClient(rest, record_path=record_path, **client_kw), spec=spec)
     else:
-        raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, random, replay:PATH or litellm:MODEL")
+        raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, random, imperfect:PRESET, replay:PATH "
+                              "or litellm:MODEL")
     log.info("proposer: %s", proposer.name)
     return proposer

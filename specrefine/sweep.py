@@ -27,9 +27,8 @@ COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
-    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation",
+    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "proposer_calls",
 ]
-PROPOSER_METHODS = ("ours", "vlm-oneshot")
 
 
 @dataclass(frozen=True)
@@ -51,6 +50,8 @@ class Cell:
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = 32, episodes: int = 200) -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer."""
+    from .pipeline import PROPOSER_METHODS
+
     cells = []
     for maze in mazes:
         for method in methods:
@@ -101,7 +102,8 @@ def _typed(row: dict) -> dict:
             out[k] = v == "True"
         else:
             try:
-                out[k] = int(v) if k in ("seed", "episodes", "evaluations", "sim_steps", "vlm_calls") else float(v)
+                out[k] = int(v) if k in ("seed", "episodes", "evaluations", "sim_steps", "vlm_calls",
+                                                "proposer_calls") else float(v)
             except (TypeError, ValueError):
                 out[k] = v
     return out

@@ -17,7 +17,10 @@ from ..graph import check_refines
 from .search import SearchResult, shortest_path
 
 
-def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0, on_step=None) -> SearchResult:
+def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0, on_step=None,
+            budget: tuple[int, int] | None = None) -> SearchResult:
+    """The paper's baseline; with ``budget = (proposer calls, subtask evaluations)`` instead a best-of-N:
+    first-round queries (no feedback) repeated until either budget is spent (the matched control)."""
     from ..proposers import GraphFeedback, GraphQuery
 
     steps: list[dict] = []
@@ -34,15 +37,16 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
                        body_radius=evaluator.body_radius)
     log("input-evaluated", predicted_success=base.predicted_success, path=base.path)
     best, feedback = None, []
-    for round_ in range(rounds):
-        for graph in proposer.propose_graph(query, w, feedback):
+    for round_, graphs in enumerate(_rounds(proposer, query, w, rounds, feedback, evaluator, budget)):
+        for graph in graphs:
             result = shortest_path(graph, evaluator, seed=seed)
             problems = check_refines(graph, original)
             log("candidate", round=round_ + 1, predicted_success=result.predicted_success, path=result.path,
                 refines_input=not problems, violations=[str(p) for p in problems[:5]], graph=graph.to_dict())
-            feedback.append(GraphFeedback(graph=graph, edge_success=_edge_success(result),
-                                          success=result.predicted_success,
-                                          image_png=_picture(maze, evaluator, graph, result)))
+            if budget is None:
+                feedback.append(GraphFeedback(graph=graph, edge_success=_edge_success(result),
+                                              success=result.predicted_success,
+                                              image_png=_picture(maze, evaluator, graph, result)))
             if best is None or result.predicted_success > best.predicted_success:
                 best = result
     if best is None:  # every reply was rejected: the input graph is all there is
@@ -51,6 +55,18 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
     best.steps = steps
     log("done", predicted_success=best.predicted_success, path=best.path)
     return best
+
+
+def _rounds(proposer, query, w, rounds, feedback, evaluator, budget):
+    """The proposals of each round: ``rounds`` rounds with feedback, or first rounds until the budget is spent."""
+    if budget is None:
+        for _ in range(rounds):
+            yield proposer.propose_graph(query, w, feedback)
+        return
+    calls, evaluations = budget
+    start = evaluator.evaluations
+    while proposer.proposer_calls < calls and evaluator.evaluations - start < evaluations:
+        yield proposer.propose_graph(query, w, ())
 
 
 def _edge_success(result: SearchResult) -> dict:
