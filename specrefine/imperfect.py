@@ -79,10 +79,10 @@ PRESETS = {
     "mild": ImperfectConfig(position_sigma=0.15, coord_grid=0.0, radius_log_sigma=0.2, corner_pull=0.1,
                             p_drop_turn=0.1, p_uncapped=0.2, p_false_opening=0.05, p_wrong_branch=0.1,
                             p_mirror_y=0.0, p_unparseable=0.02, rho=0.8, p_ignore_subgoals=0.05),
-    "moderate": ImperfectConfig(position_sigma=0.3, coord_grid=0.5, radius_log_sigma=0.35, corner_pull=0.25,
+    "moderate": ImperfectConfig(position_sigma=0.3, coord_grid=0.1, radius_log_sigma=0.35, corner_pull=0.25,
                                 p_drop_turn=0.25, p_uncapped=0.5, p_false_opening=0.15, p_wrong_branch=0.25,
                                 p_mirror_y=0.05, p_unparseable=0.05, rho=0.6, p_ignore_subgoals=0.15),
-    "severe": ImperfectConfig(position_sigma=0.5, coord_grid=1.0, radius_log_sigma=0.5, corner_pull=0.4,
+    "severe": ImperfectConfig(position_sigma=0.5, coord_grid=0.25, radius_log_sigma=0.5, corner_pull=0.4,
                               p_drop_turn=0.4, p_uncapped=0.8, p_false_opening=0.3, p_wrong_branch=0.4,
                               p_mirror_y=0.1, p_unparseable=0.1, rho=0.4, p_ignore_subgoals=0.3),
 }
