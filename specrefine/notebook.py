@@ -188,3 +188,86 @@ def execute(nb: Path, out: Path, params: dict, *, env: dict, timeout: int,
         log, _ = proc.communicate()
         return None, log
     return proc.returncode, log
+
+
+def _git(*args) -> str:
+    try:
+        return subprocess.run(["git", "-C", str(NB_DIR.parent), *args], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return ""
+
+
+def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
+    """Executed copies of the notebooks (outputs and figures) for readers; 0 when all ran."""
+    import shutil
+    import tempfile
+    import time
+
+    import nbformat
+    from nbformat.v4 import new_markdown_cell
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    commit = _git("rev-parse", "--short=12", "HEAD") or "unknown"
+    dirty = bool(_git("status", "--porcelain", "--untracked-files=no", "--", "specrefine", "notebooks", "data"))
+    failed = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        env = kernel_env(Path(tmp), mpl_backend=None)  # the inline backend, as a reader's kernel has it
+        env["PYTHONPATH"] = os.pathsep.join([str(NB_DIR.parent), *filter(None, [env.get("PYTHONPATH")])])
+        for nb in sorted(NB_DIR.glob("[0-9][0-9]_*.ipynb")):
+            if stems and not any(nb.stem.startswith(s) for s in stems):
+                continue
+            params, harness = tier_settings(nb, tier)
+            run_dir = NB_DIR.parent / "runs" / "executed" / nb.stem  # fresh: no evaluation cache from earlier runs
+            shutil.rmtree(run_dir, ignore_errors=True)
+            params = {**params, "OUT_DIR": f"../runs/executed/{nb.stem}"}
+            out = out_dir / nb.name
+            t0 = time.time()
+            code, log = execute(nb, out, params, env=env, timeout=int(harness.get("timeout_s", DEFAULT_TIMEOUT_S)))
+            wall = time.time() - t0
+            print(f"{nb.name}: {'ok' if code == 0 else 'FAILED'} in {wall:.0f} s -> {out}", flush=True)
+            if code != 0:
+                failed += 1
+                print(log[-3000:])
+                if not out.exists():
+                    continue
+            copy = nbformat.read(out, as_version=4)
+            for cell in copy.cells:  # no per-cell timestamps: a regenerated copy differs only where results do
+                cell.metadata.pop("papermill", None)
+                cell.metadata.pop("execution", None)
+            copy.metadata.pop("papermill", None)
+            shown = ", ".join(f"{k}={v!r}" for k, v in params.items() if k != "OUT_DIR") or "the notebook's defaults"
+            note = harness.get("note", "")
+            header = (f"> **Executed copy** of [`notebooks/{nb.name}`](../{nb.name}) for reading: produced by "
+                      f"`make executed` at commit `{commit}`{' (with uncommitted changes)' if dirty else ''}, "
+                      f"{time.strftime('%Y-%m-%d')}, in {wall / 60:.1f} min on a 2-core CPU machine, with the "
+                      f"**{tier}** parameters of `notebooks/{TIERS[tier]}`: {shown}."
+                      + (f"\n>\n> {note}" if note else "")
+                      + "\n>\n> The widget (notebook 05's slider) needs a live kernel; edit and run the notebook "
+                        "itself, not this copy.")
+            copy.cells.insert(0, new_markdown_cell(header))
+            copy.metadata["specrefine"] = {"executed_copy_of": f"notebooks/{nb.name}", "commit": commit,
+                                           "uncommitted_changes": dirty, "tier": tier, "parameters": params,
+                                           "ok": code == 0, "wall_s": round(wall)}
+            out.write_text(nbformat.writes(copy) + "\n")
+            out.with_suffix(".params.json").unlink(missing_ok=True)
+    return 1 if failed else 0
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    p = argparse.ArgumentParser(prog="python -m specrefine.notebook",
+                                description="Executed copies of the numbered notebooks (make executed).")
+    sub = p.add_subparsers(dest="command", required=True)
+    ex = sub.add_parser("executed", help="run the notebooks with a tier's parameters and keep the outputs")
+    ex.add_argument("--tier", choices=sorted(TIERS), default="full")
+    ex.add_argument("--out", type=Path, default=NB_DIR / "executed")
+    ex.add_argument("notebooks", nargs="*", help="stems or number prefixes (e.g. 05); default all")
+    args = p.parse_args(argv)
+    return write_executed(args.notebooks, args.tier, args.out)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
