@@ -2,6 +2,12 @@
 
 __version__ = "0.1.0"
 
-from .notebook import record  # noqa: E402  (notebooks: `from specrefine import record`)
+
+def record(name, value, *, tol=None, rel=None):
+    """Record a notebook's key figure for the regression tests: see ``specrefine.notebook.record``."""
+    from .notebook import record as _record  # imported on use: `python -m specrefine.notebook` stays clean
+
+    return _record(name, value, tol=tol, rel=rel)
+
 
 __all__ = ["record", "__version__"]
