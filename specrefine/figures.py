@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .render import PngFigure  # noqa: E402
 from .sweep import summarise  # noqa: E402
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
@@ -45,7 +46,7 @@ def figure4(rows, tasks=None, metric="success"):
     tasks = tasks or [t for t in CORE_TASKS if any(s["maze"] == t for s in summary)]
     proposers = _proposers(rows) or ["none"]
     fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
-                             squeeze=False)
+                             squeeze=False, FigureClass=PngFigure)
     width = 0.8 / len(METHOD_ORDER)
     for ax, proposer in zip(axes[:, 0], proposers):
         for i, method in enumerate(METHOD_ORDER):
@@ -76,7 +77,8 @@ def figure5(rows):
     """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer."""
     summary = summarise(rows)
     proposers = _proposers(rows) or ["none"]
-    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
+    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
+                             FigureClass=PngFigure)
     for ax, proposer in zip(axes[0], proposers):
         for method in METHOD_ORDER:
             for subgoals, style in ((False, "-"), (True, "--")):

@@ -29,6 +29,18 @@ from matplotlib.ticker import MultipleLocator
 
 from .regions import Box, Disc, Region
 
+
+class PngFigure(Figure):
+    """A Figure that shows itself as a PNG in Jupyter (``display(fig)``, or as a cell's last value).
+
+    IPython renders a plain matplotlib Figure as a picture only when the inline backend has
+    registered its formatter (``%matplotlib inline``); otherwise a live JupyterLab shows the text
+    ``<Figure size 640x535 with 1 Axes>``, which is what the search slider of notebook 05 did.
+    """
+
+    def _repr_png_(self):
+        return to_png(self)
+
 WALL = "black"
 START = "#00c8e6"  # cyan
 GOAL = "#22b14c"  # green
@@ -68,7 +80,7 @@ def new_figure(bounds, size_px: int = 768, title: str | None = None, legend_row:
     else:
         h = size_px
         w = int(round(min(size_px, max((h - top - bottom) / aspect + left + right, 0.35 * size_px))))
-    fig = Figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    fig = PngFigure(figsize=(w / DPI, h / DPI), dpi=DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((left / w, bottom / h, 1 - (left + right) / w, 1 - (top + bottom) / h))
     ax.set_xlim(x0, x1)
@@ -309,7 +321,7 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     h = int(round(float(np.clip((w * n_rows) / n_cols + top, 0.3 * size_px, size_px))))
     if h == size_px and (w * n_rows) / n_cols + top > size_px:  # tall graph: shrink the width instead
         w = int(round(max((size_px - top) * n_cols / n_rows, 0.3 * size_px)))
-    fig = Figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    fig = PngFigure(figsize=(w / DPI, h / DPI), dpi=DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0 - top / h))
     ax.set_xlim(-0.5, n_cols - 0.5)

@@ -334,7 +334,7 @@ def read_log(path) -> list[dict]:
 
 def plot_curve(log_path, png_path=None, window: int = 10):
     """Success rate, return and frames/s against frames; saved to ``png_path`` when given."""
-    from matplotlib.figure import Figure  # not pyplot: no global state, no double display in notebooks
+    from .render import PngFigure as Figure  # not pyplot: no global state; shows as a PNG in notebooks
 
     rows = read_log(log_path)
     fig = Figure(figsize=(13, 3.4))
@@ -356,7 +356,7 @@ def plot_curve(log_path, png_path=None, window: int = 10):
 
 
 def plot_success_by_distance(result: dict, bins: int = 8):
-    from matplotlib.figure import Figure
+    from .render import PngFigure as Figure
 
     rows = success_by_distance(result, bins)
     mid = [(r["from_m"] + r["to_m"]) / 2 for r in rows]
@@ -374,7 +374,7 @@ def plot_success_by_distance(result: dict, bins: int = 8):
 
 def plot_rollouts(result: dict, n: int = 24):
     """Open-floor trajectories of ``evaluate_reach``: green success, red failure, x = goal."""
-    from matplotlib.figure import Figure
+    from .render import PngFigure as Figure
 
     fig = Figure(figsize=(5, 5))
     ax = fig.subplots()
