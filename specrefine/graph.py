@@ -16,7 +16,7 @@ from itertools import count
 import networkx as nx
 import numpy as np
 
-from .errors import InvalidRefinement
+from .errors import GraphError, InvalidRefinement
 from .regions import Region, from_dict, is_subset
 
 
@@ -42,7 +42,7 @@ class TaskGraph:
         self.g.add_edge(u, v, avoid=avoid, parent=tuple(parent) if parent else (u, v))
         if not nx.is_directed_acyclic_graph(self.g):
             self.g.remove_edge(u, v)
-            raise ValueError(f"edge {u}->{v} would create a cycle")
+            raise GraphError(f"edge {u}->{v} would create a cycle")
 
     def fresh_name(self) -> str:
         while True:

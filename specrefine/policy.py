@@ -14,17 +14,13 @@ import numpy as np
 import torch
 from torch import nn
 
-from .errors import SpecrefineError
+from .errors import PolicyError
 
 FORMAT = "specrefine-policy"
 VERSION = 1
 HIDDEN = 256
 POLICY_DIR = Path(__file__).resolve().parent.parent / "data" / "policies"
 OBS_ACT_DIMS = {"point": (4, 2), "ant": (29, 8)}
-
-
-class PolicyError(SpecrefineError):
-    """A policy file is missing, corrupt, or does not fit the agent."""
 
 
 def mlp(n_in: int, n_out: int, hidden: int = HIDDEN) -> nn.Sequential:

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import RegionError
+
 
 class Region:
     """Base class; subclasses are frozen dataclasses."""
@@ -49,7 +51,7 @@ class Region:
 def _as_points(points) -> np.ndarray:
     pts = np.asarray(points, dtype=float)
     if pts.shape[-1] != 2:
-        raise ValueError(f"points must have a trailing dimension of 2, got shape {pts.shape}")
+        raise RegionError(f"points must have a trailing dimension of 2, got shape {pts.shape}")
     return pts
 
 
@@ -64,7 +66,7 @@ class Box(Region):
         for f in ("xmin", "ymin", "xmax", "ymax"):
             object.__setattr__(self, f, float(getattr(self, f)))
         if not (self.xmax > self.xmin and self.ymax > self.ymin):
-            raise ValueError(f"empty box {self}")
+            raise RegionError(f"empty box {self}")
 
     def signed_distance(self, points) -> np.ndarray:
         p = _as_points(points)
@@ -107,7 +109,7 @@ class Disc(Region):
         for f in ("cx", "cy", "r"):
             object.__setattr__(self, f, float(getattr(self, f)))
         if not self.r > 0:
-            raise ValueError(f"disc radius must be positive, got {self.r}")
+            raise RegionError(f"disc radius must be positive, got {self.r}")
 
     def signed_distance(self, points) -> np.ndarray:
         p = _as_points(points)
@@ -141,7 +143,7 @@ class Union(Region):
         for m in self.members:
             flat.extend(m.parts())
         if not flat:
-            raise ValueError("a union needs at least one member")
+            raise RegionError("a union needs at least one member")
         object.__setattr__(self, "members", tuple(flat))
 
     def parts(self):
@@ -207,7 +209,7 @@ def from_dict(d: dict) -> Region:
         return Disc(float(d["cx"]), float(d["cy"]), float(d["r"]))
     if kind == "union":
         return Union(tuple(from_dict(m) for m in d["members"]))  # Union even for one member: lossless
-    raise ValueError(f"unknown region type {kind!r}")
+    raise RegionError(f"unknown region type {kind!r}")
 
 
 def _elementary_cells(boxes, extra_bounds):

@@ -37,7 +37,14 @@ from typing import Annotated, Any, Literal  # noqa: E402
 import numpy as np  # noqa: E402
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator  # noqa: E402
 
-from .errors import SpecrefineError  # noqa: E402
+from .errors import (  # noqa: E402
+    ProposalRejected,
+    ReplayMiss,
+    SpecrefineError,
+    VLMConfigError,
+    VLMError,
+    VLMUnavailable,
+)
 from .regions import Box, Disc, Region  # noqa: E402
 
 log = logging.getLogger(__name__)
@@ -46,29 +53,6 @@ ROOT = Path(__file__).resolve().parent.parent
 PROMPT_DIR = ROOT / "prompts"
 RECORD_DIR = ROOT / "data" / "vlm"
 RECORD_VERSION = 1
-
-
-# --------------------------------------------------------------------------------------------
-# errors
-# --------------------------------------------------------------------------------------------
-class VLMError(SpecrefineError):
-    """A VLM call failed for a reason the user must fix or wait out (one line)."""
-
-
-class VLMConfigError(VLMError):
-    """Missing API key, unknown model, key rejected."""
-
-
-class VLMUnavailable(VLMError):
-    """Provider down, unreachable or rate-limiting after all retries."""
-
-
-class ReplayMiss(VLMError):
-    """A replayed run asked something the recording has no answer for."""
-
-
-class ProposalRejected(ValueError):
-    """A VLM reply that cannot be used; ``str(exc)`` is the one-line reason."""
 
 
 # --------------------------------------------------------------------------------------------
