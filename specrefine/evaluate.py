@@ -45,8 +45,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import get_agent
 from .errors import SpecrefineError
-from .mazes import CELL_SIZE, Maze
+from .mazes import Maze
 from .regions import Box, Disc, Region
 
 CACHE_VERSION = 1
@@ -244,14 +245,12 @@ class Evaluator:
                  cache_dir=None, nthread: int | None = None):
         import mujoco
 
-        from .sim import agent_spec, build_model, footprint_radius
+        from .sim import build_model, footprint_radius
 
-        if agent not in CELL_SIZE:
-            raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(CELL_SIZE)}")
-        if abs(maze.cell_size - CELL_SIZE[agent]) > 1e-9:
+        spec = get_agent(agent)
+        if abs(maze.cell_size - spec.cell_size) > 1e-9:
             raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
-                                  f"{CELL_SIZE[agent]:g} m: pass maze.for_agent({agent!r})")
-        spec = agent_spec(agent)
+                                  f"{spec.cell_size:g} m: pass maze.for_agent({agent!r})")
         self.maze, self.agent, self.policy = maze, agent, policy
         self.n, self.seed, self.nthread = int(n), seed, nthread
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon

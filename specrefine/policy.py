@@ -14,13 +14,14 @@ import numpy as np
 import torch
 from torch import nn
 
+from .agents import AGENTS
 from .errors import PolicyError
 
 FORMAT = "specrefine-policy"
 VERSION = 1
 HIDDEN = 256
 POLICY_DIR = Path(__file__).resolve().parent.parent / "data" / "policies"
-OBS_ACT_DIMS = {"point": (4, 2), "ant": (29, 8)}
+OBS_ACT_DIMS = {name: (a.obs_dim, a.act_dim) for name, a in AGENTS.items()}
 
 
 def mlp(n_in: int, n_out: int, hidden: int = HIDDEN) -> nn.Sequential:

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import get_agent
 from .errors import SpecrefineError
 from .graph import TaskGraph
 from .regions import Disc, Region, is_subset
@@ -46,20 +47,9 @@ from .vlm import (
 
 log = logging.getLogger(__name__)
 
-#: what the prompt says about each agent, and its body radius in metres (as in ``specrefine.sim``)
-# (description, body radius in m, reach in m: the goal distance the pretrained policy was trained and checked on)
-AGENT_INFO = {
-    "point": ("a point mass (a small ball driven by a 2-D force, as in Gymnasium-Robotics PointMaze); it is fast "
-              "and agile but can overshoot a target and slide along walls", 0.1, 3.0),
-    "ant": ("the MuJoCo Ant, a four-legged walking robot (as in Gymnasium-Robotics AntMaze); it is slow to turn, "
-            "can catch its legs on corners and can flip over", 0.5, 6.0),
-}
-
-
 def reach_cells(maze, agent: str) -> int:
     """How many cells one subtask should span at most: the policy's reach, at least one cell."""
-    reach = AGENT_INFO.get(agent, (None, None, None))[2]
-    return 6 if reach is None else max(1, int(reach // maze.cell_size))
+    return max(1, int(get_agent(agent).policy_reach // maze.cell_size))
 
 
 # --------------------------------------------------------------------------------------------
@@ -78,7 +68,7 @@ class EdgeQuery:
     n: int  # rollouts behind it
     image_png: bytes | None  # the map with start/goal and the evaluated trajectories
     graph: TaskGraph | None = None  # the task graph the edge belongs to (context only)
-    body_radius: float | None = None  # default: AGENT_INFO
+    body_radius: float | None = None  # default: the agent's body radius
 
 
 @dataclass
@@ -131,8 +121,9 @@ def _rj(region: Region) -> str:
 
 def environment_text(maze, agent: str, body_radius: float | None = None) -> str:
     """The environment description in every prompt: maze geometry and frame, agent, body size."""
-    desc, default_r, reach = AGENT_INFO.get(agent, (f"the {agent} agent", None, None))
-    r = body_radius if body_radius is not None else default_r
+    info = get_agent(agent)
+    desc, reach = info.description, info.policy_reach
+    r = body_radius if body_radius is not None else info.body_radius
     lines = [maze.describe(), f"Agent: {agent}, {desc}."]
     if reach is not None:
         lines.append(f"Policy: a goal-conditioned policy pretrained on an open floor to reach goal points up to "

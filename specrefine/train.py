@@ -26,9 +26,10 @@ from tensordict.nn import TensorDictModule
 from torch import nn
 from tqdm.auto import tqdm
 
+from .agents import AGENTS, get_agent
 from .errors import SpecrefineError
 from .policy import GoalPolicy, load_policy, mlp, save_policy
-from .sim import REACH_TASKS, BatchedSim, GoalReachEnv, sample_goals
+from .sim import BatchedSim, GoalReachEnv, sample_goals
 
 
 @dataclass
@@ -61,16 +62,9 @@ class Config:
         return self.num_envs * self.steps_per_env
 
 
-AGENT_DEFAULTS = {
-    "point": dict(frames=200_000, num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
-    "ant": dict(frames=10_000_000, num_envs=64, steps_per_env=64, epochs=5, minibatch=2048),
-}
-
-
 def make_config(agent: str, **overrides) -> Config:
-    if agent not in AGENT_DEFAULTS:
-        raise SpecrefineError(f"unknown agent {agent!r}; expected point or ant")
-    return replace(Config(agent=agent), **{**AGENT_DEFAULTS[agent], **overrides})
+    """The agent's training defaults (``specrefine.agents``) with ``overrides`` on top."""
+    return replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
 
 
 # --- networks ---------------------------------------------------------------------------------
@@ -98,7 +92,7 @@ class Trainer:
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         optional = {k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None}
-        task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode, **optional)
+        task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
         self.actor, self.critic = make_modules(self.policy, self.env)
@@ -233,7 +227,7 @@ def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
 
 def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
     """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
-    task = REACH_TASKS[policy.agent]
+    task = get_agent(policy.agent).reach_task
     lo = task.goal_min if lo is None else lo
     hi = task.goal_max if hi is None else hi
     rng = np.random.default_rng(seed)
@@ -394,7 +388,7 @@ def plot_rollouts(result: dict, n: int = 24):
 # --- command line -----------------------------------------------------------------------------
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m specrefine.train", description=__doc__.splitlines()[0])
-    ap.add_argument("--agent", choices=["point", "ant"], required=True)
+    ap.add_argument("--agent", choices=list(AGENTS), required=True)
     ap.add_argument("--frames", type=int, default=None, help="total frames (default: the config's)")
     ap.add_argument("--out", default=None, help="run directory (checkpoint, log, curve)")
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
