@@ -159,21 +159,22 @@ class Measurement:
 
 
 def _measure(evaluator, original, search, episodes, seed) -> Measurement:
-    from .evaluate import satisfies
+    from .evaluate import path_legs
+    from .monitor import satisfies
 
     if not search.path or len(search.path) < 2:
         return Measurement(np.zeros(0, dtype=bool), None)
-    from .evaluate import path_legs
 
     # always from the ORIGINAL initial distribution, even if a baseline changed the initial vertex
-    pr = evaluator.run_path(original.region(original.initial), path_legs(search.graph, search.path), n=episodes,
-                            seed=seed + MEASURE_SEED_OFFSET)
-    ok = satisfies(original, pr.trajectories, pr.lengths, body_radius=evaluator.body_radius)
+    legs = path_legs(search.graph, search.path)
+    pr = evaluator.run_compositional(original.region(original.initial), legs, n=episodes,
+                                     seed=seed + MEASURE_SEED_OFFSET)
+    ok = satisfies(original, pr.trajectories, pr.lengths, clearance=evaluator.clearance)
     return Measurement(ok, pr)
 
 
 def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, search, measured, evaluator, t0):
-    from .evaluate import wilson_ci
+    from .results import wilson_ci
 
     n_ok, n = int(measured.success.sum()), len(measured.success)
     graph = search.graph

@@ -128,3 +128,28 @@ def load_policy(path_or_agent) -> GoalPolicy:
         raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
     policy.meta = blob.get("meta", {})
     return policy.eval()
+
+
+class PointController:
+    """A straight-line controller for the point mass (no learning, no knowledge of walls).
+
+    It tracks the velocity ``min(gain * |e|, vmax)`` towards the goal (``e`` = goal - xy) with a
+    proportional force: ``a = clip(kv * (v* - v), -1, 1)``.  Observation layout as in
+    :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).  Deterministic;
+    a stand-in policy for tests and for notebooks without a trained checkpoint.
+    """
+
+    agent = "point"
+
+    def __init__(self, gain: float = 4.0, vmax: float = 2.0, kv: float = 0.2):
+        self.gain, self.vmax, self.kv = float(gain), float(vmax), float(kv)
+        self.fingerprint = f"point-line-g{self.gain:g}-v{self.vmax:g}-k{self.kv:g}"
+
+    def act(self, obs, deterministic: bool = True) -> np.ndarray:
+        obs = np.asarray(obs, dtype=np.float64)
+        e = obs[:, 2:4]
+        d = np.linalg.norm(e, axis=1, keepdims=True)
+        v_star = e * np.minimum(self.gain, self.vmax / np.maximum(d, 1e-9))
+        return np.clip(self.kv * (v_star - obs[:, 0:2]), -1.0, 1.0)
+
+    __call__ = act

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from dataclasses import asdict, dataclass, replace
@@ -29,6 +28,7 @@ from tqdm.auto import tqdm
 from .agents import AGENTS, get_agent
 from .errors import SpecrefineError
 from .policy import GoalPolicy, load_policy, mlp, save_policy
+from .results import wilson_ci
 from .sim import BatchedSim, GoalReachEnv, sample_goals
 
 
@@ -215,16 +215,6 @@ def train(agent: str, frames: int, out, resume: bool = False, progress: bool = T
 
 
 # --- evaluation ---------------------------------------------------------------------------------
-def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return (0.0, 1.0)
-    p = successes / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (max(0.0, c - h), min(1.0, c + h))
-
-
 def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
     """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
     task = get_agent(policy.agent).reach_task
@@ -261,8 +251,9 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
     sim.close()
     k = int(success.sum())
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goal_range_m": [lo, hi], "horizon": horizon,
-            "success_radius_m": task.success_radius, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
-            "flip_rate": float(flipped.mean()), "mean_steps_success": float(steps[success].mean()) if k else None,
+            "success_radius_m": task.success_radius, "success_rate": k / episodes,
+            "success_ci95": wilson_ci(k, episodes), "flip_rate": float(flipped.mean()),
+            "mean_steps_success": float(steps[success].mean()) if k else None,
             "distance": dist0, "success": success, "flipped": flipped, "steps": steps, "trajectories": traj,
             "goals": goals}
 
@@ -297,7 +288,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     sim.close()
     k = int(reached[-1])
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
-            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
+            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
             "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
             "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
 
@@ -310,7 +301,7 @@ def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
         m = (result["distance"] >= a) & (result["distance"] < b if b < hi else result["distance"] <= b)
         k, n = int(result["success"][m].sum()), int(m.sum())
         rows.append({"from_m": round(float(a), 3), "to_m": round(float(b), 3), "n": n,
-                     "success_rate": k / n if n else None, "ci95": wilson(k, n)})
+                     "success_rate": k / n if n else None, "ci95": wilson_ci(k, n)})
     return rows
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..graph import TaskGraph, assert_refines
-from .common import Leg, SubtaskEvaluator, evaluate_path, start_of, weight
+from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .vertex import refine_chain
 
@@ -144,7 +144,7 @@ class RefinementSearch:
 
     def _evaluate(self, start, v: str, edge):
         g = self.graph
-        return evaluate_path(self.evaluator, start, [Leg(g.region(v), g.avoid(*edge), g.goal_point(v))]).results[0]
+        return estimate_legs(self.evaluator, start, [Leg(g.region(v), g.avoid(*edge), g.goal_point(v))]).results[0]
 
     def _refine(self) -> None:
         f = self.f
@@ -220,7 +220,7 @@ class RefinementSearch:
         avoids = [g.avoid(u, v), g.avoid(v, w)]
         choice = refine_chain(self.evaluator, f.arrivals[u], [g.region(v)], g.region(w), avoids, self.cfg.k,
                               self.rng, g.goal_point(w))
-        current = evaluate_path(self.evaluator, f.arrivals[u],
+        current = estimate_legs(self.evaluator, f.arrivals[u],
                                 [Leg(g.region(v), avoids[0], g.goal_point(v)), Leg(g.region(w), avoids[1],
                                                                                    g.goal_point(w))])
         n = self.evaluator.n
