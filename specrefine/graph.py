@@ -101,6 +101,10 @@ class TaskGraph:
     def topological_order(self) -> list[str]:
         return list(nx.topological_sort(self.g))
 
+    def topological_layers(self) -> list[list[str]]:
+        """Vertices by depth: sources first, each vertex one layer after its deepest predecessor."""
+        return [list(layer) for layer in nx.topological_generations(self.g)]
+
     def descendants(self, v: str) -> set[str]:
         return nx.descendants(self.g, v)
 
@@ -128,6 +132,9 @@ class TaskGraph:
         for a, b in zip(chain, chain[1:]):
             self.add_edge(a, b, avoid, parent=parent)
         return names
+
+    def set_avoid(self, u: str, v: str, avoid: Region) -> None:
+        self.g.edges[u, v]["avoid"] = avoid
 
     def narrow_vertex(self, v: str, region: Region) -> None:
         """Replace I(v) by ``region`` (a subset of it: vertex refinement); its goal point is dropped."""

@@ -21,9 +21,10 @@ import numpy as np
 
 from .agents import AGENTS, get_agent
 from .errors import MazeError
+from .paths import data_dir
 from .regions import Box, Region, union
 
-MAZE_DIR = Path(__file__).resolve().parent.parent / "data" / "mazes"
+MAZE_DIR = data_dir() / "mazes"
 CELL_SIZE = {name: agent.cell_size for name, agent in AGENTS.items()}  # metres per cell, by agent
 _LEGAL = set("#.SG") | set("abcdefghijklmnopqrstuvwxyz")
 

@@ -117,8 +117,8 @@ def _edge_graph(graph, u, v):
     from .graph import TaskGraph
 
     sub = TaskGraph(u)
-    sub.add_vertex(u, graph.region(u), label=graph.g.nodes[u]["label"])
-    sub.add_vertex(v, graph.region(v), label=graph.g.nodes[v]["label"])
+    sub.add_vertex(u, graph.region(u), label=graph.label(u))
+    sub.add_vertex(v, graph.region(v), label=graph.label(v))
     sub.add_edge(u, v, graph.avoid(u, v))
     sub.finals = {v}
     return sub
@@ -192,7 +192,7 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
         "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,
         "refines_input": not check_refines(graph, original), "path": search.path,
-        "graph_vertices": graph.g.number_of_nodes(), "graph_edges": graph.g.number_of_edges(),
+        "graph_vertices": graph.n_vertices, "graph_edges": graph.n_edges,
         "path_edges": path_edges, "graph": graph.to_dict(), "input_graph": original.to_dict(),
     }
 

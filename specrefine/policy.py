@@ -16,11 +16,12 @@ from torch import nn
 
 from .agents import AGENTS
 from .errors import PolicyError
+from .paths import data_dir
 
 FORMAT = "specrefine-policy"
 VERSION = 1
 HIDDEN = 256
-POLICY_DIR = Path(__file__).resolve().parent.parent / "data" / "policies"
+POLICY_DIR = data_dir() / "policies"
 OBS_ACT_DIMS = {name: (a.obs_dim, a.act_dim) for name, a in AGENTS.items()}
 
 

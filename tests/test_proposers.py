@@ -18,9 +18,9 @@ from specrefine.proposers import (
     segment_clear,
     split_messages,
 )
+from specrefine.proposers.schema import check_region
 from specrefine.regions import Disc
 from specrefine.spec import maze_task
-from specrefine.vlm import check_region
 
 MAZES = sorted(benchmark_mazes())
 W = 3

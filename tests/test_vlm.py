@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.errors import SpecrefineError
+from specrefine.errors import ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
 from specrefine.graph import check_refines
 from specrefine.mazes import load_maze, parse_maze
 from specrefine.proposers import (
@@ -31,17 +31,10 @@ from specrefine.proposers import (
     make_proposer,
     split_messages,
 )
+from specrefine.proposers.schema import parse_graph
 from specrefine.regions import Disc
 from specrefine.spec import maze_task
-from specrefine.vlm import (
-    LiteLLMClient,
-    ReplayClient,
-    ReplayMiss,
-    VLMConfigError,
-    VLMUnavailable,
-    parse_graph,
-    request_hash,
-)
+from specrefine.vlm import LiteLLMClient, ReplayClient, request_hash
 
 KEY = "sk-test-DUMMY-5ecret-0123456789abcdef"
 MODEL = "openai/test-model"
@@ -369,7 +362,7 @@ def test_graph_reply_becomes_task_graph(maze):
     assert check_refines(g, original) == []  # this reply happens to be a true refinement
     bad = json.loads(graph_reply(maze))
     bad["edges"].append({"u": "G", "v": "S"})
-    from specrefine.vlm import ProposalRejected
+    from specrefine.errors import ProposalRejected
 
     with pytest.raises(ProposalRejected, match="cycle"):
         parse_graph(json.dumps(bad), maze, original)

@@ -186,7 +186,7 @@ class RefinementSearch:
 
     def _vertex_eligible(self, v) -> bool:
         g = self.graph
-        if v in g.finals or v == g.initial or g.g.in_degree(v) != 1 or g.g.out_degree(v) != 1:
+        if v in g.finals or v == g.initial or g.in_degree(v) != 1 or g.out_degree(v) != 1:
             return False
         return g.successors(v)[0] not in self.f.closed
 
@@ -235,16 +235,11 @@ class RefinementSearch:
     def _apply(self, ref: Refinement) -> None:
         g = self.graph
         if ref.kind == "split":
-            avoid, parent = g.avoid(ref.u, ref.v), g.g.edges[ref.u, ref.v]["parent"]
-            g.g.remove_edge(ref.u, ref.v)
             self.results.pop((ref.u, ref.v), None)
-            chain = [ref.u] + [g.add_vertex(None, x, refines=None) for x in ref.data.waypoints] + [ref.v]
-            for a, b in zip(chain, chain[1:]):
-                g.add_edge(a, b, avoid, parent=parent)
-            self.results[(chain[0], chain[1])] = ref.data.results[0]
+            names = g.split_edge(ref.u, ref.v, ref.data.waypoints)
+            self.results[(ref.u, (names or [ref.v])[0])] = ref.data.results[0]
         else:
-            node = g.g.nodes[ref.v]
-            node["region"], node["point"] = ref.data.regions[0], None
+            g.narrow_vertex(ref.v, ref.data.regions[0])
             self.results[(ref.u, ref.v)] = ref.data.results[0]
         self.accepted += 1
         assert_refines(g, self.original)
