@@ -40,7 +40,7 @@ import os
 import warnings
 from collections import OrderedDict
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -65,6 +65,36 @@ from .results import (
 CACHE_VERSION = 1
 
 
+@dataclass(frozen=True)
+class EvaluationFacts:
+    """What the evaluator does, as a prompt tells it to a VLM: read from the code, never restated by hand.
+
+    The goal point of a subtask whose goal vertex has no fixed point is drawn uniformly inside the
+    goal region, at least ``clearance`` from walls where the region allows (``Evaluator.sample_free``);
+    success is the agent's centre entering the goal region before touching the avoid set (coming
+    within ``clearance`` of it), before flipping and within ``horizon`` control steps.
+    """
+
+    agent: str
+    clearance: float  # m
+    horizon: int  # control steps per subtask
+    control_period: float  # s per control step
+    rollouts: int  # per subtask evaluation
+
+    @property
+    def horizon_seconds(self) -> float:
+        return self.horizon * self.control_period
+
+    @classmethod
+    def default(cls, agent: str, maze: Maze, rollouts: int = 32) -> EvaluationFacts:
+        """The facts of an ``Evaluator(maze, agent, ...)`` with default settings, without building one."""
+        from .sim import build_model, contact_margin
+
+        spec = get_agent(agent)
+        clearance = spec.body_radius + contact_margin(build_model(agent, maze))
+        return cls(agent, clearance, spec.default_horizon, spec.timestep * spec.frame_skip, rollouts)
+
+
 def _region_key(region: Region) -> dict:
     return region.to_dict()
 
@@ -84,9 +114,7 @@ class Evaluator:
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
                  cache_dir=None, nthread: int | None = None):
-        import mujoco
-
-        from .sim import build_model, footprint_radius
+        from .sim import build_model, contact_margin, footprint_radius
 
         spec = get_agent(agent)
         if abs(maze.cell_size - spec.cell_size) > 1e-9:
@@ -97,11 +125,8 @@ class Evaluator:
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon
         self.agent_radius = float(spec.body_radius)  # the agent entry's (and BatchedSim's) body radius
         model = build_model(agent, maze)
-        names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
-        wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
-        agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
         #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
-        self.contact_margin = float(wall_margin + agent_margin)
+        self.contact_margin = contact_margin(model)
         #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < clearance
         self.clearance = self.agent_radius + self.contact_margin
         #: fresh starts (default pose) keep this far from walls: the body radius, or the legs' reach if larger
@@ -120,6 +145,16 @@ class Evaluator:
         self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
 
     # --- plumbing ------------------------------------------------------------------------------
+    @property
+    def control_period(self) -> float:
+        """Seconds per control step."""
+        spec = get_agent(self.agent)
+        return spec.timestep * spec.frame_skip
+
+    def facts(self) -> EvaluationFacts:
+        """What this evaluator does, in the terms a prompt states it (see :class:`EvaluationFacts`)."""
+        return EvaluationFacts(self.agent, self.clearance, self.horizon, self.control_period, self.n)
+
     @property
     def body_radius(self) -> float:
         """Former name of :attr:`clearance` (torso + contact margin), kept for older notebooks."""

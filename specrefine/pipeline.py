@@ -88,8 +88,9 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
     if method == "ours":
         cfg = SearchConfig(w=w, d=d, k=k, seed=seed)
+        query_for = edge_query_builder(maze, agent, evaluator.facts())
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
-                                query_for=edge_query_builder(maze, agent), picture=candidate_picture(maze)).run()
+                                query_for=query_for, picture=candidate_picture(maze)).run()
     if method == "vlm-oneshot":
         from .refine.oneshot import oneshot
 
@@ -98,8 +99,12 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
     raise SpecrefineError(f"unknown method {method!r}")
 
 
-def edge_query_builder(maze, agent):
-    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts."""
+def edge_query_builder(maze, agent, facts=None):
+    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts.
+
+    ``facts``: the evaluator's ``facts()``, what the prompt says about the evaluation (default: an
+    evaluator with default settings on ``maze``).
+    """
     from .proposers import EdgeQuery
     from .render import render_task, to_png
 
@@ -108,7 +113,8 @@ def edge_query_builder(maze, agent):
                           success=getattr(result, "success", None), lengths=getattr(result, "lengths", None),
                           title=f"{u} -> {v}: {result.p:.0%} of {result.n} rollouts succeed")
         return EdgeQuery(maze=maze, agent=agent, start=graph.region(u), goal=graph.region(v),
-                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph)
+                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph,
+                         facts=facts)
 
     return build
 

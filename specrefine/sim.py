@@ -77,6 +77,14 @@ def footprint_radius(model: mujoco.MjModel) -> float:
     return reach
 
 
+def contact_margin(model: mujoco.MjModel) -> float:
+    """The gap at which the agent's contacts with walls become active (the sum of both geoms' margins)."""
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
+    wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
+    agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
+    return float(wall_margin + agent_margin)
+
+
 def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
     """The agent's MJCF plus one static box geom per wall part of ``maze``."""
     spec_ = get_agent(agent)

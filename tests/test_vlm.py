@@ -166,7 +166,7 @@ def test_request_carries_image_prompt_and_key_header(srv, tmp_path, query):
     assert [i["image_url"]["url"] for i in images] == ["data:image/png;base64," + base64.b64encode(tiny_png()).decode()]
     text = user_text(body)
     for part in ("Maze 'split_doorway': 10 rows x 13 columns, cell size 1.0 m", "#SS...#####.#",  # environment
-                 "Agent: point", "within 0.1 m", "origin at the map centre",
+                 "Agent: point", "within 0.104 m", "origin at the map centre",  # clearance = 0.1 m + contact margin
                  "succeeded 10 times", "31.2%", "run 32 times",  # evaluation
                  '{"type": "box", "min": [1.5, -2.0], "max": [3.5, -1.0]}',  # goal region
                  "the maze walls", '"waypoints"', "at most 32"):  # avoid set, schema

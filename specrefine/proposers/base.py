@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..evaluate import EvaluationFacts
 from ..graph import TaskGraph
 from ..regions import Region
 from .schema import region_json
@@ -31,7 +32,7 @@ class EdgeQuery:
     n: int  # rollouts behind it
     image_png: bytes | None  # the map with start/goal and the evaluated trajectories
     graph: TaskGraph | None = None  # the task graph the edge belongs to (context only)
-    body_radius: float | None = None  # default: the agent's body radius
+    facts: EvaluationFacts | None = None  # what the evaluator does (default: an Evaluator's default settings)
 
 
 @dataclass
@@ -58,7 +59,7 @@ class GraphQuery:
     n: int  # rollouts per subtask evaluation
     image_png: bytes | None
     edge_success: dict[tuple[str, str], float] = field(default_factory=dict)
-    body_radius: float | None = None
+    facts: EvaluationFacts | None = None
 
 
 @dataclass

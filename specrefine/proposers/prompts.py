@@ -16,6 +16,7 @@ import numpy as np
 
 from ..agents import get_agent
 from ..errors import SpecrefineError
+from ..evaluate import EvaluationFacts
 from ..graph import TaskGraph
 from ..paths import prompt_dir
 from ..regions import Region, is_subset
@@ -51,20 +52,28 @@ def _rj(region: Region) -> str:
     return json.dumps(region_json(region))
 
 
-def environment_text(maze, agent: str, body_radius: float | None = None) -> str:
-    """The environment description in every prompt: maze geometry and frame, agent, body size."""
+def environment_text(maze, agent: str, facts: EvaluationFacts | None = None) -> str:
+    """The environment description in every prompt: maze geometry and frame, agent, policy, evaluation.
+
+    Every number comes from the agent entry and the evaluator's ``facts`` (default: an evaluator
+    with default settings on this maze), so the prompt says what the code does.
+    """
     info = get_agent(agent)
-    desc, reach = info.description, info.policy_reach
-    r = body_radius if body_radius is not None else info.body_radius
-    lines = [maze.describe(), f"Agent: {agent}, {desc}."]
-    if reach is not None:
-        lines.append(f"Policy: a goal-conditioned policy pretrained on an open floor to reach goal points up to "
-                     f"{reach:g} m away; it knows nothing about walls (they are the task graph's job).")
-    if r is not None:
-        lines.append(f"Body size: the agent's position is its centre; it counts as touching a wall when its centre "
-                     f"comes within {r:g} m of one, so keep waypoints at least that far from walls.")
-    lines.append("The maze walls are the avoid set of every subtask.")
-    return "\n".join(lines)
+    facts = facts or EvaluationFacts.default(agent, maze)
+    r = f"{facts.clearance:.3g}"
+    return "\n".join([
+        maze.describe(),
+        f"Agent: {agent}, {info.description}.",
+        f"Policy: a goal-conditioned policy pretrained on an open floor to reach goal points up to "
+        f"{info.policy_reach:g} m away; it knows nothing about walls (they are the task graph's job).",
+        f"Target point: in each rollout of a subtask the policy steers towards one target point, drawn uniformly "
+        f"at random inside the next region (at least {r} m from walls where the region allows), a new draw per "
+        f"rollout; the subtask is reached as soon as the agent's centre enters that region.",
+        f"Body size: the agent's position is its centre; it counts as touching a wall when its centre comes within "
+        f"{r} m of one, so keep waypoints at least that far from walls.",
+        f"Time limit: {facts.horizon} control steps ({facts.horizon_seconds:g} s) per subtask.",
+        "The maze walls are the avoid set of every subtask.",
+    ])
 
 
 def _avoid_text(avoid: Region, maze) -> str:
@@ -105,7 +114,7 @@ def _edge_values(q: EdgeQuery) -> dict:
     context = ""
     if q.graph is not None:
         context = "\nThe edge belongs to this task graph (for context):\n" + graph_text(q.graph) + "\n"
-    return dict(environment=environment_text(q.maze, q.agent, q.body_radius), start=_rj(q.start), goal=_rj(q.goal),
+    return dict(environment=environment_text(q.maze, q.agent, q.facts), start=_rj(q.start), goal=_rj(q.goal),
                 avoid=_avoid_text(q.avoid, q.maze), success_pct=_pct(q.success),
                 successes=int(round(q.success * q.n)), n=q.n, graph_context=context,
                 schema=render_prompt("split_schema"))
@@ -133,7 +142,7 @@ def split_messages(q: EdgeQuery, feedback: Sequence[CandidateFeedback] = ()) -> 
 
 def graph_messages(q: GraphQuery, feedback: Sequence[GraphFeedback] = ()) -> list[dict]:
     """The chat messages of a one-shot whole-graph query (first, or follow-up with feedback)."""
-    values = dict(environment=environment_text(q.maze, q.agent, q.body_radius), graph=graph_text(q.graph),
+    values = dict(environment=environment_text(q.maze, q.agent, q.facts), graph=graph_text(q.graph),
                   edge_lines=_edge_lines(q.graph, q.edge_success), success_pct=_pct(q.success), n=q.n,
                   example=render_prompt("graph_example"), schema=render_prompt("graph_schema"))
     images = {"map": q.image_png}

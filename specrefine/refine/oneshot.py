@@ -31,7 +31,7 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
     base = shortest_path(original, evaluator, seed=seed)
     query = GraphQuery(maze=maze, agent=agent, graph=original, success=base.predicted_success, n=evaluator.n,
                        image_png=_picture(maze, evaluator, original, base), edge_success=_edge_success(base),
-                       body_radius=evaluator.clearance)
+                       facts=evaluator.facts())
     log("input-evaluated", predicted_success=base.predicted_success, path=base.path)
     best, feedback = None, []
     for round_ in range(rounds):
