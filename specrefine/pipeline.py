@@ -18,9 +18,8 @@ import numpy as np
 
 from .errors import SpecrefineError
 from .graph import check_refines
-from .mazes import load_maze
-from .spec import maze_task
 
+PROPOSER_METHODS = ("ours", "vlm-oneshot")  # the methods that ask a proposer
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
 
 
@@ -44,18 +43,14 @@ class RunResult:
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
                 rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None) -> RunResult:
-    from .evaluate import Evaluator
-    from .policy import load_policy
+    from .experiment import setup
 
     t0 = time.time()
-    maze = load_maze(maze_path).for_agent(agent)
-    original = maze_task(maze)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    if evaluator is None:
-        policy = load_policy(policy_path or agent)
-        evaluator = Evaluator(maze, agent, policy, n=rollouts, seed=seed, cache_dir=out / "cache")
-    prop = _make_proposer(proposer, method, seed, out)
+    exp = setup(maze_path, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
+                rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
+                record_path=out / "vlm_recording.jsonl")
+    maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
 
         def on_step(step):
@@ -68,14 +63,6 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
-
-
-def _make_proposer(spec: str, method: str, seed: int, out: Path):
-    if method not in ("ours", "vlm-oneshot"):
-        return None
-    from .proposers import make_proposer
-
-    return make_proposer(spec, seed=seed, record_path=out / "vlm_recording.jsonl")
 
 
 def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step):
