@@ -1,5 +1,7 @@
 """specrefine: VLM-proposed, symbolically tuned refinement of reach-avoid task specifications."""
 
+from .experiment import Experiment, setup
+
 __version__ = "0.1.0"
 
 
@@ -10,4 +12,4 @@ def record(name, value, *, tol=None, rel=None):
     return _record(name, value, tol=tol, rel=rel)
 
 
-__all__ = ["record", "__version__"]
+__all__ = ["Experiment", "setup", "record", "__version__"]

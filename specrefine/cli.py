@@ -12,11 +12,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from .agents import AGENTS as _AGENT_REGISTRY
 from .errors import SpecrefineError
-from .mazes import CELL_SIZE
 
 METHODS = ("ours", "vlm-oneshot", "symbolic", "dirl")
-AGENTS = tuple(CELL_SIZE)  # the agents a maze can be scaled for
+AGENTS = tuple(_AGENT_REGISTRY)
 
 
 def proposer_arg(text: str) -> str:

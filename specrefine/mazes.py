@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import AGENTS, get_agent
 from .errors import MazeError
+from .paths import data_dir
 from .regions import Box, Region, union
 
-MAZE_DIR = Path(__file__).resolve().parent.parent / "data" / "mazes"
-CELL_SIZE = {"point": 1.0, "ant": 4.0}
+MAZE_DIR = data_dir() / "mazes"
+CELL_SIZE = {name: agent.cell_size for name, agent in AGENTS.items()}  # metres per cell, by agent
 _LEGAL = set("#.SG") | set("abcdefghijklmnopqrstuvwxyz")
 
 
@@ -45,7 +47,7 @@ class Maze:
         return Maze(self.name, self.grid, cell_size)
 
     def for_agent(self, agent: str) -> Maze:
-        return self.scaled(CELL_SIZE[agent])
+        return self.scaled(get_agent(agent).cell_size)
 
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
     @property

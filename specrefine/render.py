@@ -19,7 +19,6 @@ import io
 from pathlib import Path
 
 import matplotlib
-import networkx as nx
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -199,7 +198,7 @@ def draw_graph(ax, graph, *, path=None, edge_labels=None, regions=True, alpha=0.
         p = pts[v]
         colour = _vertex_colour(graph, v)
         ax.plot([p[0]], [p[1]], "o", ms=0.45 * fs, mfc=colour, mec="black", mew=0.8, zorder=6)
-        label = graph.g.nodes[v].get("label") or v
+        label = graph.label(v) or v
         dark = {START: "#007a8c", GOAL: "#116622", SUBGOAL: "#b35f00"}[colour]
         ax.annotate(label, p, xytext=(0.55 * fs, 0.55 * fs), textcoords="offset points", fontsize=0.85 * fs,
                     color=dark, fontweight="bold", zorder=7,
@@ -308,9 +307,8 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     probs: optional {(u, v): success probability} written on the edges; path: vertices to highlight.
     Vertex colours as on the map: initial cyan, finals green, the rest orange.
     """
-    g = graph.g
-    order = {v: i for i, v in enumerate(g.nodes)}
-    layers = [sorted(layer, key=order.get) for layer in nx.topological_generations(g)]
+    order = {v: i for i, v in enumerate(graph.vertices())}
+    layers = [sorted(layer, key=order.get) for layer in graph.topological_layers()]
     depth = {v: i for i, layer in enumerate(layers) for v in layer}
     pos = {v: np.array([float(i), (len(layer) - 1) / 2.0 - j]) for i, layer in enumerate(layers)
            for j, v in enumerate(layer)}
@@ -334,7 +332,7 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     node_r = 0.22
     px_per_unit = min(w / n_cols, (h - top) / n_rows)
     shrink = node_r * px_per_unit * 72 / DPI + 1.0  # points
-    for u, v in g.edges():
+    for u, v in graph.edges():
         hot = (u, v) in on_path
         rad = 0.0 if depth[v] - depth[u] == 1 else -0.3
         ax.add_patch(FancyArrowPatch(pos[u], pos[v], arrowstyle="-|>", mutation_scale=1.5 * fs,
@@ -345,10 +343,10 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
             ax.text(mid[0], mid[1], f"{float(probs[(u, v)]):.2f}", ha="center", va="bottom", fontsize=0.9 * fs,
                     color=PATH if hot else EDGE, zorder=4,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.9))
-    for v in g.nodes():
+    for v in graph.vertices():
         ax.add_patch(Circle(pos[v], node_r, facecolor=_vertex_colour(graph, v), edgecolor="black",
                             lw=2.0 if v in (path or ()) else 0.8, zorder=3))
-        ax.text(pos[v][0], pos[v][1], g.nodes[v].get("label") or v, ha="center", va="center", fontsize=fs,
+        ax.text(pos[v][0], pos[v][1], graph.label(v) or v, ha="center", va="center", fontsize=fs,
                 fontweight="bold", zorder=4)
     return fig
 

@@ -92,7 +92,7 @@ def _compile(tg: TaskGraph, spec: Spec, entries: list[str], avoids: list[Region]
     if isinstance(spec, Reach):
         if not avoids:
             raise SpecError("every reach must avoid something: wrap the spec in avoiding(..., walls)")
-        name = spec.name if spec.name and spec.name not in tg.g else tg.fresh_name()
+        name = spec.name if spec.name and spec.name not in tg else tg.fresh_name()
         v = tg.add_vertex(name, spec.region, label=spec.name or name)
         for u in entries:
             tg.add_edge(u, v, union(avoids))

@@ -23,6 +23,8 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from .agents import AGENTS
+
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
@@ -198,7 +200,7 @@ def main(argv=None) -> int:
     p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
     p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
     p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
-    p.add_argument("--agent", default="point", choices=["point", "ant"])
+    p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=int, default=32)
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--out", default="runs/sweep")
