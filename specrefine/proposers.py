@@ -140,15 +140,20 @@ def environment_text(maze, agent: str, body_radius: float | None = None) -> str:
     if r is not None:
         lines.append(f"Body size: the agent's position is its centre; it counts as touching a wall when its centre "
                      f"comes within {r:g} m of one, so keep waypoints at least that far from walls.")
-    lines.append("The maze walls are the avoid set of every subtask.")
+    if getattr(maze, "hazards", None) is not None:
+        lines.append("Hazards: the '~' cells are free floor without walls, but touching one fails the task like "
+                     "touching a wall; the walls and the hazards are the avoid set of every subtask, so route "
+                     "waypoints around the hazards (keep them at least the body size away).")
+    else:
+        lines.append("The maze walls are the avoid set of every subtask.")
     return "\n".join(lines)
 
 
 def _avoid_text(avoid: Region, maze) -> str:
-    walls = maze.walls
+    walls = maze.obstacles
     extra = [p for p in avoid.parts() if not is_subset(p, walls)]
     if not extra and is_subset(walls, avoid):
-        return "the maze walls (black in the pictures)"
+        return "the maze walls (black) and hazards (purple in the pictures)" if maze.hazards is not None else "the maze walls (black in the pictures)"
     if not extra:
         return "parts of the maze walls: " + _rj(avoid)
     return "the maze walls and " + ", ".join(_rj(p) for p in extra)
@@ -356,9 +361,9 @@ _STEPS = [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)]
 
 def _nearest_free_cell(maze, xy) -> tuple[int, int]:
     r, c = (int(v) for v in maze.xy_to_cell(np.asarray(xy, dtype=float)))
-    if maze.is_free(r, c):
+    if maze.passable(r, c):
         return (r, c)
-    cells = maze.free_cells()
+    cells = maze.passable_cells()
     centres = maze.cell_to_xy(np.array([a for a, _ in cells]), np.array([b for _, b in cells]))
     return cells[int(np.argmin(np.linalg.norm(centres - np.asarray(xy), axis=1)))]
 
@@ -379,9 +384,9 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
         r, c = cell
         for dr, dc in _STEPS:
             nb = (r + dr, c + dc)
-            if not maze.is_free(*nb):
+            if not maze.passable(*nb):
                 continue
-            if dr and dc and not (maze.is_free(r + dr, c) and maze.is_free(r, c + dc)):
+            if dr and dc and not (maze.passable(r + dr, c) and maze.passable(r, c + dc)):
                 continue
             step = math.sqrt(2.0) if dr and dc else 1.0
             if noise > 0 and rng is not None:
@@ -402,8 +407,8 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
 
 
 def clearance(maze, pts) -> np.ndarray:
-    """Distance of each point from the nearest wall (negative inside a wall)."""
-    return maze.walls.signed_distance(np.asarray(pts, dtype=float))
+    """Distance of each point from the nearest wall or hazard (negative inside one)."""
+    return maze.obstacles.signed_distance(np.asarray(pts, dtype=float))
 
 
 def segment_clear(maze, a, b, margin: float) -> bool:
