@@ -32,7 +32,8 @@ class RunResult:
     def summary(self) -> str:
         d = self.data
         lo, hi = d["success_ci"]
-        return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} seed={d['seed']}\n"
+        return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
+                f"seed={d['seed']}\n"
                 f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
                 f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "

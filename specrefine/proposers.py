@@ -153,7 +153,8 @@ def _avoid_text(avoid: Region, maze) -> str:
     walls = maze.obstacles
     extra = [p for p in avoid.parts() if not is_subset(p, walls)]
     if not extra and is_subset(walls, avoid):
-        return "the maze walls (black) and hazards (purple in the pictures)" if maze.hazards is not None else "the maze walls (black in the pictures)"
+        return ("the maze walls (black) and hazards (purple in the pictures)" if maze.hazards is not None
+                else "the maze walls (black in the pictures)")
     if not extra:
         return "parts of the maze walls: " + _rj(avoid)
     return "the maze walls and " + ", ".join(_rj(p) for p in extra)

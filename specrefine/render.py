@@ -43,8 +43,8 @@ PATH = "#1f4fff"
 DPI = 100
 
 __all__ = [
-    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_hazards", "draw_region",
-    "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
+    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_hazards",
+    "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
 ]
 
 
