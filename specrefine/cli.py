@@ -1,7 +1,7 @@
 """The ``specrefine`` command line.
 
     specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl}
-        --proposer {geometric,random,replay:PATH,litellm:MODEL} --seed N --out DIR
+        --proposer {geometric,random,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -54,6 +54,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "random (random free-space waypoints, ablation), replay:PATH (recorded VLM replies), "
                         "litellm:MODEL (any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; "
                         "keys from the environment) (default: geometric)")
+    r.add_argument("--spec", metavar="EXPR", default=None,
+                   help="the task as an expression over the maze's letters: a..z its subgoal regions, G the goal, "
+                        "S implicit; '->' sequence, '|' choice (binds tighter), parentheses; must end in G; e.g. "
+                        "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
     r.add_argument("--seed", type=int, default=0, help="random seed for rollouts and proposers (default: 0)")
     r.add_argument("--out", type=Path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
@@ -75,7 +79,7 @@ def main(argv=None) -> int:
 
         result = refine_maze(args.maze, agent=args.agent, method=args.method, proposer=args.proposer,
                              seed=args.seed, out=args.out, rollouts=args.rollouts, episodes=args.episodes,
-                             policy_path=args.policy, w=args.w, d=args.d, k=args.k)
+                             policy_path=args.policy, w=args.w, d=args.d, k=args.k, spec=args.spec)
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2

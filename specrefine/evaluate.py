@@ -140,7 +140,7 @@ class Evaluator:
         self._sims: dict[int, object] = {}
         self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
         self._compiled: dict[Region, CompiledRegion] = {}
-        self._walls = self.compiled(maze.walls)
+        self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
         grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
         self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
 

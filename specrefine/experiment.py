@@ -21,7 +21,7 @@ from .mazes import Maze, load_maze
 class Experiment:
     maze: Maze  # at the agent's scale
     agent: str
-    graph: TaskGraph  # the maze's task: S -> a -> ... -> G, avoiding walls
+    graph: TaskGraph  # the task: the maze's own (S -> a -> ... -> G) or a spec's, avoiding walls and hazards
     policy: object
     policy_name: str
     evaluator: object  # specrefine.evaluate.Evaluator (or a stand-in passed to setup)
@@ -52,7 +52,8 @@ def load_goal_policy(agent: str, policy="shipped"):
 
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = 32,
-          policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None) -> Experiment:
+          policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None,
+          spec: str | None = None) -> Experiment:
     """Everything an experiment starts from.
 
     maze: a name in ``data/mazes/``, a ``.maze`` path or a :class:`Maze`; agent: a registered agent
@@ -60,13 +61,16 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     ``replay:PATH``, ``litellm:MODEL``) or None; rollouts: per subtask evaluation; policy:
     ``"shipped"``, ``"scripted"`` or a checkpoint path; out: a directory (created) whose ``cache/``
     keeps evaluations unless ``cache_dir`` says otherwise; evaluator: use this one instead of
-    building one; record_path: where a ``litellm:`` proposer records its calls.
+    building one; record_path: where a ``litellm:`` proposer records its calls; spec: the task as an
+    expression over the maze's letters (``"(a | b) -> c -> G"``, see ``specrefine.spec.parse_spec``),
+    None = the maze's own task (its ``; spec:`` line, else its chain).
     """
     from .evaluate import Evaluator
     from .spec import maze_task
 
     get_agent(agent)
     maze = (maze if isinstance(maze, Maze) else load_maze(maze)).for_agent(agent)
+    graph = maze_task(maze, spec)  # a bad spec fails before anything is built or written
     out = Path(out) if out is not None else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
@@ -81,4 +85,4 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
         from .proposers import make_proposer
 
         chosen = make_proposer(proposer, seed=seed, record_path=record_path)
-    return Experiment(maze, agent, maze_task(maze), goal_policy, policy_name, evaluator, chosen, seed, out)
+    return Experiment(maze, agent, graph, goal_policy, policy_name, evaluator, chosen, seed, out)

@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import SpecrefineError
 from .graph import check_refines
+from .spec import maze_spec_text
 
 PROPOSER_METHODS = ("ours", "vlm-oneshot")  # the methods that ask a proposer
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
@@ -31,7 +32,8 @@ class RunResult:
     def summary(self) -> str:
         d = self.data
         lo, hi = d["success_ci"]
-        return (f"{d['maze']} | {d['agent']} | method={d['method']} proposer={d['proposer']} seed={d['seed']}\n"
+        return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
+                f"seed={d['seed']}\n"
                 f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
                 f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
@@ -42,14 +44,17 @@ class RunResult:
 
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
-                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None) -> RunResult:
+                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
+                spec: str | None = None) -> RunResult:
+    """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
+    ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain)."""
     from .experiment import setup
 
     t0 = time.time()
     out = Path(out)
     exp = setup(maze_path, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
                 rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
-                record_path=out / "vlm_recording.jsonl")
+                record_path=out / "vlm_recording.jsonl", spec=spec)
     maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
 
@@ -60,6 +65,7 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
     measured = _measure(evaluator, original, search, episodes, seed)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
+    data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)

@@ -1,7 +1,8 @@
 """Top-down pictures of a maze task: the image a VLM sees, and the pictures in the notebooks.
 
 Colours follow the paper's figures: walls black, the start region cyan, the goal green,
-subgoals / waypoints orange, successful trajectories green and failed ones red.  Axes are in
+subgoals / waypoints orange, successful trajectories green and failed ones red; hazard cells
+``~`` (avoided like walls, but no walls) purple and hatched.  Axes are in
 metres with a light grid at every cell so that coordinates can be read off the picture.
 
 Figures are plain :class:`matplotlib.figure.Figure` objects (no pyplot state, nothing to
@@ -41,6 +42,7 @@ class PngFigure(Figure):
         return to_png(self)
 
 WALL = "black"
+HAZARD = "#8e24aa"  # purple: hazard cells '~'
 START = "#00c8e6"  # cyan
 GOAL = "#22b14c"  # green
 SUBGOAL = "#ff8c00"  # orange
@@ -52,8 +54,8 @@ PATH = "#1f4fff"
 DPI = 100
 
 __all__ = [
-    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_region",
-    "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
+    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_hazards",
+    "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
 ]
 
 
@@ -135,6 +137,12 @@ def draw_region(ax, region: Region, color, *, alpha=0.45, edge=False, hatch=None
 def draw_walls(ax, maze) -> None:
     """Wall cells in black (the frame around the grid lies outside the axes)."""
     draw_region(ax, maze.walls, WALL, alpha=1.0, zorder=1.0)
+
+
+def draw_hazards(ax, maze) -> None:
+    """Hazard cells ``~`` in hatched purple (avoided by every subtask, but no walls: the body can cross them)."""
+    if getattr(maze, "hazards", None) is not None:
+        draw_region(ax, maze.hazards, HAZARD, alpha=0.55, hatch="xx", zorder=1.05)
 
 
 def _label(ax, xy, text, color="black", size=None, zorder=6):
@@ -248,7 +256,8 @@ def _legend(fig, ax, items) -> None:
     handles = []
     for name, colour, kind in items:
         if kind == "patch":
-            handles.append(Patch(facecolor=colour, edgecolor="black" if colour == WALL else colour, label=name))
+            handles.append(Patch(facecolor=colour, edgecolor="black" if colour == WALL else colour, label=name,
+                                 hatch="xx" if colour == HAZARD else None))
         else:
             handles.append(Line2D([0], [0], color=colour, lw=2, label=name))
     fs = _fs(ax)
@@ -275,6 +284,7 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
     ax.set_facecolor("white")
     _grid(ax, maze.cell_size)
     draw_walls(ax, maze)
+    draw_hazards(ax, maze)
     if graph is None:
         draw_maze_regions(ax, maze)
     else:
@@ -288,6 +298,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
         draw_points(ax, points)
     if legend:
         items = [("wall", WALL, "patch"), ("start", START, "patch"), ("goal", GOAL, "patch")]
+        if getattr(maze, "hazards", None) is not None:
+            items.insert(1, ("hazard", HAZARD, "patch"))
         if (graph is not None and len(graph.vertices()) > 2) or maze.subgoals or waypoints:
             items.append(("subgoal / waypoint", SUBGOAL, "patch"))
         if trajectories is not None and len(trajectories):

@@ -32,9 +32,9 @@ _STEPS = [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)]
 
 def _nearest_free_cell(maze, xy) -> tuple[int, int]:
     r, c = (int(v) for v in maze.xy_to_cell(np.asarray(xy, dtype=float)))
-    if maze.is_free(r, c):
+    if maze.passable(r, c):
         return (r, c)
-    cells = maze.free_cells()
+    cells = maze.passable_cells()
     centres = maze.cell_to_xy(np.array([a for a, _ in cells]), np.array([b for _, b in cells]))
     return cells[int(np.argmin(np.linalg.norm(centres - np.asarray(xy), axis=1)))]
 
@@ -55,9 +55,9 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
         r, c = cell
         for dr, dc in _STEPS:
             nb = (r + dr, c + dc)
-            if not maze.is_free(*nb):
+            if not maze.passable(*nb):
                 continue
-            if dr and dc and not (maze.is_free(r + dr, c) and maze.is_free(r, c + dc)):
+            if dr and dc and not (maze.passable(r + dr, c) and maze.passable(r, c + dc)):
                 continue
             step = math.sqrt(2.0) if dr and dc else 1.0
             if noise > 0 and rng is not None:
@@ -79,7 +79,7 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
 
 def clearance(maze, pts) -> np.ndarray:
     """Distance of each point from the nearest wall (negative inside a wall)."""
-    return maze.walls.signed_distance(np.asarray(pts, dtype=float))
+    return maze.obstacles.signed_distance(np.asarray(pts, dtype=float))
 
 
 def segment_clear(maze, a, b, margin: float) -> bool:

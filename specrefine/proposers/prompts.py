@@ -72,15 +72,24 @@ def environment_text(maze, agent: str, facts: EvaluationFacts | None = None) -> 
         f"Body size: the agent's position is its centre; it counts as touching a wall when its centre comes within "
         f"{r} m of one, so keep waypoints at least that far from walls.",
         f"Time limit: {facts.horizon} control steps ({facts.horizon_seconds:g} s) per subtask.",
-        "The maze walls are the avoid set of every subtask.",
+        _avoid_sentence(maze),
     ])
 
 
+def _avoid_sentence(maze) -> str:
+    if maze.hazards is None:
+        return "The maze walls are the avoid set of every subtask."
+    return ("Hazards: the '~' cells are free floor without walls, but touching one fails the task like touching a "
+            "wall; the walls and the hazards are the avoid set of every subtask, so route waypoints around the "
+            "hazards (keep them at least the body size away).")
+
+
 def _avoid_text(avoid: Region, maze) -> str:
-    walls = maze.walls
+    walls = maze.obstacles
     extra = [p for p in avoid.parts() if not is_subset(p, walls)]
     if not extra and is_subset(walls, avoid):
-        return "the maze walls (black in the pictures)"
+        return ("the maze walls (black) and hazards (purple in the pictures)" if maze.hazards is not None
+                else "the maze walls (black in the pictures)")
     if not extra:
         return "parts of the maze walls: " + _rj(avoid)
     return "the maze walls and " + ", ".join(_rj(p) for p in extra)

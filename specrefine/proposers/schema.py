@@ -167,9 +167,10 @@ def check_region(region: Region, maze, what: str = "waypoint") -> str | None:
     if not (x0 <= c[0] <= x1 and y0 <= c[1] <= y1):
         return (f"{what} centre ({c[0]:.3g}, {c[1]:.3g}) lies outside the maze "
                 f"(x in [{x0:g}, {x1:g}], y in [{y0:g}, {y1:g}])")
-    if bool(maze.walls.contains(c)):
+    if bool(maze.obstacles.contains(c)):
         row, col = (int(v) for v in maze.xy_to_cell(c))
-        return f"{what} centre ({c[0]:.3g}, {c[1]:.3g}) lies inside a wall (cell row {row}, col {col})"
+        kind = "wall" if bool(maze.walls.contains(c)) else "hazard"
+        return f"{what} centre ({c[0]:.3g}, {c[1]:.3g}) lies inside a {kind} (cell row {row}, col {col})"
     if isinstance(region, Disc):
         if region.r > size:
             return f"{what} radius {region.r:.3g} is larger than the maze ({size:g})"
