@@ -12,8 +12,10 @@ from matplotlib.image import imread
 
 from specrefine import cli
 from specrefine.errors import MazeError
-from specrefine.evaluate import AVOID, Evaluator, PointController, satisfies
+from specrefine.evaluate import AVOID, Evaluator
 from specrefine.mazes import load_maze, parse_maze
+from specrefine.monitor import satisfies
+from specrefine.policy import PointController
 from specrefine.proposers import EdgeQuery, environment_text, make_proposer, segment_clear
 from specrefine.regions import is_subset
 from specrefine.render import render_task, to_png
@@ -89,9 +91,9 @@ def test_the_simulator_builds_no_walls_for_hazards(pool):
     res = ev.evaluate_edge(g, "S", "G", seed=0)
     assert res.p == 0.0 and np.all(res.outcome == AVOID)
     last = res.trajectories[np.arange(res.n), res.lengths - 1]
-    assert np.all(pool.hazards.signed_distance(last) < ev.body_radius)
-    assert np.all(pool.walls.signed_distance(last) > ev.body_radius)  # not a wall: the hazard ended it
-    assert not satisfies(g, crossing.trajectories, crossing.lengths, ev.body_radius).any()
+    assert np.all(pool.hazards.signed_distance(last) < ev.clearance)
+    assert np.all(pool.walls.signed_distance(last) > ev.clearance)  # not a wall: the hazard ended it
+    assert not satisfies(g, crossing.trajectories, crossing.lengths, ev.clearance).any()
 
 
 def test_monitor_counts_a_hazard_touch_as_failure(pool):
@@ -109,8 +111,8 @@ def test_monitor_counts_a_hazard_touch_as_failure(pool):
     T = max(len(t) for t in trajs)
     arr = np.stack([np.concatenate([t, np.repeat(t[-1:], T - len(t), 0)]) for t in trajs])
     lengths = np.array([len(t) for t in trajs])
-    assert satisfies(g, arr, lengths, body_radius=0.0).tolist() == [True, True, False]
-    assert satisfies(g, arr, lengths, body_radius=0.1).tolist() == [True, False, False]  # the body touches it
+    assert satisfies(g, arr, lengths, clearance=0.0).tolist() == [True, True, False]
+    assert satisfies(g, arr, lengths, clearance=0.1).tolist() == [True, False, False]  # the body touches it
 
 
 def test_geometric_route_goes_around_the_pool(pool):
