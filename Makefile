@@ -21,4 +21,25 @@ test: $(VENV)/.installed
 	$(BIN)/ruff check specrefine tests benchmarks
 	$(BIN)/python -m pytest -q
 
-.PHONY: venv demo test
+# Notebooks: the full-parameter tier (notebooks/full.json, minutes per notebook) and its expected values,
+# regenerating expected values (a decision, not a fix: tests/test_notebooks.py), executed copies for readers,
+# and JupyterLab on the notebooks with this project's kernel.
+notebooks-full: $(VENV)/.installed
+	$(BIN)/python -m pytest -q -m notebooks_full
+
+notebook-expected: $(VENV)/.installed
+	$(BIN)/python -m pytest -q -m notebooks -k values_smoke --update-notebook-expected
+
+notebook-expected-full: $(VENV)/.installed
+	$(BIN)/python -m pytest -q -m notebooks_full --update-notebook-expected
+
+executed: $(VENV)/.installed
+	$(BIN)/python -m specrefine.notebook executed --tier full --out notebooks/executed
+
+LAB_PORT ?= 8888
+lab: $(VENV)/.installed
+	$(BIN)/python -m ipykernel install --sys-prefix --name specrefine --display-name "Python 3 (specrefine)"
+	$(BIN)/jupyter lab --notebook-dir=notebooks --ip=127.0.0.1 --port=$(LAB_PORT) \
+		--MappingKernelManager.default_kernel_name=specrefine
+
+.PHONY: venv demo test notebooks-full notebook-expected notebook-expected-full executed lab

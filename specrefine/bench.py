@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import AGENTS, get_agent
 from .mazes import load_maze
 
 
@@ -34,7 +35,7 @@ def open_room(agent: str, cells: int | None = None):
     """
     from .mazes import parse_maze
 
-    cells = cells or {"point": 61, "ant": 31}[agent]  # 30 m (point, at most 5 m/s x 5 s) / 60 m (ant) to a wall
+    cells = cells or get_agent(agent).bench_room_cells
     rows = ["#" * cells] + ["#" + "." * (cells - 2) + "#" for _ in range(cells - 2)] + ["#" * cells]
     mid = cells // 2
     rows[mid] = rows[mid][:mid] + "S" + rows[mid][mid + 1:]
@@ -153,7 +154,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m specrefine.bench", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
     e = sub.add_parser("evaluator", help="env steps/s of the subtask evaluator vs raw mujoco.rollout")
-    e.add_argument("--agent", choices=("point", "ant"), default="point")
+    e.add_argument("--agent", choices=list(AGENTS), default="point")
     e.add_argument("--batch", type=int, default=32)
     e.add_argument("--seconds", type=float, default=6.0, help="time spent in the evaluator measurement")
     e.add_argument("--horizon", type=int, default=None)

@@ -1,7 +1,7 @@
 """The ``specrefine`` command line.
 
     specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl}
-        --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR
+        --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -12,11 +12,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from .agents import AGENTS as _AGENT_REGISTRY
 from .errors import SpecrefineError
-from .mazes import CELL_SIZE
 from .pipeline import METHODS
 
-AGENTS = tuple(CELL_SIZE)  # the agents a maze can be scaled for
+AGENTS = tuple(_AGENT_REGISTRY)
 
 
 def proposer_arg(text: str) -> str:
@@ -26,7 +26,7 @@ def proposer_arg(text: str) -> str:
     if kind in ("replay", "litellm") and rest:
         return text
     if kind == "imperfect" and rest:
-        from .imperfect import parse_imperfect
+        from .proposers.imperfect import parse_imperfect
 
         try:
             parse_imperfect(rest)
@@ -62,6 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "replay:PATH (recorded VLM replies), "
                         "litellm:MODEL (any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; "
                         "keys from the environment) (default: geometric)")
+    r.add_argument("--spec", metavar="EXPR", default=None,
+                   help="the task as an expression over the maze's letters: a..z its subgoal regions, G the goal, "
+                        "S implicit; '->' sequence, '|' choice (binds tighter), parentheses; must end in G; e.g. "
+                        "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
     r.add_argument("--seed", type=int, default=0, help="random seed for rollouts and proposers (default: 0)")
     r.add_argument("--out", type=Path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
@@ -83,7 +87,7 @@ def main(argv=None) -> int:
 
         result = refine_maze(args.maze, agent=args.agent, method=args.method, proposer=args.proposer,
                              seed=args.seed, out=args.out, rollouts=args.rollouts, episodes=args.episodes,
-                             policy_path=args.policy, w=args.w, d=args.d, k=args.k)
+                             policy_path=args.policy, w=args.w, d=args.d, k=args.k, spec=args.spec)
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2

@@ -1,4 +1,8 @@
-"""Errors a user can cause.  The CLI prints them as one line and exits 2."""
+"""Every error a user can cause, in one place.  The CLI prints any of them as one line and exits 2.
+
+All derive from :class:`SpecrefineError`.  A few also derive from ``ValueError`` (bad values handed
+to a constructor or parser), so that code written against the standard exception still catches them.
+"""
 
 
 class SpecrefineError(Exception):
@@ -6,12 +10,47 @@ class SpecrefineError(Exception):
 
 
 class MazeError(SpecrefineError):
-    pass
+    """A malformed ``*.maze`` file: ``file:line:column: what``."""
 
 
 class SpecError(SpecrefineError):
-    pass
+    """A malformed task specification."""
+
+
+class RegionError(SpecrefineError, ValueError):
+    """An impossible region (empty box, non-positive radius, unknown type, points of the wrong shape)."""
+
+
+class GraphError(SpecrefineError, ValueError):
+    """A task graph that cannot be built (an edge that would close a cycle)."""
 
 
 class InvalidRefinement(SpecrefineError):
     """A refined task graph does not imply the original one (Theorem 4.1 violated)."""
+
+
+class PolicyError(SpecrefineError):
+    """A policy file is missing, corrupt, or does not fit the agent."""
+
+
+class VLMError(SpecrefineError):
+    """A VLM call failed for a reason the user must fix or wait out (one line)."""
+
+
+class VLMConfigError(VLMError):
+    """Missing API key, unknown model, key rejected."""
+
+
+class VLMUnavailable(VLMError):
+    """Provider down, unreachable or rate-limiting after all retries."""
+
+
+class ReplayMiss(VLMError):
+    """A replayed run asked something the recording has no answer for."""
+
+
+class ProposalRejected(SpecrefineError, ValueError):
+    """A proposal (VLM reply) that cannot be used; ``str(exc)`` is the one-line reason.
+
+    A proposer logs it, re-asks once and drops the candidate: it never ends a run.
+    """

@@ -1,14 +1,15 @@
-"""Subtask evaluation: batched rollouts of the goal policy on a reach-avoid edge, and the monitor.
+"""Subtask evaluation: estimate, by batched rollouts of the goal policy, how often a subtask succeeds.
 
 ``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
 policy, started from ``start`` (uniform in a region where the agent fits: ``spawn_radius`` from
 walls, for the Ant the reach of its legs; or resampled end states of a preceding edge), reaches
 ``goal`` before entering ``avoid`` and before flipping, within ``horizon`` control steps. Entering
-means touching: ``avoid.signed_distance(xy) < body_radius`` where ``Evaluator.body_radius`` = the
-simulator's body radius + MuJoCo's contact margin (pass the same ``Evaluator.body_radius`` to
-``satisfies``). The policy's goal point is ``goal_point`` if given, else a point sampled uniformly
-from ``goal`` per rollout (the paper's "representative waypoint randomly sampled from the inclusion
-set of the subtask's goal vertex").
+means touching: ``avoid.signed_distance(xy) < clearance`` where ``Evaluator.clearance`` = the
+agent's body radius + MuJoCo's contact margin (pass the same ``Evaluator.clearance`` to
+:func:`specrefine.monitor.satisfies`). The policy's goal point is ``goal_point`` if given, else a
+point sampled uniformly from ``goal`` per rollout, at least ``clearance`` from walls where the
+region allows (the paper's "representative waypoint randomly sampled from the inclusion set of the
+subtask's goal vertex"); :meth:`Evaluator.goal_point_rule` says this in words for the VLM.
 
 All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
 :class:`~specrefine.sim.BatchedSim` (one per batch size, built lazily and reused); a rollout that
@@ -22,205 +23,76 @@ compaction of finished rollouts), thread count or CPU, the same successes (barri
 ends within rounding of a boundary), with floats equal to a tolerance. Results are cached in memory
 and, with ``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the
 canonical JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon,
-seed, agent, maze, body radius, code version), written atomically (a run interrupted midway keeps
+seed, agent, maze, clearance, code version), written atomically (a run interrupted midway keeps
 every entry it finished); an unreadable or mismatching entry is ignored with a warning and
 recomputed.
 
-``run_path`` runs a compositional policy (a sequence of legs, the goal switching when a leg's goal
-region is reached) end to end; ``satisfies`` is a monitor that checks trajectories against a task
-graph's specification (used to measure success on the ORIGINAL task).
+``run_compositional`` runs a compositional policy (a sequence of legs, the goal switching when a
+leg's goal region is reached) end to end, through the same loop.  Result types live in
+:mod:`specrefine.results`, the monitor in :mod:`specrefine.monitor`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import warnings
 from collections import OrderedDict
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from .agents import get_agent
 from .errors import SpecrefineError
-from .mazes import CELL_SIZE, Maze
-from .regions import Box, Disc, Region
+from .mazes import Maze
+from .regions import CompiledRegion, Region
+from .results import (
+    AVOID,
+    FLIPPED,
+    SUCCESS,
+    TIMEOUT,
+    UNFINISHED,
+    CompositionalResult,
+    EdgeResult,
+    StartStates,
+    unreached,
+    wilson_ci,
+)
 
 CACHE_VERSION = 1
-_TINY = float(np.nextafter(0.0, 1.0))  # sd <= 0  <=>  sd < _TINY
-SUCCESS, AVOID, FLIPPED, TIMEOUT, UNFINISHED = 0, 1, 2, 3, 4
-OUTCOMES = ("success", "avoid", "flipped", "timeout", "unfinished")
 
 
-# --- results ---------------------------------------------------------------------------------------
-@dataclass
-class StartStates:
-    """A start distribution given by full physics states (resampled with replacement)."""
+@dataclass(frozen=True)
+class EvaluationFacts:
+    """What the evaluator does, as a prompt tells it to a VLM: read from the code, never restated by hand.
 
-    states: np.ndarray  # (m, state_dim)
-    xy: np.ndarray  # (m, 2)
-
-    def __len__(self) -> int:
-        return len(self.states)
-
-    def digest(self) -> str:
-        h = hashlib.sha256(np.ascontiguousarray(self.states, dtype=np.float64).tobytes())
-        h.update(str(self.states.shape).encode())
-        return h.hexdigest()[:32]
-
-
-@dataclass
-class EdgeResult:
-    p: float
-    ci: tuple[float, float]
-    n: int
-    successes: int
-    success: np.ndarray  # (n,) bool
-    trajectories: np.ndarray  # (n, T, 2) float32; row i is valid up to lengths[i], then padded with its last point
-    lengths: np.ndarray  # (n,) int: number of valid points (1 + control steps taken)
-    end_states: StartStates | None  # states of the successful rollouts at the moment they reached the goal
-    steps: int  # environment steps simulated (the batch is stepped together: n x loop iterations)
-    cached: bool = False
-    outcome: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int8))  # per rollout, see OUTCOMES
-
-    @property
-    def weight(self) -> float:
-        """-log p (inf for p = 0)."""
-        return -math.log(self.p) if self.p > 0 else math.inf
-
-    def counts(self) -> dict[str, int]:
-        return {name: int(np.sum(self.outcome == i)) for i, name in enumerate(OUTCOMES) if np.any(self.outcome == i)}
-
-
-@dataclass
-class PathResult:
-    p: float
-    ci: tuple[float, float]
-    n: int
-    successes: int
-    success: np.ndarray  # (n,) bool: every leg completed
-    legs_done: np.ndarray  # (n,) int: legs completed by each episode
-    trajectories: np.ndarray  # (n, T, 2) float32, padded like EdgeResult's
-    lengths: np.ndarray  # (n,)
-    steps: int
-    outcome: np.ndarray  # (n,) int8, see OUTCOMES
-
-    n_legs: int = 1
-
-    def counts(self) -> dict[str, int]:
-        return {name: int(np.sum(self.outcome == i)) for i, name in enumerate(OUTCOMES) if np.any(self.outcome == i)}
-
-    @property
-    def leg_success(self) -> list[float | None]:
-        """Empirical success probability of each leg among the episodes that started it (None: none did)."""
-        out = []
-        for k in range(self.n_legs):
-            started = self.legs_done >= k
-            out.append(float(np.mean(self.legs_done[started] > k)) if started.any() else None)
-        return out
-
-
-def wilson_ci(successes, n, z: float = 1.96) -> tuple[float, float]:
-    """Wilson score interval for a binomial proportion (95 % by default); (0, 1) when n = 0."""
-    n = int(n)
-    if n <= 0:
-        return (0.0, 1.0)
-    p = successes / n
-    z2 = z * z
-    denom = 1 + z2 / n
-    centre = (p + z2 / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
-    return (max(0.0, centre - half), min(1.0, centre + half))
-
-
-# --- fast region checks ------------------------------------------------------------------------------
-class CompiledRegion:
-    """A region's boxes and discs as arrays: signed distances of many points in a few numpy calls.
-
-    ``signed_distance`` gives the same numbers as ``Region.signed_distance`` (the same formula,
-    vectorised over parts).  ``below(pts, thr)`` answers ``signed_distance < thr`` exactly but only
-    looks at the few boxes near each point (a bucket grid built once per threshold), which keeps the
-    wall check of a big maze (hundreds of boxes) cheap in the rollout loop.
+    The goal point of a subtask whose goal vertex has no fixed point is drawn uniformly inside the
+    goal region, at least ``clearance`` from walls where the region allows (``Evaluator.sample_free``);
+    success is the agent's centre entering the goal region before touching the avoid set (coming
+    within ``clearance`` of it), before flipping and within ``horizon`` control steps.
     """
 
-    BUCKET_MIN_PARTS = 12  # fewer boxes than this: just compute against all of them
+    agent: str
+    clearance: float  # m
+    horizon: int  # control steps per subtask
+    control_period: float  # s per control step
+    rollouts: int  # per subtask evaluation
 
-    def __init__(self, region: Region):
-        self.region = region
-        parts = region.parts()
-        boxes = [p for p in parts if isinstance(p, Box)]
-        discs = [p for p in parts if isinstance(p, Disc)]
-        self.other = [p for p in parts if not isinstance(p, (Box, Disc))]
-        self.bc = np.array([[(b.xmin + b.xmax) / 2, (b.ymin + b.ymax) / 2] for b in boxes]).reshape(-1, 2)
-        self.bh = np.array([[(b.xmax - b.xmin) / 2, (b.ymax - b.ymin) / 2] for b in boxes]).reshape(-1, 2)
-        self.dc = np.array([[d.cx, d.cy] for d in discs]).reshape(-1, 2)
-        self.dr = np.array([d.r for d in discs])
-        self._grids: dict[float, tuple] = {}
+    @property
+    def horizon_seconds(self) -> float:
+        return self.horizon * self.control_period
 
-    @staticmethod
-    def _box_sd(pts, c, h):
-        d = np.abs(pts[:, None, :] - c) - h  # (n, m, 2)
-        dx, dy = d[..., 0], d[..., 1]
-        return (np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0)) + np.minimum(np.maximum(dx, dy), 0.0)).min(axis=1)
+    @classmethod
+    def default(cls, agent: str, maze: Maze, rollouts: int = 32) -> EvaluationFacts:
+        """The facts of an ``Evaluator(maze, agent, ...)`` with default settings, without building one."""
+        from .sim import build_model, contact_margin
 
-    def _rest_sd(self, pts, out):
-        if len(self.dc):
-            dd = np.hypot(pts[:, None, 0] - self.dc[None, :, 0], pts[:, None, 1] - self.dc[None, :, 1]) - self.dr
-            out = np.minimum(out, dd.min(axis=1))
-        for p in self.other:
-            out = np.minimum(out, p.signed_distance(pts))
-        return out
-
-    def signed_distance(self, pts: np.ndarray) -> np.ndarray:
-        pts = np.asarray(pts, dtype=float).reshape(-1, 2)
-        out = self._box_sd(pts, self.bc[None], self.bh[None]) if len(self.bc) else np.full(len(pts), np.inf)
-        return self._rest_sd(pts, out)
-
-    def contains(self, pts: np.ndarray) -> np.ndarray:
-        """``signed_distance(pts) <= 0`` (= below the smallest positive float), exactly."""
-        if len(self.bc) < self.BUCKET_MIN_PARTS:
-            return self.signed_distance(pts) <= 0.0
-        return self.below(pts, _TINY)
-
-    def _grid(self, thr: float):
-        """Bucket grid: for every bucket the boxes whose bounding box grown by ``thr`` meets it."""
-        g = self._grids.get(thr)
-        if g is None:
-            lo = (self.bc - self.bh).min(axis=0) - thr - 1e-9
-            hi = (self.bc + self.bh).max(axis=0) + thr + 1e-9
-            size = float(max(np.median(self.bh.min(axis=1)) * 2, thr, (hi - lo).max() / 256, 1e-6))
-            shape = np.maximum(np.ceil((hi - lo) / size).astype(int), 1)
-            cells = [[] for _ in range(shape[0] * shape[1])]
-            i0 = np.clip(np.floor((self.bc - self.bh - thr - 1e-9 - lo) / size).astype(int), 0, shape - 1)
-            i1 = np.clip(np.floor((self.bc + self.bh + thr + 1e-9 - lo) / size).astype(int), 0, shape - 1)
-            for j in range(len(self.bc)):
-                for ix in range(i0[j, 0], i1[j, 0] + 1):
-                    for iy in range(i0[j, 1], i1[j, 1] + 1):
-                        cells[ix * shape[1] + iy].append(j)
-            k = max(1, max(len(c) for c in cells))
-            table = np.full((len(cells), k), len(self.bc))  # padding -> a dummy box far away
-            for i, c in enumerate(cells):
-                table[i, : len(c)] = c
-            c = np.vstack([self.bc, [[1e18, 1e18]]])
-            h = np.vstack([self.bh, [[0.0, 0.0]]])
-            g = self._grids[thr] = (lo, size, shape, table, c, h)
-        return g
-
-    def below(self, pts: np.ndarray, thr: float) -> np.ndarray:
-        """``signed_distance(pts) < thr``, exactly, looking only at nearby boxes."""
-        pts = np.asarray(pts, dtype=float).reshape(-1, 2)
-        if len(self.bc) < self.BUCKET_MIN_PARTS:
-            return self.signed_distance(pts) < thr
-        lo, size, shape, table, c, h = self._grid(float(thr))
-        ij = np.floor((pts - lo) / size).astype(np.int64)
-        inside = np.all((ij >= 0) & (ij < shape), axis=1)
-        cand = table[np.where(inside, ij[:, 0] * shape[1] + ij[:, 1], 0)]  # (n, k)
-        cand[~inside] = len(self.bc)
-        out = self._box_sd(pts, c[cand], h[cand])
-        return self._rest_sd(pts, out) < thr
+        spec = get_agent(agent)
+        clearance = spec.body_radius + contact_margin(build_model(agent, maze))
+        return cls(agent, clearance, spec.default_horizon, spec.timestep * spec.frame_skip, rollouts)
 
 
 def _region_key(region: Region) -> dict:
@@ -242,53 +114,60 @@ class Evaluator:
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = 32, horizon: int | None = None, seed: int = 0,
                  cache_dir=None, nthread: int | None = None):
-        import mujoco
+        from .sim import build_model, contact_margin, footprint_radius
 
-        from .sim import agent_spec, build_model, footprint_radius
-
-        if agent not in CELL_SIZE:
-            raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(CELL_SIZE)}")
-        if abs(maze.cell_size - CELL_SIZE[agent]) > 1e-9:
+        spec = get_agent(agent)
+        if abs(maze.cell_size - spec.cell_size) > 1e-9:
             raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
-                                  f"{CELL_SIZE[agent]:g} m: pass maze.for_agent({agent!r})")
-        spec = agent_spec(agent)
+                                  f"{spec.cell_size:g} m: pass maze.for_agent({agent!r})")
         self.maze, self.agent, self.policy = maze, agent, policy
         self.n, self.seed, self.nthread = int(n), seed, nthread
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon
-        self.agent_radius = float(spec.body_radius)  # BatchedSim.body_radius
+        self.agent_radius = float(spec.body_radius)  # the agent entry's (and BatchedSim's) body radius
         model = build_model(agent, maze)
-        names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
-        wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
-        agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
         #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
-        self.contact_margin = float(wall_margin + agent_margin)
-        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < body_radius
-        self.body_radius = self.agent_radius + self.contact_margin
-        self.avoid_radius = self.body_radius  # alias
+        self.contact_margin = contact_margin(model)
+        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < clearance
+        self.clearance = self.agent_radius + self.contact_margin
         #: fresh starts (default pose) keep this far from walls: the body radius, or the legs' reach if larger
-        self.spawn_radius = max(self.body_radius, footprint_radius(model) + self.contact_margin)
+        self.spawn_radius = max(self.clearance, footprint_radius(model) + self.contact_margin)
         self.cache_dir = Path(cache_dir) if cache_dir is not None else None
         self.evaluations = 0  # subtask evaluations actually simulated
-        self.sim_steps = 0  # environment steps simulated (evaluate + run_path)
+        self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
         self.cache_hits = 0
         self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
         self._act = policy.act if hasattr(policy, "act") else policy
         self._sims: dict[int, object] = {}
         self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
         self._compiled: dict[Region, CompiledRegion] = {}
-        self._walls = self.compiled(maze.walls)
+        self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
         grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
         self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
 
     # --- plumbing ------------------------------------------------------------------------------
-    def sim(self, n: int | None = None):
-        """The BatchedSim of batch ``n`` (built on first use, then reused)."""
+    @property
+    def control_period(self) -> float:
+        """Seconds per control step."""
+        spec = get_agent(self.agent)
+        return spec.timestep * spec.frame_skip
+
+    def facts(self) -> EvaluationFacts:
+        """What this evaluator does, in the terms a prompt states it (see :class:`EvaluationFacts`)."""
+        return EvaluationFacts(self.agent, self.clearance, self.horizon, self.control_period, self.n)
+
+    @property
+    def body_radius(self) -> float:
+        """Former name of :attr:`clearance` (torso + contact margin), kept for older notebooks."""
+        return self.clearance
+
+    def sim(self, batch: int | None = None):
+        """The BatchedSim of ``batch`` rows (default: ``n``; built on first use, then reused)."""
         from .sim import BatchedSim
 
-        n = int(n or self.n)
-        if n not in self._sims:
-            self._sims[n] = BatchedSim(self.agent, self.maze, n, nthread=self.nthread)
-        return self._sims[n]
+        batch = int(batch or self.n)
+        if batch not in self._sims:
+            self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread)
+        return self._sims[batch]
 
     def compiled(self, region: Region) -> CompiledRegion:
         c = self._compiled.get(region)
@@ -305,11 +184,11 @@ class Evaluator:
 
     def sample_free(self, region: Region, k: int, rng: np.random.Generator, clearance: float | None = None
                     ) -> np.ndarray:
-        """``k`` points uniform in ``region`` at least ``clearance`` (default: the body radius) from walls.
+        """``k`` points uniform in ``region`` at least ``clearance`` (default: ``self.clearance``) from walls.
 
         Falls back to plain uniform samples if the region has (almost) no such points.
         """
-        clearance = self.body_radius if clearance is None else clearance
+        clearance = self.clearance if clearance is None else clearance
         chunks, got = [], 0
         for _ in range(64):
             pts = region.sample(max(2 * (k - got), 16), rng)
@@ -324,7 +203,7 @@ class Evaluator:
 
     def spawn_points(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
         """Fresh start positions in ``region``: clear of walls by ``spawn_radius`` where the region allows it."""
-        if self.spawn_radius > self.body_radius and not self._has_room(region, self.spawn_radius, rng):
+        if self.spawn_radius > self.clearance and not self._has_room(region, self.spawn_radius, rng):
             return self.sample_free(region, k, rng)  # a tight start region: the body still fits, the legs may not
         return self.sample_free(region, k, rng, self.spawn_radius)
 
@@ -342,7 +221,7 @@ class Evaluator:
                     for g, a, p in legs]
         body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
                 "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
-                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.body_radius,
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.clearance,
                 "spawn": self.spawn_radius}
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
@@ -421,7 +300,8 @@ class Evaluator:
             elif (hit := self._lookup(key, text)) is not None:
                 results[i] = hit
             elif isinstance(start, StartStates) and len(start) == 0:
-                results[i] = _unreached_result(start)  # nothing reached the start: p = 0, nothing run
+                # nothing reached the start: p = 0, nothing run
+                results[i] = unreached(start.states.shape[1] if start.states.ndim == 2 else 0)
             else:
                 todo[key] = (text, (start, legs, n, seed), [i])
         batch = max(1, self.MAX_EPISODES // n)
@@ -466,7 +346,8 @@ class Evaluator:
         return self.evaluate(graph.region(u) if start is None else start, graph.region(v), graph.avoid(u, v),
                              goal_point=graph.goal_point(v), seed=seed, n=n)
 
-    def run_path(self, start: Region | StartStates, legs, n: int | None = None, seed=None) -> PathResult:
+    def run_compositional(self, start: Region | StartStates, legs, n: int | None = None, seed=None
+                          ) -> CompositionalResult:
         """Run the compositional policy: legs ``[(goal, avoid, goal_point | None), ...]`` end to end.
 
         Each episode starts in ``start`` and pursues leg 0's goal point; on reaching a leg's goal region it
@@ -477,18 +358,19 @@ class Evaluator:
         seed = self.seed if seed is None else seed
         legs = [tuple(leg) if len(leg) == 3 else (leg[0], leg[1], None) for leg in legs]
         if not legs:
-            raise SpecrefineError("run_path needs at least one leg")
+            raise SpecrefineError("run_compositional needs at least one leg")
         out = self._rollout(start, legs, n, seed)
         success = out["legs_done"] == len(legs)
         k = int(success.sum())
-        res = PathResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success, legs_done=out["legs_done"],
-                         trajectories=out["trajectories"], lengths=out["lengths"], steps=out["steps"],
-                         outcome=out["outcome"], n_legs=len(legs))
-        return res
+        return CompositionalResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                                   legs_done=out["legs_done"], trajectories=out["trajectories"], lengths=out["lengths"],
+                                   steps=out["steps"], outcome=out["outcome"], n_legs=len(legs))
 
-    def run_graph_path(self, graph, path: list[str], n: int | None = None, seed=None) -> PathResult:
-        """``run_path`` along a vertex path of a task graph, from I(path[0])."""
-        return self.run_path(graph.region(path[0]), path_legs(graph, path), n=n, seed=seed)
+    run_path = run_compositional  # the former name (notebooks written against it)
+
+    def run_graph_path(self, graph, path: list[str], n: int | None = None, seed=None) -> CompositionalResult:
+        """``run_compositional`` along a vertex path of a task graph, from I(path[0])."""
+        return self.run_compositional(graph.region(path[0]), path_legs(graph, path), n=n, seed=seed)
 
     # --- the hot loop --------------------------------------------------------------------------
     def _rollout(self, start, legs, n: int, seed) -> dict:
@@ -509,7 +391,7 @@ class Evaluator:
             sim.reset(xy=self.spawn_points(start, n, rng), rng=rng, idx=rows)
 
     def _rollout_batches(self, tasks: list[tuple]) -> list[dict]:
-        """Run every task's n episodes through its legs; the core loop behind ``evaluate`` and ``run_path``.
+        """Run every task's n episodes through its legs; the core loop behind ``evaluate`` and ``run_compositional``.
 
         Episodes of all tasks live in rows of one BatchedSim (each task seeded on its own, so a task's
         start states and goal points do not depend on its neighbours).  When at most half of the rows
@@ -538,7 +420,7 @@ class Evaluator:
                 avoid_id[j, k] = _index_of(avoids, self.compiled(avoid))
         if sim.n > N:  # padding rows: copies of row 0, never checked
             sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
-        H, r = self.horizon, self.body_radius
+        H, r = self.horizon, self.clearance
         T = L * H + 1
         traj = np.empty((N, T, 2), dtype=np.float32)
         leg = np.zeros(N, dtype=np.int64)
@@ -650,13 +532,6 @@ def _edge_result(out: dict, n: int) -> EdgeResult:
                       steps=out["steps"], outcome=out["outcome"])
 
 
-def _unreached_result(start: StartStates) -> EdgeResult:
-    sdim = start.states.shape[1] if start.states.ndim == 2 else 0
-    return EdgeResult(0.0, (0.0, 1.0), 0, 0, np.zeros(0, bool), np.zeros((0, 1, 2), np.float32),
-                      np.zeros(0, np.int64), StartStates(np.zeros((0, sdim)), np.zeros((0, 2))), 0,
-                      outcome=np.zeros(0, np.int8))
-
-
 def _index_of(items: list, item) -> int:
     """Position of ``item`` (by identity) in ``items``, appending it if new."""
     for i, x in enumerate(items):
@@ -683,84 +558,3 @@ def _torch_threads(k: int):
         torch.set_num_threads(before)
 
 
-# --- the monitor --------------------------------------------------------------------------------------
-def satisfies(graph, trajectories, lengths=None, body_radius: float = 0.0) -> np.ndarray:
-    """Which trajectories satisfy the task graph's specification.
-
-    A trajectory s_0..s_{T-1} satisfies the graph if there are a path v0 = initial -> v1 -> ... -> vk
-    (vk final) and times 0 = t0 <= t1 <= ... <= tk < T with s_{ti} in I(vi) and, for every i >= 1, no
-    state s_t with t_{i-1} <= t <= t_i inside O(v_{i-1} -> v_i) (signed distance < ``body_radius``).
-    Choices in the DAG are resolved nondeterministically: the monitor tracks the set of edges a
-    trajectory may currently be traversing (an NFA over edges), vectorised over trajectories.
-    """
-    traj = np.asarray(trajectories, dtype=float)
-    if traj.ndim == 2:
-        traj = traj[None]
-    n, T = traj.shape[:2]
-    lengths = np.full(n, T) if lengths is None else np.asarray(lengths, dtype=np.int64)
-    valid = np.arange(T)[None, :] < lengths[:, None]  # (n, T)
-    flat = traj.reshape(-1, 2)
-    g = graph.g
-    order = list(_topological(graph))
-    def chunked(fn, *args):  # bounded memory for long trajectories x many boxes
-        return np.concatenate([fn(flat[i:i + 32768], *args) for i in range(0, len(flat), 32768)]).reshape(n, T)
-
-    compiled: dict = {}
-    comp = lambda region: compiled.setdefault(region, CompiledRegion(region))  # noqa: E731
-    in_v = {v: chunked(comp(graph.region(v)).contains) for v in order}
-    bad = {}
-    for u, v in graph.edges():
-        bad[(u, v)] = chunked(comp(graph.avoid(u, v)).below, body_radius)
-    active = {e: np.zeros(n, dtype=bool) for e in bad}
-    accepted = np.zeros(n, dtype=bool)
-    finals = set(graph.finals)
-    for t in range(T):
-        ok_t = valid[:, t]
-        reached = {}
-        for v in order:
-            r = (in_v[v][:, t] & ok_t) if (t == 0 and v == graph.initial) else np.zeros(n, dtype=bool)
-            for u in g.predecessors(v):
-                r |= active[(u, v)] & in_v[v][:, t]
-            reached[v] = r
-            if v in finals:
-                accepted |= r
-            for w in g.successors(v):
-                e = (v, w)
-                active[e] = (active[e] | r) & ~bad[e][:, t] & ok_t
-        # edges into v were updated before v was visited (topological order), so reaching v at time t
-        # uses edges that survived time t -- the avoid check includes the reaching state itself
-        if not any(a.any() for a in active.values()):
-            break
-    return accepted
-
-
-def _topological(graph):
-    import networkx as nx
-
-    return nx.topological_sort(graph.g)
-
-
-# --- a scripted controller for the point mass ------------------------------------------------------
-class PointController:
-    """A straight-line controller for the point mass (no learning, no knowledge of walls).
-
-    It tracks the velocity ``min(gain * |e|, vmax)`` towards the goal (``e`` = goal - xy) with a
-    proportional force: ``a = clip(kv * (v* - v), -1, 1)``.  Observation layout as in
-    :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).  Deterministic;
-    a stand-in policy for tests and for notebooks without a trained checkpoint.
-    """
-
-    agent = "point"
-
-    def __init__(self, gain: float = 4.0, vmax: float = 2.0, kv: float = 0.2):
-        self.gain, self.vmax, self.kv = float(gain), float(vmax), float(kv)
-        self.fingerprint = f"point-line-g{self.gain:g}-v{self.vmax:g}-k{self.kv:g}"
-
-    def act(self, obs, deterministic: bool = True) -> np.ndarray:
-        obs = np.asarray(obs, dtype=np.float64)
-        e = obs[:, 2:4]
-        d = np.linalg.norm(e, axis=1, keepdims=True)
-        v_star = e * np.minimum(self.gain, self.vmax / np.maximum(d, 1e-9))
-        return np.clip(self.kv * (v_star - obs[:, 0:2]), -1.0, 1.0)
-
-    __call__ = act

@@ -51,7 +51,7 @@ def draw_step(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: 
     step = steps[i]
     graph = graph_at(steps, input_graph, i)
     edge = step.get("edge")
-    highlight = [edge[0], edge[1]] if edge and all(v in graph.g for v in edge) else step.get("path")
+    highlight = [edge[0], edge[1]] if edge and all(v in graph for v in edge) else step.get("path")
     fig = render_task(maze, graph, path=highlight, title=describe(step), size_px=size_px, legend=False)
     fig.axes[0].text(0.01, 0.01, f"open {step.get('open', [])}   closed {step.get('closed', [])}",
                      transform=fig.axes[0].transAxes, fontsize=8, va="bottom",

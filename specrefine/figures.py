@@ -15,11 +15,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .render import PngFigure  # noqa: E402
 from .sweep import summarise  # noqa: E402
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
 METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6c00", "ours": "#1565c0"}
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
+EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
 _UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")
 
 
@@ -42,10 +44,10 @@ def _select(summary, maze, method, proposer):
 def figure4(rows, tasks=None, metric="success"):
     """Success (or graph size, metric='vertices') per task per method, one panel per proposer."""
     summary = summarise(rows)
-    tasks = tasks or [t for t in CORE_TASKS if any(s["maze"] == t for s in summary)]
+    tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
     proposers = _proposers(rows) or ["none"]
     fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
-                             squeeze=False)
+                             squeeze=False, FigureClass=PngFigure)
     width = 0.8 / len(METHOD_ORDER)
     for ax, proposer in zip(axes[:, 0], proposers):
         for i, method in enumerate(METHOD_ORDER):
@@ -60,7 +62,9 @@ def figure4(rows, tasks=None, metric="success"):
             ax.set_ylim(0, 1.05)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
         ax.grid(axis="y", alpha=0.3)
-    axes[0, 0].legend(ncol=len(METHOD_ORDER), fontsize=8, loc="upper left")
+    # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
+    axes[0, 0].legend(ncol=len(METHOD_ORDER), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
+                      frameon=False, borderaxespad=0.2)
     fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
                  if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
                  fontsize=11)
@@ -76,7 +80,8 @@ def figure5(rows):
     """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer."""
     summary = summarise(rows)
     proposers = _proposers(rows) or ["none"]
-    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
+    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
+                             FigureClass=PngFigure)
     for ax, proposer in zip(axes[0], proposers):
         for method in METHOD_ORDER:
             for subgoals, style in ((False, "-"), (True, "--")):

@@ -16,7 +16,7 @@ from itertools import count
 import networkx as nx
 import numpy as np
 
-from .errors import InvalidRefinement
+from .errors import GraphError, InvalidRefinement
 from .regions import Region, from_dict, is_subset
 
 
@@ -42,7 +42,7 @@ class TaskGraph:
         self.g.add_edge(u, v, avoid=avoid, parent=tuple(parent) if parent else (u, v))
         if not nx.is_directed_acyclic_graph(self.g):
             self.g.remove_edge(u, v)
-            raise ValueError(f"edge {u}->{v} would create a cycle")
+            raise GraphError(f"edge {u}->{v} would create a cycle")
 
     def fresh_name(self) -> str:
         while True:
@@ -72,6 +72,74 @@ class TaskGraph:
 
     def predecessors(self, v: str) -> list[str]:
         return list(self.g.predecessors(v))
+
+    def has_vertex(self, v: str) -> bool:
+        return v in self.g
+
+    __contains__ = has_vertex
+
+    def has_edge(self, u: str, v: str) -> bool:
+        return self.g.has_edge(u, v)
+
+    def in_degree(self, v: str) -> int:
+        return self.g.in_degree(v)
+
+    def out_degree(self, v: str) -> int:
+        return self.g.out_degree(v)
+
+    def label(self, v: str) -> str:
+        return self.g.nodes[v]["label"]
+
+    def refines(self, v: str) -> str | None:
+        """The original vertex whose set I(v) narrows (None: an intermediate waypoint)."""
+        return self.g.nodes[v]["refines"]
+
+    def parent(self, u: str, v: str) -> tuple[str, str]:
+        """The original edge that u -> v helps to implement."""
+        return self.g.edges[u, v]["parent"]
+
+    def topological_order(self) -> list[str]:
+        return list(nx.topological_sort(self.g))
+
+    def topological_layers(self) -> list[list[str]]:
+        """Vertices by depth: sources first, each vertex one layer after its deepest predecessor."""
+        return [list(layer) for layer in nx.topological_generations(self.g)]
+
+    def descendants(self, v: str) -> set[str]:
+        return nx.descendants(self.g, v)
+
+    @property
+    def n_vertices(self) -> int:
+        return self.g.number_of_nodes()
+
+    @property
+    def n_edges(self) -> int:
+        return self.g.number_of_edges()
+
+    # --- surgery (in place; the result still refines what it refined: Theorem 4.1) ------------
+    def split_edge(self, u: str, v: str, waypoints) -> list[str]:
+        """Replace edge u -> v by u -> x1 -> ... -> v; returns the new vertex names (none for no waypoints).
+
+        New vertices are intermediates (``refines=None``); new edges keep the avoid set and the
+        ``parent`` of the edge they replace.
+        """
+        if not waypoints:
+            return []
+        avoid, parent = self.avoid(u, v), self.parent(u, v)
+        self.g.remove_edge(u, v)
+        names = [self.add_vertex(None, w, refines=None) for w in waypoints]
+        chain = [u, *names, v]
+        for a, b in zip(chain, chain[1:]):
+            self.add_edge(a, b, avoid, parent=parent)
+        return names
+
+    def set_avoid(self, u: str, v: str, avoid: Region) -> None:
+        self.g.edges[u, v]["avoid"] = avoid
+
+    def narrow_vertex(self, v: str, region: Region) -> None:
+        """Replace I(v) by ``region`` (a subset of it: vertex refinement); its goal point is dropped."""
+        node = self.g.nodes[v]
+        node["region"], node["point"] = region, None
 
     def copy(self) -> TaskGraph:
         return TaskGraph.from_json(self.to_json())

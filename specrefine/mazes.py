@@ -2,8 +2,12 @@
 
 Format (one grid row per line): ``#`` wall, ``.`` free, ``S`` start cell(s), ``G`` goal
 cell(s), ``a``..``z`` subgoal cells (one letter = one region, visited in alphabetical
-order).  Lines starting with ``;`` are comments, blank lines are ignored, and anything
-outside the grid is wall.
+order), ``~`` hazard cells (free floor the body can cross, with no wall geometry in the
+simulator, but part of every subtask's avoid set: touching one fails the task).  Lines
+starting with ``;`` are comments, blank lines are ignored, and anything outside the grid is
+wall.  A comment line ``; spec: EXPR`` gives the maze's default task as a spec expression
+(``specrefine.spec.parse_spec``, e.g. ``; spec: (a | b) -> G``) in place of the chain
+S -> a -> b -> ... -> G; ``--spec`` on the command line overrides it.
 
 Coordinates follow Gymnasium-Robotics' ``maze_v4.py``: the origin is the centre of the
 map, x grows with the column, y grows upwards (row 0 is the top row), and every cell is
@@ -12,6 +16,7 @@ map, x grows with the column, y grows upwards (row 0 is the top row), and every 
 
 from __future__ import annotations
 
+import re
 from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
@@ -19,12 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import AGENTS, get_agent
 from .errors import MazeError
+from .paths import data_dir
 from .regions import Box, Region, union
 
-MAZE_DIR = Path(__file__).resolve().parent.parent / "data" / "mazes"
-CELL_SIZE = {"point": 1.0, "ant": 4.0}
-_LEGAL = set("#.SG") | set("abcdefghijklmnopqrstuvwxyz")
+MAZE_DIR = data_dir() / "mazes"
+CELL_SIZE = {name: agent.cell_size for name, agent in AGENTS.items()}  # metres per cell, by agent
+_LEGAL = set("#.SG~") | set("abcdefghijklmnopqrstuvwxyz")
+HAZARD = "~"
+_SPEC_LINE = re.compile(r"^\s*;\s*spec\s*:\s*(.*)$")
 
 
 @dataclass(frozen=True)
@@ -32,6 +41,7 @@ class Maze:
     name: str
     grid: tuple[str, ...]
     cell_size: float = 1.0
+    spec: str | None = None  # the default task from a '; spec: EXPR' line (None: the chain S -> a -> ... -> G)
 
     @property
     def rows(self) -> int:
@@ -42,10 +52,10 @@ class Maze:
         return len(self.grid[0])
 
     def scaled(self, cell_size: float) -> Maze:
-        return Maze(self.name, self.grid, cell_size)
+        return Maze(self.name, self.grid, cell_size, self.spec)
 
     def for_agent(self, agent: str) -> Maze:
-        return self.scaled(CELL_SIZE[agent])
+        return self.scaled(get_agent(agent).cell_size)
 
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
     @property
@@ -86,6 +96,13 @@ class Maze:
 
     def free_cells(self) -> list[tuple[int, int]]:
         return [(r, c) for r in range(self.rows) for c in range(self.cols) if self.is_free(r, c)]
+
+    def passable(self, row: int, col: int) -> bool:
+        """Free and not a hazard: a cell a route may use (``is_free`` also counts hazards, the body can cross them)."""
+        return self.is_free(row, col) and self.grid[row][col] != HAZARD
+
+    def passable_cells(self) -> list[tuple[int, int]]:
+        return [(r, c) for r in range(self.rows) for c in range(self.cols) if self.passable(r, c)]
 
     def region_of(self, cells) -> Region:
         """Union of cells, merged into maximal horizontal runs so it stays small."""
@@ -129,6 +146,17 @@ class Maze:
         return union(([self.region_of(wall_cells)] if wall_cells else []) + frame)
 
     @cached_property
+    def hazards(self) -> Region | None:
+        """The hazard cells ``~`` (None if there are none): free floor, but avoided by every subtask."""
+        cells = self.cells(HAZARD)
+        return self.region_of(cells) if cells else None
+
+    @cached_property
+    def obstacles(self) -> Region:
+        """What every subtask avoids: the walls plus the hazards (exactly ``walls`` when there are no hazards)."""
+        return self.walls if self.hazards is None else union([*self.walls.parts(), *self.hazards.parts()])
+
+    @cached_property
     def free(self) -> Region:
         return self.region_of(self.free_cells())
 
@@ -140,7 +168,8 @@ class Maze:
             f"Map extent: x in [{-self.width / 2:g}, {self.width / 2:g}], "
             f"y in [{-self.height / 2:g}, {self.height / 2:g}].",
             "Cell (row, col) has centre x = (col + 0.5) * cell - width/2, y = height/2 - (row + 0.5) * cell.",
-            "Grid ('#' wall, '.' free, 'S' start, 'G' goal, letters = subgoals):",
+            "Grid ('#' wall, '.' free, 'S' start, 'G' goal, letters = subgoals"
+            + (", '~' hazard: free floor that counts as touching an obstacle" if self.hazards else "") + "):",
             *("    " + line for line in self.grid),
         ]
         return "\n".join(lines)
@@ -148,14 +177,19 @@ class Maze:
 
 def parse_maze(text: str, name: str = "<maze>", cell_size: float = 1.0) -> Maze:
     """Parse maze text; any problem raises MazeError('name:line:col: what')."""
-    rows, width, first_line = [], None, None
+    rows, width, first_line, spec_line = [], None, None, None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.rstrip("\r\n").rstrip()
         if not line.strip() or line.lstrip().startswith(";"):
+            m = _SPEC_LINE.match(line)
+            if m:
+                if spec_line is not None:
+                    raise MazeError(f"{name}:{lineno}:1: a second '; spec:' line (line {spec_line[0]} has one)")
+                spec_line = (lineno, m.start(1), m.group(1).rstrip())
             continue
         for col, ch in enumerate(line, start=1):
             if ch not in _LEGAL:
-                raise MazeError(f"{name}:{lineno}:{col}: unknown character {ch!r} (use # . S G or a-z)")
+                raise MazeError(f"{name}:{lineno}:{col}: unknown character {ch!r} (use # . S G ~ or a-z)")
         if width is None:
             width, first_line = len(line), lineno
         elif len(line) != width:
@@ -168,6 +202,17 @@ def parse_maze(text: str, name: str = "<maze>", cell_size: float = 1.0) -> Maze:
         raise MazeError(f"{name}:1:1: empty maze: no grid rows")
     maze = Maze(Path(name).stem, tuple(line for _, line in rows), cell_size)
     _check_cells(maze, name, [lineno for lineno, _ in rows])
+    if spec_line is not None:
+        from .errors import SpecError
+        from .spec import parse_spec
+
+        lineno, offset, expr = spec_line
+        try:
+            parse_spec(expr, maze)
+        except SpecError as exc:
+            col = offset + getattr(exc, "column", 1)
+            raise MazeError(f"{name}:{lineno}:{col}: '; spec:' line: {getattr(exc, 'reason', exc)}") from None
+        maze = Maze(maze.name, maze.grid, cell_size, expr)
     return maze
 
 
@@ -179,26 +224,32 @@ def _check_cells(maze: Maze, name: str, linenos: list[int]) -> None:
     if not goals:
         raise MazeError(f"{name}:{linenos[0]}:1: no goal cell 'G'")
     reached = reachable_cells(maze, starts)
+    safe = reachable_cells(maze, starts, maze.passable)  # without crossing a hazard '~'
+    only_hazards = " (only through hazard cells '~', which every subtask avoids)"
     for goal in goals:
-        if goal not in reached:
-            raise MazeError(f"{where(goal)}: goal cell 'G' is not reachable from the start through free cells")
-    to_goal = reachable_cells(maze, goals)
+        if goal not in safe:
+            raise MazeError(f"{where(goal)}: goal cell 'G' is not reachable from the start through free cells"
+                            + (only_hazards if goal in reached else ""))
+    to_goal = reachable_cells(maze, goals, maze.passable)
     for start in starts:  # the initial distribution covers every S cell, so each must lead to the goal
         if start not in to_goal:
-            raise MazeError(f"{where(start)}: start cell 'S' cannot reach the goal through free cells")
+            raise MazeError(f"{where(start)}: start cell 'S' cannot reach the goal through free cells"
+                            + (only_hazards if start in reachable_cells(maze, goals) else ""))
     for letter in maze.subgoals:
         for cell in maze.cells(letter):
-            if cell not in reached:
-                raise MazeError(
-                    f"{where(cell)}: subgoal {letter!r} is not reachable from the start through free cells")
+            if cell not in safe:
+                raise MazeError(f"{where(cell)}: subgoal {letter!r} is not reachable from the start through free "
+                                "cells" + (only_hazards if cell in reached else ""))
 
 
-def reachable_cells(maze: Maze, sources) -> set[tuple[int, int]]:
+def reachable_cells(maze: Maze, sources, through=None) -> set[tuple[int, int]]:
+    """Cells 4-connected to ``sources`` through cells where ``through(row, col)`` (default ``maze.is_free``)."""
+    through = through or maze.is_free
     seen, queue = set(sources), deque(sources)
     while queue:
         r, c = queue.popleft()
         for nb in ((r + 1, c), (r - 1, c), (r, c + 1), (r, c - 1)):
-            if nb not in seen and maze.is_free(*nb):
+            if nb not in seen and through(*nb):
                 seen.add(nb)
                 queue.append(nb)
     return seen

@@ -18,8 +18,7 @@ import numpy as np
 
 from .errors import SpecrefineError
 from .graph import check_refines
-from .mazes import load_maze
-from .spec import maze_task
+from .spec import maze_spec_text
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
 
@@ -45,7 +44,8 @@ class RunResult:
     def summary(self) -> str:
         d = self.data
         lo, hi = d["success_ci"]
-        return (f"{d['maze']} | {d['agent']} | method={d['method']} proposer={d['proposer']} seed={d['seed']}\n"
+        return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
+                f"seed={d['seed']}\n"
                 f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
                 f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
@@ -56,19 +56,18 @@ class RunResult:
 
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
-                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None) -> RunResult:
-    from .evaluate import Evaluator
-    from .policy import load_policy
+                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
+                spec: str | None = None) -> RunResult:
+    """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
+    ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain)."""
+    from .experiment import setup
 
     t0 = time.time()
-    maze = load_maze(maze_path).for_agent(agent)
-    original = maze_task(maze)
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    if evaluator is None:
-        policy = load_policy(policy_path or agent)
-        evaluator = Evaluator(maze, agent, policy, n=rollouts, seed=seed, cache_dir=out / "cache")
-    prop = _make_proposer(proposer, method, seed, out)
+    exp = setup(maze_path, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
+                rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
+                record_path=out / "vlm_recording.jsonl", spec=spec)
+    maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
 
         def on_step(step):
@@ -78,17 +77,10 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
     measured = _measure(evaluator, original, search, episodes, seed)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
+    data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
-
-
-def _make_proposer(spec: str, method: str, seed: int, out: Path):
-    if method not in PROPOSER_METHODS:
-        return None
-    from .proposers import make_proposer
-
-    return make_proposer(spec, seed=seed, record_path=out / "vlm_recording.jsonl")
 
 
 def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step):
@@ -102,8 +94,9 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
     if method.startswith("ours"):
         cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
                            vertex_refinement=method != "ours-novertex")
+        query_for = edge_query_builder(maze, agent, evaluator.facts())
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
-                                query_for=edge_query_builder(maze, agent), picture=candidate_picture(maze)).run()
+                                query_for=query_for, picture=candidate_picture(maze)).run()
     if method.startswith("vlm-oneshot"):
         from .refine.oneshot import oneshot
 
@@ -125,8 +118,12 @@ def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, 
     return proposer.proposer_calls, twin.evaluations + twin.disk_hits
 
 
-def edge_query_builder(maze, agent):
-    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts."""
+def edge_query_builder(maze, agent, facts=None):
+    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts.
+
+    ``facts``: the evaluator's ``facts()``, what the prompt says about the evaluation (default: an
+    evaluator with default settings on ``maze``).
+    """
     from .proposers import EdgeQuery
     from .render import render_task, to_png
 
@@ -135,7 +132,8 @@ def edge_query_builder(maze, agent):
                           success=getattr(result, "success", None), lengths=getattr(result, "lengths", None),
                           title=f"{u} -> {v}: {result.p:.0%} of {result.n} rollouts succeed")
         return EdgeQuery(maze=maze, agent=agent, start=graph.region(u), goal=graph.region(v),
-                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph)
+                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph,
+                         facts=facts)
 
     return build
 
@@ -144,8 +142,8 @@ def _edge_graph(graph, u, v):
     from .graph import TaskGraph
 
     sub = TaskGraph(u)
-    sub.add_vertex(u, graph.region(u), label=graph.g.nodes[u]["label"])
-    sub.add_vertex(v, graph.region(v), label=graph.g.nodes[v]["label"])
+    sub.add_vertex(u, graph.region(u), label=graph.label(u))
+    sub.add_vertex(v, graph.region(v), label=graph.label(v))
     sub.add_edge(u, v, graph.avoid(u, v))
     sub.finals = {v}
     return sub
@@ -186,21 +184,22 @@ class Measurement:
 
 
 def _measure(evaluator, original, search, episodes, seed) -> Measurement:
-    from .evaluate import satisfies
+    from .evaluate import path_legs
+    from .monitor import satisfies
 
     if not search.path or len(search.path) < 2:
         return Measurement(np.zeros(0, dtype=bool), None)
-    from .evaluate import path_legs
 
     # always from the ORIGINAL initial distribution, even if a baseline changed the initial vertex
-    pr = evaluator.run_path(original.region(original.initial), path_legs(search.graph, search.path), n=episodes,
-                            seed=seed + MEASURE_SEED_OFFSET)
-    ok = satisfies(original, pr.trajectories, pr.lengths, body_radius=evaluator.body_radius)
+    legs = path_legs(search.graph, search.path)
+    pr = evaluator.run_compositional(original.region(original.initial), legs, n=episodes,
+                                     seed=seed + MEASURE_SEED_OFFSET)
+    ok = satisfies(original, pr.trajectories, pr.lengths, clearance=evaluator.clearance)
     return Measurement(ok, pr)
 
 
 def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, search, measured, evaluator, t0):
-    from .evaluate import wilson_ci
+    from .results import wilson_ci
 
     n_ok, n = int(measured.success.sum()), len(measured.success)
     graph = search.graph
@@ -219,7 +218,7 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
         "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,
         "refines_input": not check_refines(graph, original), "path": search.path,
-        "graph_vertices": graph.g.number_of_nodes(), "graph_edges": graph.g.number_of_edges(),
+        "graph_vertices": graph.n_vertices, "graph_edges": graph.n_edges,
         "path_edges": path_edges, "graph": graph.to_dict(), "input_graph": original.to_dict(),
     }
 

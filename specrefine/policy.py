@@ -14,17 +14,15 @@ import numpy as np
 import torch
 from torch import nn
 
-from .errors import SpecrefineError
+from .agents import AGENTS
+from .errors import PolicyError
+from .paths import data_dir
 
 FORMAT = "specrefine-policy"
 VERSION = 1
 HIDDEN = 256
-POLICY_DIR = Path(__file__).resolve().parent.parent / "data" / "policies"
-OBS_ACT_DIMS = {"point": (4, 2), "ant": (29, 8)}
-
-
-class PolicyError(SpecrefineError):
-    """A policy file is missing, corrupt, or does not fit the agent."""
+POLICY_DIR = data_dir() / "policies"
+OBS_ACT_DIMS = {name: (a.obs_dim, a.act_dim) for name, a in AGENTS.items()}
 
 
 def mlp(n_in: int, n_out: int, hidden: int = HIDDEN) -> nn.Sequential:
@@ -131,3 +129,28 @@ def load_policy(path_or_agent) -> GoalPolicy:
         raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
     policy.meta = blob.get("meta", {})
     return policy.eval()
+
+
+class PointController:
+    """A straight-line controller for the point mass (no learning, no knowledge of walls).
+
+    It tracks the velocity ``min(gain * |e|, vmax)`` towards the goal (``e`` = goal - xy) with a
+    proportional force: ``a = clip(kv * (v* - v), -1, 1)``.  Observation layout as in
+    :class:`~specrefine.sim.BatchedSim` for the point: velocity (2), goal - xy (2).  Deterministic;
+    a stand-in policy for tests and for notebooks without a trained checkpoint.
+    """
+
+    agent = "point"
+
+    def __init__(self, gain: float = 4.0, vmax: float = 2.0, kv: float = 0.2):
+        self.gain, self.vmax, self.kv = float(gain), float(vmax), float(kv)
+        self.fingerprint = f"point-line-g{self.gain:g}-v{self.vmax:g}-k{self.kv:g}"
+
+    def act(self, obs, deterministic: bool = True) -> np.ndarray:
+        obs = np.asarray(obs, dtype=np.float64)
+        e = obs[:, 2:4]
+        d = np.linalg.norm(e, axis=1, keepdims=True)
+        v_star = e * np.minimum(self.gain, self.vmax / np.maximum(d, 1e-9))
+        return np.clip(self.kv * (v_star - obs[:, 0:2]), -1.0, 1.0)
+
+    __call__ = act

@@ -1,7 +1,8 @@
 """Top-down pictures of a maze task: the image a VLM sees, and the pictures in the notebooks.
 
 Colours follow the paper's figures: walls black, the start region cyan, the goal green,
-subgoals / waypoints orange, successful trajectories green and failed ones red.  Axes are in
+subgoals / waypoints orange, successful trajectories green and failed ones red; hazard cells
+``~`` (avoided like walls, but no walls) purple and hatched.  Axes are in
 metres with a light grid at every cell so that coordinates can be read off the picture.
 
 Figures are plain :class:`matplotlib.figure.Figure` objects (no pyplot state, nothing to
@@ -19,7 +20,6 @@ import io
 from pathlib import Path
 
 import matplotlib
-import networkx as nx
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -29,7 +29,20 @@ from matplotlib.ticker import MultipleLocator
 
 from .regions import Box, Disc, Region
 
+
+class PngFigure(Figure):
+    """A Figure that shows itself as a PNG in Jupyter (``display(fig)``, or as a cell's last value).
+
+    IPython renders a plain matplotlib Figure as a picture only when the inline backend has
+    registered its formatter (``%matplotlib inline``); otherwise a live JupyterLab shows the text
+    ``<Figure size 640x535 with 1 Axes>``, which is what the search slider of notebook 05 did.
+    """
+
+    def _repr_png_(self):
+        return to_png(self)
+
 WALL = "black"
+HAZARD = "#8e24aa"  # purple: hazard cells '~'
 START = "#00c8e6"  # cyan
 GOAL = "#22b14c"  # green
 SUBGOAL = "#ff8c00"  # orange
@@ -41,8 +54,8 @@ PATH = "#1f4fff"
 DPI = 100
 
 __all__ = [
-    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_region",
-    "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
+    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_hazards",
+    "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
 ]
 
 
@@ -68,7 +81,7 @@ def new_figure(bounds, size_px: int = 768, title: str | None = None, legend_row:
     else:
         h = size_px
         w = int(round(min(size_px, max((h - top - bottom) / aspect + left + right, 0.35 * size_px))))
-    fig = Figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    fig = PngFigure(figsize=(w / DPI, h / DPI), dpi=DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((left / w, bottom / h, 1 - (left + right) / w, 1 - (top + bottom) / h))
     ax.set_xlim(x0, x1)
@@ -124,6 +137,12 @@ def draw_region(ax, region: Region, color, *, alpha=0.45, edge=False, hatch=None
 def draw_walls(ax, maze) -> None:
     """Wall cells in black (the frame around the grid lies outside the axes)."""
     draw_region(ax, maze.walls, WALL, alpha=1.0, zorder=1.0)
+
+
+def draw_hazards(ax, maze) -> None:
+    """Hazard cells ``~`` in hatched purple (avoided by every subtask, but no walls: the body can cross them)."""
+    if getattr(maze, "hazards", None) is not None:
+        draw_region(ax, maze.hazards, HAZARD, alpha=0.55, hatch="xx", zorder=1.05)
 
 
 def _label(ax, xy, text, color="black", size=None, zorder=6):
@@ -187,7 +206,7 @@ def draw_graph(ax, graph, *, path=None, edge_labels=None, regions=True, alpha=0.
         p = pts[v]
         colour = _vertex_colour(graph, v)
         ax.plot([p[0]], [p[1]], "o", ms=0.45 * fs, mfc=colour, mec="black", mew=0.8, zorder=6)
-        label = graph.g.nodes[v].get("label") or v
+        label = graph.label(v) or v
         dark = {START: "#007a8c", GOAL: "#116622", SUBGOAL: "#b35f00"}[colour]
         ax.annotate(label, p, xytext=(0.55 * fs, 0.55 * fs), textcoords="offset points", fontsize=0.85 * fs,
                     color=dark, fontweight="bold", zorder=7,
@@ -237,7 +256,8 @@ def _legend(fig, ax, items) -> None:
     handles = []
     for name, colour, kind in items:
         if kind == "patch":
-            handles.append(Patch(facecolor=colour, edgecolor="black" if colour == WALL else colour, label=name))
+            handles.append(Patch(facecolor=colour, edgecolor="black" if colour == WALL else colour, label=name,
+                                 hatch="xx" if colour == HAZARD else None))
         else:
             handles.append(Line2D([0], [0], color=colour, lw=2, label=name))
     fs = _fs(ax)
@@ -264,6 +284,7 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
     ax.set_facecolor("white")
     _grid(ax, maze.cell_size)
     draw_walls(ax, maze)
+    draw_hazards(ax, maze)
     if graph is None:
         draw_maze_regions(ax, maze)
     else:
@@ -277,6 +298,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
         draw_points(ax, points)
     if legend:
         items = [("wall", WALL, "patch"), ("start", START, "patch"), ("goal", GOAL, "patch")]
+        if getattr(maze, "hazards", None) is not None:
+            items.insert(1, ("hazard", HAZARD, "patch"))
         if (graph is not None and len(graph.vertices()) > 2) or maze.subgoals or waypoints:
             items.append(("subgoal / waypoint", SUBGOAL, "patch"))
         if trajectories is not None and len(trajectories):
@@ -296,9 +319,8 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     probs: optional {(u, v): success probability} written on the edges; path: vertices to highlight.
     Vertex colours as on the map: initial cyan, finals green, the rest orange.
     """
-    g = graph.g
-    order = {v: i for i, v in enumerate(g.nodes)}
-    layers = [sorted(layer, key=order.get) for layer in nx.topological_generations(g)]
+    order = {v: i for i, v in enumerate(graph.vertices())}
+    layers = [sorted(layer, key=order.get) for layer in graph.topological_layers()]
     depth = {v: i for i, layer in enumerate(layers) for v in layer}
     pos = {v: np.array([float(i), (len(layer) - 1) / 2.0 - j]) for i, layer in enumerate(layers)
            for j, v in enumerate(layer)}
@@ -309,7 +331,7 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     h = int(round(float(np.clip((w * n_rows) / n_cols + top, 0.3 * size_px, size_px))))
     if h == size_px and (w * n_rows) / n_cols + top > size_px:  # tall graph: shrink the width instead
         w = int(round(max((size_px - top) * n_cols / n_rows, 0.3 * size_px)))
-    fig = Figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    fig = PngFigure(figsize=(w / DPI, h / DPI), dpi=DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0 - top / h))
     ax.set_xlim(-0.5, n_cols - 0.5)
@@ -322,7 +344,7 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
     node_r = 0.22
     px_per_unit = min(w / n_cols, (h - top) / n_rows)
     shrink = node_r * px_per_unit * 72 / DPI + 1.0  # points
-    for u, v in g.edges():
+    for u, v in graph.edges():
         hot = (u, v) in on_path
         rad = 0.0 if depth[v] - depth[u] == 1 else -0.3
         ax.add_patch(FancyArrowPatch(pos[u], pos[v], arrowstyle="-|>", mutation_scale=1.5 * fs,
@@ -333,10 +355,10 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
             ax.text(mid[0], mid[1], f"{float(probs[(u, v)]):.2f}", ha="center", va="bottom", fontsize=0.9 * fs,
                     color=PATH if hot else EDGE, zorder=4,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.9))
-    for v in g.nodes():
+    for v in graph.vertices():
         ax.add_patch(Circle(pos[v], node_r, facecolor=_vertex_colour(graph, v), edgecolor="black",
                             lw=2.0 if v in (path or ()) else 0.8, zorder=3))
-        ax.text(pos[v][0], pos[v][1], g.nodes[v].get("label") or v, ha="center", va="center", fontsize=fs,
+        ax.text(pos[v][0], pos[v][1], graph.label(v) or v, ha="center", va="center", fontsize=fs,
                 fontweight="bold", zorder=4)
     return fig
 

@@ -32,7 +32,6 @@ rollouts that wander).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -43,21 +42,11 @@ from tensordict import TensorDict
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
+from .agents import ReachTask, get_agent
 from .errors import SpecrefineError
 from .mazes import Maze
 
-AGENTS = ("point", "ant")
-
-
-@dataclass(frozen=True)
-class AgentSpec:
-    xml: Path
-    integrator: int
-    timestep: float
-    frame_skip: int
-    body_radius: float
-    default_horizon: int
-    wall_half_height: float
+_INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "rk4": mujoco.mjtIntegrator.mjINT_RK4}
 
 
 def _asset(module: str, *parts: str) -> Path:
@@ -68,16 +57,6 @@ def _asset(module: str, *parts: str) -> Path:
     if spec is None or spec.origin is None:
         raise SpecrefineError(f"package {module!r} is not installed; it provides the agent's MuJoCo model")
     return Path(spec.origin).parent.joinpath(*parts)
-
-
-def agent_spec(agent: str) -> AgentSpec:
-    if agent == "point":
-        return AgentSpec(_asset("gymnasium_robotics", "envs", "assets", "point", "point.xml"),
-                         mujoco.mjtIntegrator.mjINT_EULER, 0.01, 5, 0.1, 100, 0.5)
-    if agent == "ant":
-        return AgentSpec(_asset("gymnasium", "envs", "mujoco", "assets", "ant.xml"),
-                         mujoco.mjtIntegrator.mjINT_RK4, 0.01, 5, 0.5, 300, 0.5)
-    raise SpecrefineError(f"unknown agent {agent!r}; expected one of {', '.join(AGENTS)}")
 
 
 def footprint_radius(model: mujoco.MjModel) -> float:
@@ -98,11 +77,19 @@ def footprint_radius(model: mujoco.MjModel) -> float:
     return reach
 
 
+def contact_margin(model: mujoco.MjModel) -> float:
+    """The gap at which the agent's contacts with walls become active (the sum of both geoms' margins)."""
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "" for i in range(model.ngeom)]
+    wall_margin = max([model.geom_margin[i] for i, nm in enumerate(names) if nm.startswith("wall_")], default=0.0)
+    agent_margin = float(model.geom_margin[model.geom_bodyid > 0].max(initial=0.0))
+    return float(wall_margin + agent_margin)
+
+
 def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
     """The agent's MJCF plus one static box geom per wall part of ``maze``."""
-    spec_ = agent_spec(agent)
-    spec = mujoco.MjSpec.from_file(str(spec_.xml))
-    spec.option.integrator = spec_.integrator
+    spec_ = get_agent(agent)
+    spec = mujoco.MjSpec.from_file(str(_asset(*spec_.mjcf)))
+    spec.option.integrator = _INTEGRATORS[spec_.integrator]
     spec.option.timestep = spec_.timestep
     if maze is not None:
         h = spec_.wall_half_height
@@ -110,7 +97,7 @@ def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
             x0, y0, x1, y1 = box.bounds()
             spec.worldbody.add_geom(
                 name=f"wall_{i}", type=mujoco.mjtGeom.mjGEOM_BOX,
-                size=[(x1 - x0) / 2, (y1 - y0) / 2, h], pos=[(x0 + x1) / 2, (y0 + y1) / 2, h if agent == "ant" else 0],
+                size=[(x1 - x0) / 2, (y1 - y0) / 2, h], pos=[(x0 + x1) / 2, (y0 + y1) / 2, 0 if spec_.planar else h],
                 contype=1, conaffinity=1, rgba=[0.4, 0.4, 0.5, 1])
     return spec.compile()
 
@@ -124,7 +111,7 @@ class BatchedSim:
         if n < 1:
             raise SpecrefineError(f"BatchedSim needs n >= 1 rollouts, got {n}")
         self.agent, self.n, self.maze = agent, int(n), maze
-        self._spec = agent_spec(agent)
+        self._spec = get_agent(agent)
         self.model = build_model(agent, maze)
         m = self.model
         self.frame_skip = self._spec.frame_skip
@@ -132,7 +119,7 @@ class BatchedSim:
         self.body_radius = self._spec.body_radius
         self.default_horizon = self._spec.default_horizon
         self.act_dim = m.nu
-        self.obs_dim = 4 if agent == "point" else (m.nq - 2) + m.nv + 2
+        self.obs_dim = m.nv + 2 if self._spec.planar else (m.nq - 2) + m.nv + 2
         self.state_dim = mujoco.mj_stateSize(m, self.STATE_SPEC)
         self._qpos = slice(1, 1 + m.nq)  # FULLPHYSICS layout: time, qpos, qvel, act, ...
         self._qvel = slice(1 + m.nq, 1 + m.nq + m.nv)
@@ -151,10 +138,11 @@ class BatchedSim:
         base = np.empty(self.state_dim)
         mujoco.mj_getState(self.model, d, base, self.STATE_SPEC)
         states = np.tile(base, (k, 1))
-        if rng is not None and self.agent == "ant":  # Gymnasium's reset noise (0.1), not on x, y
+        noise = self._spec.reset_noise
+        if rng is not None and noise:  # Gymnasium's reset noise, not on x, y
             nq, nv = self.model.nq, self.model.nv
-            states[:, 3:1 + nq] += rng.uniform(-0.1, 0.1, size=(k, nq - 2))
-            states[:, self._qvel] += 0.1 * rng.standard_normal((k, nv))
+            states[:, 3:1 + nq] += rng.uniform(-noise, noise, size=(k, nq - 2))
+            states[:, self._qvel] += noise * rng.standard_normal((k, nv))
         return states
 
     def reset(self, xy=None, states=None, rng: np.random.Generator | None = None, idx=None) -> None:
@@ -193,7 +181,7 @@ class BatchedSim:
     @property
     def up(self) -> np.ndarray:
         """z-component of the torso's z axis: 1 upright, 0 on its side, < 0 upside down (point: always 1)."""
-        if self.agent != "ant":
+        if self._spec.planar:
             return np.ones(self.n)
         _, qx, qy, _ = self.qpos[:, 3:7].T
         return 1.0 - 2.0 * (qx * qx + qy * qy)
@@ -209,7 +197,7 @@ class BatchedSim:
     # --- observe / step --------------------------------------------------------------------
     def observe(self, goals: np.ndarray) -> np.ndarray:
         rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
-        if self.agent == "point":
+        if self._spec.planar:
             return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
         c, s = np.cos(self._yaw()), np.sin(self._yaw())
         local = np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
@@ -217,14 +205,15 @@ class BatchedSim:
 
     def step(self, actions: np.ndarray) -> None:
         ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)
-        if self.agent == "point":  # force bounded in norm, not per axis: then straight is the fastest way to a goal
+        if self._spec.action_in_disc:  # force bounded in norm, not per axis: then straight is the fastest way to a goal
             ctrl /= np.maximum(np.linalg.norm(ctrl, axis=-1, keepdims=True), 1.0)
         ctrl = np.ascontiguousarray(np.broadcast_to(ctrl, (self.n, self.frame_skip, self.act_dim)))
         self._pool.rollout(self._models, self._datas, self._state, ctrl, nstep=self.frame_skip,
                            state=self._out, skip_checks=True)
         self._state[:] = self._out[:, -1]
-        if self.agent == "point":
-            np.clip(self._state[:, self._qvel], -5.0, 5.0, out=self._state[:, self._qvel])
+        if self._spec.max_speed is not None:
+            v = self._spec.max_speed
+            np.clip(self._state[:, self._qvel], -v, v, out=self._state[:, self._qvel])
 
     def close(self) -> None:
         if self._pool is not None:
@@ -239,29 +228,6 @@ class BatchedSim:
 
 
 # --- goal-conditioned reach task for training (open floor) -----------------------------------
-@dataclass(frozen=True)
-class ReachTask:
-    goal_min: float
-    goal_max: float
-    success_radius: float
-    max_steps: int
-    progress_scale: float  # reward per metre of progress towards the goal
-    success_bonus: float
-    flip_penalty: float
-    step_cost: float = 0.0  # per control step: without it the point learns to idle just outside the radius
-    arrive_speed: float | None = None  # success also needs a planar speed below this (m/s): arrive under control
-    lateral_cost: float = 0.0  # per metre moved across the line to the goal: keeps paths straight in corridors
-    goals_per_episode: int = 1  # > 1: on success a new goal is drawn from where the agent is, without a reset
-    tilt_cost: float = 0.0  # per step x (1 - the torso's up-vector z): a dense warning long before a flip
-
-
-REACH_TASKS = {
-    # the point (up to 5 m/s in 1 m corridors) must arrive slowly, or the next subtask starts by hitting a wall
-    "point": ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02, arrive_speed=1.0, lateral_cost=2.0),
-    "ant": ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0, 0.0),
-}
-
-
 def sample_goals(xy: np.ndarray, lo: float, hi: float, rng: np.random.Generator) -> np.ndarray:
     """Goals at a uniform distance in [lo, hi] and a uniform direction from each row of ``xy``."""
     r = rng.uniform(lo, hi, size=len(xy))
@@ -282,7 +248,7 @@ class GoalReachEnv(EnvBase):
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
         self.sim = BatchedSim(agent, None, n, nthread=nthread)
-        self.task = task or REACH_TASKS[agent]
+        self.task = task or get_agent(agent).reach_task
         self.rng = np.random.default_rng(seed)
         self.goals = np.zeros((n, 2))
         self.dist = np.zeros(n)

@@ -1,10 +1,15 @@
-"""Experiment sweeps: a grid of (maze x method x proposer x seed) runs -> one tidy CSV table.
+"""Experiment sweeps: a grid of (maze [x spec] x method x proposer x seed) runs -> one tidy CSV table.
 
 Each cell is one ``refine_maze`` run (the CLI's code path) in its own output directory
 ``OUT/cells/<cell id>/``; its row is appended to ``OUT/results.csv`` as soon as it
 finishes.  Rerunning a sweep skips cells that already have a row with status ``ok``
 (resume after a kill), retries failed ones, and keeps each cell's evaluation cache, so
 an interrupted cell restarts from what it had evaluated.
+
+A cell's ``spec`` (``--specs``, or ``MAZE=SPEC`` in ``--mazes``) is the task as a spec expression
+(``specrefine refine --spec``); empty = the maze's own task.  It is part of the cell id only when
+given, so the ids of default-task cells (and the rows of older tables, which lack the ``spec``
+column) stay valid; rows are appended in the columns of the table they go into.
 
 Backends: ``local`` (a process pool sized to the machine) and ``ray`` (the same cells as
 Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).
@@ -14,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import os
+import sys
 import time
 import traceback
 from collections.abc import Iterable
@@ -23,11 +29,14 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from .agents import AGENTS
+
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
-    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "proposer_calls",
+    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
+    "proposer_calls",
 ]
 
 
@@ -40,25 +49,49 @@ class Cell:
     seed: int
     rollouts: int = 32
     episodes: int = 200
+    spec: str = ""  # the task as a spec expression; "" = the maze's own task
 
     @property
     def id(self) -> str:
         prop = self.proposer.replace(":", "-").replace("/", "-")
-        return f"{self.maze}__{self.agent}__{self.method}__{prop}__s{self.seed}"
+        task = f"{self.maze}__{spec_slug(self.spec)}" if self.spec else self.maze
+        return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}"
+
+
+def spec_slug(spec: str) -> str:
+    """A spec expression as a file-name-safe id part: '(a | b) -> G' -> 'Pa-or-bQ-then-G'."""
+    text = "".join(spec.split())
+    for old, new in (("->", "-then-"), ("|", "-or-"), ("(", "P"), (")", "Q")):
+        text = text.replace(old, new)
+    return text
+
+
+def split_maze_arg(arg: str) -> tuple[str, str]:
+    """'MAZE' -> (MAZE, ''); 'MAZE=SPEC' -> (MAZE, SPEC): a per-maze spec on the command line."""
+    maze, _, spec = arg.partition("=")
+    return maze, spec.strip()
 
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
-         agent: str = "point", rollouts: int = 32, episodes: int = 200) -> list[Cell]:
-    """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer."""
+         agent: str = "point", rollouts: int = 32, episodes: int = 200,
+         specs: Iterable[str | None] = (None,)) -> list[Cell]:
+    """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
+
+    ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
+    ``MAZE=SPEC`` runs that spec only.
+    """
     from .pipeline import PROPOSER_METHODS
 
     cells = []
-    for maze in mazes:
-        for method in methods:
-            props = list(proposers) if method in PROPOSER_METHODS else ["none"]
-            for proposer in props:
-                for seed in seeds:
-                    cells.append(Cell(Path(maze).stem, agent, method, proposer, int(seed), rollouts, episodes))
+    for arg in mazes:
+        maze, own = split_maze_arg(str(arg))
+        for spec in [own] if own else [s or "" for s in specs]:
+            for method in methods:
+                props = list(proposers) if method in PROPOSER_METHODS else ["none"]
+                for proposer in props:
+                    for seed in seeds:
+                        cells.append(Cell(Path(maze).stem, agent, method, proposer, int(seed), rollouts, episodes,
+                                          spec))
     return cells
 
 
@@ -70,7 +103,8 @@ def run_cell(cell: Cell, out_root: str) -> dict:
     try:
         result = refine_maze(cell.maze, agent=cell.agent, method=cell.method,
                              proposer="geometric" if cell.proposer == "none" else cell.proposer, seed=cell.seed,
-                             out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes)
+                             out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes,
+                             spec=cell.spec or None)
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
@@ -110,12 +144,18 @@ def _typed(row: dict) -> dict:
 
 
 def _append(path: Path, row: dict) -> None:
-    new = not path.exists()
+    new = not path.exists() or path.stat().st_size == 0
+    columns = COLUMNS
+    if not new:  # an older table (without the later columns, e.g. spec) keeps its own header
+        with path.open(newline="") as fh:
+            columns = next(csv.reader(fh), None) or COLUMNS
+        if row.get("spec") and "spec" not in columns:
+            raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
     with path.open("a", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
-        writer.writerow({k: row.get(k, "") for k in COLUMNS})
+        writer.writerow({k: row.get(k, "") for k in columns})
         fh.flush()
         os.fsync(fh.fileno())
 
@@ -179,6 +219,8 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
         if r.get("status") == "ok":
+            if r.get("spec") and "maze" in by:  # a task other than the maze's own is its own group
+                r = {**r, "maze": f"{r['maze']} [{r['spec']}]"}
             groups.setdefault(tuple(r[k] for k in by), []).append(r)
     out = []
     for key, rs in sorted(groups.items()):
@@ -190,17 +232,35 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
     return out
 
 
+def _check_specs(cells: list[Cell]) -> str | None:
+    """The first bad (maze, spec) pair's one-line message, before any cell runs (None: all fine)."""
+    from .errors import SpecrefineError
+    from .mazes import load_maze
+    from .spec import maze_task
+
+    for maze, spec in sorted({(c.maze, c.spec) for c in cells if c.spec}):
+        try:
+            maze_task(load_maze(maze), spec)
+        except SpecrefineError as exc:
+            return f"{maze}: {exc}"
+    return None
+
+
 def main(argv=None) -> int:
     import argparse
 
     from .mazes import benchmark_mazes
 
     p = argparse.ArgumentParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
-    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()), help="maze names or files")
+    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
+                   help="maze names or files; MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
+    p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
+                   help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
+                        "'' = the maze's own task; default: the maze's own task)")
     p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
     p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
     p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
-    p.add_argument("--agent", default="point", choices=["point", "ant"])
+    p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=int, default=32)
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--out", default="runs/sweep")
@@ -209,7 +269,11 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
-                 episodes=args.episodes)
+                 episodes=args.episodes, specs=args.specs)
+    bad = _check_specs(cells)
+    if bad:
+        print(f"python -m specrefine.sweep: error: {bad}", file=sys.stderr)
+        return 2
     t0 = time.time()
     table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
     rows = read_table(table)

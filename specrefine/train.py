@@ -1,4 +1,6 @@
-"""Goal-conditioned PPO (TorchRL building blocks), CleanRL-style: one file, one config dataclass.
+"""Goal-conditioned PPO (TorchRL building blocks), CleanRL-style: one file, one config dataclass whose
+documented fields are the command line; PPO diagnostics (approximate KL, clip fraction, entropy, value loss,
+explained variance) go into the curves.
 
     python -m specrefine.train --agent point --frames 400000 --out runs/point
     python -m specrefine.train --agent ant --frames 10000000 --out runs/ant_train --resume
@@ -14,10 +16,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,51 +27,79 @@ from tensordict.nn import TensorDictModule
 from torch import nn
 from tqdm.auto import tqdm
 
+from .agents import AGENTS, get_agent
 from .errors import SpecrefineError
 from .policy import GoalPolicy, load_policy, mlp, save_policy
-from .sim import REACH_TASKS, BatchedSim, GoalReachEnv, sample_goals
+from .results import wilson_ci
+from .sim import BatchedSim, GoalReachEnv, sample_goals
+
+
+def knob(default, help: str):
+    """A documented config field: its ``help`` becomes the command line's (``python -m specrefine.train -h``)."""
+    return field(default=default, metadata={"help": help})
 
 
 @dataclass
 class Config:
-    agent: str = "point"
-    frames: int = 300_000
-    seed: int = 0
-    num_envs: int = 64
-    steps_per_env: int = 32          # frames per batch = num_envs * steps_per_env
-    epochs: int = 4
-    minibatch: int = 1024            # large minibatches: the update is cheap per frame
-    lr: float = 3e-4
-    anneal_lr: bool = True
-    gamma: float = 0.99
-    gae_lambda: float = 0.95
-    clip_epsilon: float = 0.2
-    entropy_coef: float = 0.0
-    critic_coef: float = 0.5
-    max_grad_norm: float = 0.5
-    torch_threads: int = 1
-    sim_threads: int = 2
-    checkpoint_every_s: float = 120.0
-    goals_per_episode: int = 1       # > 1: chained goals without a reset (see GoalReachEnv)
-    init: str | None = None          # fine-tune: actor + critic weights from this trainer checkpoint.pt
-    tilt_cost: float | None = None   # None: the agent's ReachTask value
-    flip_penalty: float | None = None
+    """Every training knob; each field is also a ``--field-name`` option (default: the agent's entry)."""
+
+    agent: str = knob("point", "a registered agent (specrefine.agents)")
+    frames: int = knob(300_000, "total environment frames")
+    seed: int = knob(0, "seed of torch and the goal sampler")
+    num_envs: int = knob(64, "environments stepped together")
+    steps_per_env: int = knob(32, "steps per environment per batch (frames per batch = num_envs x steps_per_env)")
+    epochs: int = knob(4, "PPO epochs per batch")
+    minibatch: int = knob(1024, "PPO minibatch size (large: the update is cheap per frame)")
+    lr: float = knob(3e-4, "Adam learning rate")
+    anneal_lr: bool = knob(True, "anneal the learning rate linearly to 5%% of lr")
+    gamma: float = knob(0.99, "discount")
+    gae_lambda: float = knob(0.95, "GAE lambda")
+    clip_epsilon: float = knob(0.2, "PPO clip range")
+    entropy_coef: float = knob(0.0, "entropy bonus coefficient")
+    critic_coef: float = knob(0.5, "value loss coefficient")
+    max_grad_norm: float = knob(0.5, "gradient norm clip")
+    torch_threads: int = knob(1, "torch threads")
+    sim_threads: int = knob(2, "mujoco.rollout threads")
+    checkpoint_every_s: float = knob(120.0, "seconds between checkpoints")
+    goals_per_episode: int = knob(1, "> 1: chain this many goals per episode, each drawn where the last was reached")
+    init: str | None = knob(None, "fine-tune: actor + critic weights from this trainer checkpoint.pt")
+    tilt_cost: float | None = knob(None, "reward -= this x (1 - torso up z) per step (default: the agent's task)")
+    flip_penalty: float | None = knob(None, "reward -= this on flipping (default: the agent's task)")
 
     @property
     def frames_per_batch(self) -> int:
         return self.num_envs * self.steps_per_env
 
 
-AGENT_DEFAULTS = {
-    "point": dict(frames=200_000, num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
-    "ant": dict(frames=10_000_000, num_envs=64, steps_per_env=64, epochs=5, minibatch=2048),
-}
+#: logged per batch (mean over minibatches): log key -> ClipPPOLoss output
+PPO_DIAGNOSTICS = {"approx_kl": "kl_approx", "clip_fraction": "clip_fraction", "entropy": "entropy",
+                   "value_loss": "loss_critic"}
+
+
+def explained_variance(target: torch.Tensor, value: torch.Tensor) -> float:
+    """1 - Var(target - value) / Var(target): 1 for a perfect critic, <= 0 for a useless one (nan if Var = 0)."""
+    target, value = target.detach().reshape(-1).double(), value.detach().reshape(-1).double()
+    var = target.var()
+    return float(1.0 - (target - value).var() / var) if var > 0 else float("nan")
+
+
+def config_arguments(parser: argparse.ArgumentParser) -> None:
+    """One ``--field-name`` option per :class:`Config` field (except ``agent``), default None = the agent's."""
+    types = {"int": int, "float": float, "str | None": str, "float | None": float, "int | None": int}
+    for f in fields(Config):
+        if f.name == "agent":
+            continue
+        flag = "--" + f.name.replace("_", "-")
+        help_text = f"{f.metadata['help']} (default: {f.default})"
+        if f.type == "bool":
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=None, help=help_text)
+        else:
+            parser.add_argument(flag, type=types[f.type], default=None, help=help_text)
 
 
 def make_config(agent: str, **overrides) -> Config:
-    if agent not in AGENT_DEFAULTS:
-        raise SpecrefineError(f"unknown agent {agent!r}; expected point or ant")
-    return replace(Config(agent=agent), **{**AGENT_DEFAULTS[agent], **overrides})
+    """The agent's training defaults (``specrefine.agents``) with ``overrides`` on top."""
+    return replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
 
 
 # --- networks ---------------------------------------------------------------------------------
@@ -98,7 +127,7 @@ class Trainer:
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         optional = {k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None}
-        task = replace(REACH_TASKS[cfg.agent], goals_per_episode=cfg.goals_per_episode, **optional)
+        task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
         self.actor, self.critic = make_modules(self.policy, self.env)
@@ -153,7 +182,7 @@ class Trainer:
         with torch.no_grad():
             self.gae(batch)
         flat = batch.reshape(-1)
-        stats = []
+        stats: dict[str, list[float]] = {key: [] for key in ("loss", *PPO_DIAGNOSTICS)}
         for _ in range(cfg.epochs):
             for idx in torch.randperm(flat.shape[0]).split(cfg.minibatch):
                 losses = self.loss(flat[idx])
@@ -162,9 +191,13 @@ class Trainer:
                 total.backward()
                 nn.utils.clip_grad_norm_(self.loss.parameters(), cfg.max_grad_norm)
                 self.optim.step()
-                stats.append(total.item())
+                stats["loss"].append(total.item())
+                for key, name in PPO_DIAGNOSTICS.items():
+                    if name in losses.keys():
+                        stats[key].append(float(losses[name].detach().float().mean()))
         self.policy.norm.update(batch["observation"])  # after the update: stored log-probs stay valid
-        return {"loss": float(np.mean(stats))}
+        out = {key: float(np.mean(v)) for key, v in stats.items() if v}
+        return out | {"explained_variance": explained_variance(flat["value_target"], flat["state_value"])}
 
     def episode_stats(self, batch) -> dict:
         nxt = batch["next"]
@@ -221,19 +254,9 @@ def train(agent: str, frames: int, out, resume: bool = False, progress: bool = T
 
 
 # --- evaluation ---------------------------------------------------------------------------------
-def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return (0.0, 1.0)
-    p = successes / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (max(0.0, c - h), min(1.0, c + h))
-
-
 def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
     """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
-    task = REACH_TASKS[policy.agent]
+    task = get_agent(policy.agent).reach_task
     lo = task.goal_min if lo is None else lo
     hi = task.goal_max if hi is None else hi
     rng = np.random.default_rng(seed)
@@ -267,8 +290,9 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
     sim.close()
     k = int(success.sum())
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goal_range_m": [lo, hi], "horizon": horizon,
-            "success_radius_m": task.success_radius, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
-            "flip_rate": float(flipped.mean()), "mean_steps_success": float(steps[success].mean()) if k else None,
+            "success_radius_m": task.success_radius, "success_rate": k / episodes,
+            "success_ci95": wilson_ci(k, episodes), "flip_rate": float(flipped.mean()),
+            "mean_steps_success": float(steps[success].mean()) if k else None,
             "distance": dist0, "success": success, "flipped": flipped, "steps": steps, "trajectories": traj,
             "goals": goals}
 
@@ -303,7 +327,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     sim.close()
     k = int(reached[-1])
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
-            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson(k, episodes),
+            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
             "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
             "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
 
@@ -316,7 +340,7 @@ def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
         m = (result["distance"] >= a) & (result["distance"] < b if b < hi else result["distance"] <= b)
         k, n = int(result["success"][m].sum()), int(m.sum())
         rows.append({"from_m": round(float(a), 3), "to_m": round(float(b), 3), "n": n,
-                     "success_rate": k / n if n else None, "ci95": wilson(k, n)})
+                     "success_rate": k / n if n else None, "ci95": wilson_ci(k, n)})
     return rows
 
 
@@ -334,7 +358,7 @@ def read_log(path) -> list[dict]:
 
 def plot_curve(log_path, png_path=None, window: int = 10):
     """Success rate, return and frames/s against frames; saved to ``png_path`` when given."""
-    from matplotlib.figure import Figure  # not pyplot: no global state, no double display in notebooks
+    from .render import PngFigure as Figure  # not pyplot: no global state; shows as a PNG in notebooks
 
     rows = read_log(log_path)
     fig = Figure(figsize=(13, 3.4))
@@ -356,7 +380,7 @@ def plot_curve(log_path, png_path=None, window: int = 10):
 
 
 def plot_success_by_distance(result: dict, bins: int = 8):
-    from matplotlib.figure import Figure
+    from .render import PngFigure as Figure
 
     rows = success_by_distance(result, bins)
     mid = [(r["from_m"] + r["to_m"]) / 2 for r in rows]
@@ -374,7 +398,7 @@ def plot_success_by_distance(result: dict, bins: int = 8):
 
 def plot_rollouts(result: dict, n: int = 24):
     """Open-floor trajectories of ``evaluate_reach``: green success, red failure, x = goal."""
-    from matplotlib.figure import Figure
+    from .render import PngFigure as Figure
 
     fig = Figure(figsize=(5, 5))
     ax = fig.subplots()
@@ -394,11 +418,9 @@ def plot_rollouts(result: dict, n: int = 24):
 # --- command line -----------------------------------------------------------------------------
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m specrefine.train", description=__doc__.splitlines()[0])
-    ap.add_argument("--agent", choices=["point", "ant"], required=True)
-    ap.add_argument("--frames", type=int, default=None, help="total frames (default: the config's)")
+    ap.add_argument("--agent", choices=list(AGENTS), required=True)
     ap.add_argument("--out", default=None, help="run directory (checkpoint, log, curve)")
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
-    ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--evaluate", metavar="POLICY", help="only evaluate POLICY ('point', 'ant' or a path)")
     ap.add_argument("--episodes", type=int, default=500)
     ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
@@ -406,31 +428,26 @@ def main(argv=None) -> int:
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--chain", type=int, default=None, metavar="K",
                     help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain)")
-    ap.add_argument("--goals-per-episode", type=int, default=1,
-                    help="chain this many goals per episode, each drawn where the last was reached (no reset)")
-    ap.add_argument("--init", metavar="CHECKPOINT", help="fine-tune from another run's OUT/checkpoint.pt")
-    ap.add_argument("--lr", type=float, default=None, help="learning rate (default: the config's)")
-    ap.add_argument("--tilt-cost", type=float, default=None, help="reward -= this x (1 - torso up z) per step")
-    ap.add_argument("--flip-penalty", type=float, default=None, help="reward -= this on flipping")
+    config_arguments(ap)
     args = ap.parse_args(argv)
+    seed = args.seed or 0
     try:
         if args.evaluate and args.chain:
             lo, hi = args.goal_range or (None, None)
-            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=args.seed)
+            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed)
             print(json.dumps(res))
             return 0
         if args.evaluate:
             lo, hi = args.goal_range or (None, None)
-            res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=args.seed)
+            res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=seed)
             print(json.dumps(summary(res)))
             if args.plot:
                 plot_success_by_distance(res).savefig(args.plot, dpi=90)
             return 0
         if not args.out:
             raise SpecrefineError("--out DIR is required for training")
-        overrides = {"seed": args.seed, "goals_per_episode": args.goals_per_episode, "init": args.init,
-                     "tilt_cost": args.tilt_cost, "flip_penalty": args.flip_penalty}
-        overrides |= ({"frames": args.frames} if args.frames else {}) | ({"lr": args.lr} if args.lr else {})
+        overrides = {f.name: getattr(args, f.name) for f in fields(Config)
+                     if f.name != "agent" and getattr(args, f.name) is not None}
         cfg = make_config(args.agent, **overrides)
         path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()
         print(f"policy written to {path}")

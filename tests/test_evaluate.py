@@ -6,20 +6,13 @@ import numpy as np
 import pytest
 
 from specrefine.errors import SpecrefineError
-from specrefine.evaluate import (
-    AVOID,
-    SUCCESS,
-    CompiledRegion,
-    Evaluator,
-    PointController,
-    StartStates,
-    path_legs,
-    satisfies,
-    wilson_ci,
-)
+from specrefine.evaluate import Evaluator, path_legs
 from specrefine.graph import TaskGraph
 from specrefine.mazes import load_maze
-from specrefine.regions import Box, Disc, union
+from specrefine.monitor import satisfies
+from specrefine.policy import PointController
+from specrefine.regions import Box, CompiledRegion, Disc, union
+from specrefine.results import AVOID, SUCCESS, StartStates, wilson_ci
 from specrefine.spec import maze_task
 
 # Floats computed through different batch shapes, thread counts or CPUs agree only to a tolerance
@@ -84,9 +77,9 @@ def test_wall_contact_ends_rollout_as_failure(maze):
     assert np.all(res.outcome == AVOID)
     assert np.all(res.lengths < 81)  # ended early, not by the horizon
     last = res.trajectories[np.arange(res.n), res.lengths - 1]
-    assert np.all(maze.walls.signed_distance(last) < ev.body_radius)
+    assert np.all(maze.walls.signed_distance(last) < ev.clearance)
     before = res.trajectories[np.arange(res.n), res.lengths - 2]
-    assert np.all(maze.walls.signed_distance(before) >= ev.body_radius)
+    assert np.all(maze.walls.signed_distance(before) >= ev.clearance)
     # frozen after the failure: the padded tail repeats the last point
     np.testing.assert_array_equal(res.trajectories[:, -1], last)
 
@@ -169,14 +162,14 @@ def test_run_path_and_monitor_agree(maze):
     graph = maze_task(maze)
     legs = [(maze.cell_box(3, 3), maze.walls, None), (maze.cell_box(1, 3), maze.walls, None),
             (maze.goal, maze.walls, None)]
-    res = ev.run_path(maze.start, legs, seed=3)
+    res = ev.run_compositional(maze.start, legs, seed=3)
     assert res.n == 24 and res.legs_done.max() <= 3
     assert res.successes > 0
-    ok = satisfies(graph, res.trajectories, res.lengths, ev.body_radius)
+    ok = satisfies(graph, res.trajectories, res.lengths, ev.clearance)
     np.testing.assert_array_equal(ok, res.success)  # reaching G without touching walls = the original task
     assert len(res.leg_success) == 3
     # the direct single edge with a straight-line controller runs into the wall
-    direct = ev.run_path(maze.start, path_legs(graph, ["S", "G"]), seed=3)
+    direct = ev.run_compositional(maze.start, path_legs(graph, ["S", "G"]), seed=3)
     assert direct.p < res.p
 
 
@@ -285,7 +278,7 @@ def test_compaction_of_finished_rollouts_changes_nothing_but_cost(maze):
 def test_ant_starts_clear_of_walls_by_its_legs_reach(maze):
     ant_maze = maze.for_agent("ant")
     ev = Evaluator(ant_maze, "ant", Constant([0.0] * 8), n=8)
-    assert ev.spawn_radius > 2 * ev.body_radius  # legs reach further than the torso
+    assert ev.spawn_radius > 2 * ev.clearance  # legs reach further than the torso
     walls = CompiledRegion(ant_maze.walls)
     rng = np.random.default_rng(0)
     start = maze_task(ant_maze).region("S")
@@ -295,12 +288,12 @@ def test_ant_starts_clear_of_walls_by_its_legs_reach(maze):
     x0, y0, x1, y1 = start.bounds()
     tight = Box(x0, y0 + 1.0, x0 + 0.9, y1 - 1.0)  # a strip along the wall: no room for the legs, fall back
     tight_pts = ev.spawn_points(tight, 50, rng)
-    assert len(tight_pts) == 50 and walls.signed_distance(tight_pts).min() >= ev.body_radius - 1e-9
+    assert len(tight_pts) == 50 and walls.signed_distance(tight_pts).min() >= ev.clearance - 1e-9
 
 
 def test_point_spawns_where_its_body_fits(maze):
     ev = Evaluator(maze, "point", Constant([0.0, 0.0]), n=8)
-    assert ev.spawn_radius == ev.body_radius
+    assert ev.spawn_radius == ev.clearance
 
 
 def test_evaluate_many_equals_one_evaluate_per_subtask(maze):

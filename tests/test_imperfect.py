@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from specrefine.errors import SpecrefineError
-from specrefine.imperfect import (
+from specrefine.mazes import load_maze, parse_maze
+from specrefine.proposers import CandidateFeedback, EdgeQuery, GraphQuery, make_proposer, parse_split
+from specrefine.proposers.imperfect import (
     PRESETS,
     ErrorModelClient,
     ImperfectConfig,
@@ -19,10 +21,7 @@ from specrefine.imperfect import (
     convex_corners,
     parse_imperfect,
 )
-from specrefine.mazes import load_maze, parse_maze
-from specrefine.proposers import CandidateFeedback, EdgeQuery, GraphQuery, make_proposer
 from specrefine.spec import maze_task
-from specrefine.vlm import parse_split
 
 N = 200  # replies per measurement
 

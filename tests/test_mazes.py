@@ -25,6 +25,15 @@ def test_benchmark_suite_is_complete():
     assert all(p.parent == MAZE_DIR and p.suffix == ".maze" for p in BENCHMARK.values())
 
 
+def test_off_suite_mazes_load_and_stay_out_of_the_suite():
+    unseen = sorted((MAZE_DIR / "unseen").glob("*.maze"))
+    assert {p.stem for p in unseen} == {"zigzag", "pillars", "detour_subgoal", "spiral"}
+    assert not {p.stem for p in unseen} & set(BENCHMARK)  # benchmark_mazes() does not descend into subfolders
+    for p in unseen:
+        maze = load_maze(p)
+        assert maze.name == p.stem and maze.for_agent("point").cell_size == 1.0
+
+
 @pytest.mark.parametrize("name", sorted(BENCHMARK))
 def test_every_shipped_maze_parses(name):
     maze = load_maze(BENCHMARK[name])

@@ -1,47 +1,53 @@
-"""Run every numbered notebook through papermill with its smoke parameters.
+"""Run every numbered notebook through papermill and check the key figures it records.
 
-Each ``notebooks/NN_*.ipynb`` is one test (select them with ``-m notebooks``, skip them with
-``-m "not notebooks"``).  A notebook's own ``parameters`` cell IS its smoke set; the optional
-``notebooks/smoke.json`` overrides it::
+Two tiers of parameters:
 
-    {"05_astar_refinement": {"ROLLOUTS": 4, "timeout_s": 600}}
+* **smoke** (default suite, marker ``notebooks``): each notebook's own ``parameters`` cell, with
+  optional overrides from ``notebooks/smoke.json``;
+* **full** (marker ``notebooks_full``, skipped unless selected: ``make notebooks-full`` or
+  ``pytest -m notebooks_full``): the overrides in ``notebooks/full.json``.
 
-Keys are notebook file names or stems.  UPPERCASE keys are parameters (each must exist in the
-notebook's ``parameters`` cell); lowercase keys are harness settings: ``timeout_s`` (whole
-notebook, default ``DEFAULT_TIMEOUT_S``).  The notebook runs in a subprocess (so the timeout is
-hard) with cwd ``notebooks/``, on a kernel named ``python3`` that is this interpreter, with
-``MPLBACKEND=Agg``; the executed copy is written to a temporary directory and its path is in the
-failure message.
+Keys of those files are notebook file names or stems (``_``-keys are comments). UPPERCASE keys are
+parameters (each must exist in the notebook's ``parameters`` cell); lowercase keys are harness
+settings: ``timeout_s`` (whole notebook, default 300 s) and ``note``. ``OUT_DIR`` is always set to a
+fresh temporary directory, so no evaluation cache from an earlier run changes the counts. The
+notebook runs in a subprocess (so the timeout is hard) with cwd ``notebooks/``, on a kernel named
+``python3`` that is this interpreter (PYTHONPATH passes through; the test checks that the kernel
+imported THIS checkout's ``specrefine``), with ``MPLBACKEND=Agg``.
+
+**Values under regression.** The last cell of every notebook calls ``specrefine.record(name,
+value, tol=..., rel=...)`` for its key figures (success probabilities, predicted and measured
+success, evaluation counts, the chosen path). ``test_notebook_values_*`` reads them back from the
+executed notebook of the run test (each notebook runs once per tier) and compares them with
+``tests/notebook_expected/<tier>.json``: discrete values (paths, counts, names) exactly, floats
+within the tolerance stored with them (one rollout or episode out of n: how far a figure may move at
+the same seed on another x86-64 CPU). The failure message names the notebook and the figure.
+
+**Regenerating the expected values is a decision, not a fix.** When a test here fails, first find out
+why the figure moved. Only when the new behaviour is intended, regenerate and commit the diff with
+the reason::
+
+    make notebook-expected         # smoke tier: pytest -m notebooks --update-notebook-expected
+    make notebook-expected-full    # full tier
+
+The tolerances written are the ones the notebook's ``record`` calls state.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import signal
-import subprocess
-import sys
 from pathlib import Path
 
 import nbformat
 import pytest
 
-NB_DIR = Path(__file__).resolve().parent.parent / "notebooks"
-NOTEBOOKS = sorted(NB_DIR.glob("[0-9][0-9]_*.ipynb"))
-SMOKE_FILE = NB_DIR / "smoke.json"
-DEFAULT_TIMEOUT_S = 300
-HARNESS_KEYS = {"timeout_s"}
+from specrefine.notebook import DEFAULT_TIMEOUT_S, TIERS, compare, execute, kernel_env, read_records, tier_settings
 
-
-def _smoke_settings(nb: Path) -> tuple[dict, dict]:
-    """(parameter overrides, harness settings) for one notebook from notebooks/smoke.json."""
-    table = json.loads(SMOKE_FILE.read_text()) if SMOKE_FILE.exists() else {}
-    entry = {**table.get(nb.stem, {}), **table.get(nb.name, {})}
-    params = {k: v for k, v in entry.items() if k.isupper()}
-    harness = {k: v for k, v in entry.items() if not k.isupper()}
-    unknown = set(harness) - HARNESS_KEYS
-    assert not unknown, f"{SMOKE_FILE.name}: unknown settings {sorted(unknown)} for {nb.name}"
-    return params, harness
+REPO = Path(__file__).resolve().parent.parent  # the checkout under test (its kernel must import this one)
+NOTEBOOKS = sorted((REPO / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+EXPECTED_DIR = Path(__file__).resolve().parent / "notebook_expected"
+IDS = [nb.stem for nb in NOTEBOOKS]
+_EXECUTED: dict[tuple[str, str], tuple[Path | None, str]] = {}  # (tier, stem) -> (executed copy or None, failure)
 
 
 def _parameters_cells(nb: Path):
@@ -57,17 +63,63 @@ def _parameter_names(nb: Path) -> set[str]:
 @pytest.fixture(scope="session")
 def venv_kernel_env(tmp_path_factory) -> dict:
     """Environment whose kernel 'python3' is this interpreter (the venv), whatever else is installed."""
-    root = tmp_path_factory.mktemp("jupyter")
-    spec_dir = root / "kernels" / "python3"
-    spec_dir.mkdir(parents=True)
-    spec = {"argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-            "display_name": "Python 3 (specrefine venv)", "language": "python"}
-    (spec_dir / "kernel.json").write_text(json.dumps(spec))
-    env = dict(os.environ)
-    env["JUPYTER_PATH"] = os.pathsep.join([str(root), *filter(None, [env.get("JUPYTER_PATH")])])
-    env["MPLBACKEND"] = "Agg"
-    env["PYDEVD_DISABLE_FILE_VALIDATION"] = "1"
-    return env
+    return kernel_env(tmp_path_factory.mktemp("jupyter"))
+
+
+def _run(nb: Path, tier: str, tmp_root: Path, env: dict) -> Path:
+    """Execute ``nb`` with ``tier``'s parameters once per session; the executed copy (or pytest.fail)."""
+    key = (tier, nb.stem)
+    if key not in _EXECUTED:
+        params, harness = tier_settings(nb, tier)
+        work = tmp_root / f"{tier}_{nb.stem}"
+        work.mkdir(parents=True, exist_ok=True)
+        if "OUT_DIR" in _parameter_names(nb):
+            params = {**params, "OUT_DIR": str(work / "out")}
+        timeout = int(harness.get("timeout_s", DEFAULT_TIMEOUT_S))
+        out = work / nb.name
+        code, log = execute(nb, out, params, env=env, timeout=timeout)
+        failure = ""
+        if code is None:
+            failure = f"{nb.name} did not finish within {timeout} s ({tier} parameters {params}); " \
+                      f"partial output in {out}\n{log[-4000:]}"
+        elif code != 0:
+            failure = f"{nb.name} failed ({tier} parameters {params}); executed copy in {out}\n{log[-6000:]}"
+        else:
+            executed = nbformat.read(out, as_version=4)
+            errors = [o for c in executed.cells if c.cell_type == "code" for o in c.get("outputs", [])
+                      if o.get("output_type") == "error"]
+            ran = [c for c in executed.cells if c.cell_type == "code" and c.source.strip()]
+            if errors:
+                failure = f"{nb.name}: error outputs in {out}"
+            elif not all(c.get("execution_count") for c in ran):
+                failure = f"{nb.name}: some code cells did not run ({out})"
+        _EXECUTED[key] = (out, failure)
+    out, failure = _EXECUTED[key]
+    if failure:
+        pytest.fail(failure, pytrace=False)
+    return out
+
+
+def _check_values(nb: Path, tier: str, executed: Path, update: bool):
+    recorded = read_records(executed)
+    assert recorded, f"{nb.name}: no figures recorded (its last cell should call specrefine.record)"
+    packages = {r["package"] for r in recorded.values()}
+    assert packages == {str(REPO / "specrefine")}, \
+        f"{nb.name}: the kernel imported specrefine from {packages}, not from this checkout {REPO}"
+    path = EXPECTED_DIR / f"{tier}.json"
+    table = json.loads(path.read_text()) if path.exists() else {}
+    if update:
+        table[nb.stem] = {name: {k: v for k, v in r.items() if k != "package" and v is not None}
+                          for name, r in recorded.items()}
+        EXPECTED_DIR.mkdir(exist_ok=True)
+        path.write_text(json.dumps(dict(sorted(table.items())), indent=1) + "\n")
+        return
+    assert nb.stem in table, f"{nb.name}: no expected {tier} values in {path.relative_to(REPO)}; " \
+                             f"regenerate deliberately with `make notebook-expected{'-full' * (tier == 'full')}`"
+    problems = compare(recorded, table[nb.stem])
+    assert not problems, (f"{nb.name} ({tier} parameters) moved from {path.relative_to(REPO)}:\n  "
+                          + "\n  ".join(problems) + f"\nexecuted copy: {executed}\n(see this file's docstring "
+                          "before regenerating: that is a decision, not a fix)")
 
 
 def test_notebooks_are_found():
@@ -77,7 +129,7 @@ def test_notebooks_are_found():
         assert expected in names
 
 
-@pytest.mark.parametrize("nb", NOTEBOOKS, ids=[nb.stem for nb in NOTEBOOKS])
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
 def test_notebook_has_uppercase_parameters(nb):
     cells = _parameters_cells(nb)
     assert len(cells) == 1, f"{nb.name}: needs exactly one cell tagged 'parameters', found {len(cells)}"
@@ -85,34 +137,33 @@ def test_notebook_has_uppercase_parameters(nb):
     assert names, f"{nb.name}: the parameters cell defines nothing"
     lower = sorted(n for n in names if not n.isupper())
     assert not lower, f"{nb.name}: parameters must be UPPERCASE names, got {lower}"
-    overrides, _ = _smoke_settings(nb)
-    assert set(overrides) <= names, f"{SMOKE_FILE.name}: {sorted(set(overrides) - names)} not parameters of {nb.name}"
+    for tier, file in TIERS.items():
+        overrides, _ = tier_settings(nb, tier)
+        assert set(overrides) <= names, f"{file}: {sorted(set(overrides) - names)} not parameters of {nb.name}"
+
+
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
+def test_notebook_committed_without_outputs(nb):
+    cells = nbformat.read(nb, as_version=4).cells
+    dirty = [i for i, c in enumerate(cells) if c.cell_type == "code" and (c.outputs or c.execution_count)]
+    assert not dirty, f"{nb.name}: cells {dirty} carry outputs; executed copies belong in notebooks/executed/"
 
 
 @pytest.mark.notebooks
-@pytest.mark.parametrize("nb", NOTEBOOKS, ids=[nb.stem for nb in NOTEBOOKS])
-def test_notebook_runs_with_smoke_parameters(nb, tmp_path, venv_kernel_env):
-    params, harness = _smoke_settings(nb)
-    timeout = int(harness.get("timeout_s", DEFAULT_TIMEOUT_S))
-    out = tmp_path / nb.name
-    params_file = tmp_path / "params.json"  # JSON is YAML
-    params_file.write_text(json.dumps(params))
-    cmd = [sys.executable, "-m", "papermill", str(nb), str(out), "-f", str(params_file), "-k", "python3",
-           "--cwd", str(NB_DIR), "--no-progress-bar", "--execution-timeout", str(timeout),
-           "--start-timeout", "120"]
-    proc = subprocess.Popen(cmd, env=venv_kernel_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            start_new_session=True)
-    try:
-        log, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)  # papermill and the kernel it started, nothing else
-        log, _ = proc.communicate()
-        pytest.fail(f"{nb.name} did not finish within {timeout} s (smoke parameters {params}); "
-                    f"partial output in {out}\n{log[-4000:]}")
-    assert proc.returncode == 0, f"{nb.name} failed (smoke parameters {params}); executed copy in {out}\n{log[-6000:]}"
-    executed = nbformat.read(out, as_version=4)
-    errors = [o for c in executed.cells if c.cell_type == "code" for o in c.get("outputs", [])
-              if o.get("output_type") == "error"]
-    assert not errors, f"{nb.name}: error outputs in {out}"
-    ran = [c for c in executed.cells if c.cell_type == "code" and c.source.strip()]
-    assert all(c.get("execution_count") for c in ran), f"{nb.name}: some code cells did not run"
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
+def test_notebook_runs_with_smoke_parameters(nb, tmp_path_factory, venv_kernel_env):
+    _run(nb, "smoke", tmp_path_factory.getbasetemp() / "notebooks", venv_kernel_env)
+
+
+@pytest.mark.notebooks
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
+def test_notebook_values_smoke(nb, tmp_path_factory, venv_kernel_env, request):
+    executed = _run(nb, "smoke", tmp_path_factory.getbasetemp() / "notebooks", venv_kernel_env)
+    _check_values(nb, "smoke", executed, request.config.getoption("--update-notebook-expected"))
+
+
+@pytest.mark.notebooks_full
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
+def test_notebook_values_full(nb, tmp_path_factory, venv_kernel_env, request):
+    executed = _run(nb, "full", tmp_path_factory.getbasetemp() / "notebooks", venv_kernel_env)
+    _check_values(nb, "full", executed, request.config.getoption("--update-notebook-expected"))

@@ -18,9 +18,9 @@ from specrefine.proposers import (
     segment_clear,
     split_messages,
 )
+from specrefine.proposers.schema import check_region
 from specrefine.regions import Disc
 from specrefine.spec import maze_task
-from specrefine.vlm import check_region
 
 MAZES = sorted(benchmark_mazes())
 W = 3
@@ -144,5 +144,5 @@ def test_split_prompt_without_pictures_still_builds():
     q = edge_queries(maze, "ant")[0]
     msgs = split_messages(q, [CandidateFeedback([Disc(0.0, 0.0, 1.6)], [0.5, 0.5], None)])
     text = "\n".join(p["text"] for p in msgs[1]["content"] if p["type"] == "text")
-    assert "cell size 4.0 m" in text and "Agent: ant" in text and "within 0.5 m" in text
+    assert "cell size 4.0 m" in text and "Agent: ant" in text and "within 0.52 m" in text
     assert "no picture available" in text and not any(p["type"] == "image_url" for p in msgs[1]["content"])

@@ -115,9 +115,9 @@ def test_torchrl_env_partial_reset_and_termination():
 def test_chained_goals_continue_without_reset_until_the_last():
     from dataclasses import replace
 
-    from specrefine.sim import REACH_TASKS
+    from specrefine.agents import AGENTS
 
-    env = GoalReachEnv("point", 2, seed=0, nthread=1, task=replace(REACH_TASKS["point"], goals_per_episode=2))
+    env = GoalReachEnv("point", 2, seed=0, nthread=1, task=replace(AGENTS["point"].reach_task, goals_per_episode=2))
     td = env.reset()
     td["action"] = torch.zeros(2, 2)
     env.goals[0] = env.sim.xy[0]  # goal 1 of 2 reached on the next step
@@ -159,11 +159,11 @@ def test_ant_spawned_at_its_footprint_radius_does_not_touch_a_wall():
 def test_tilt_cost_charges_an_ant_on_its_side():
     from dataclasses import replace
 
-    from specrefine.sim import REACH_TASKS
+    from specrefine.agents import AGENTS
 
     rewards = {}
     for tilt in (0.0, 0.5):
-        env = GoalReachEnv("ant", 2, seed=0, nthread=1, task=replace(REACH_TASKS["ant"], tilt_cost=tilt))
+        env = GoalReachEnv("ant", 2, seed=0, nthread=1, task=replace(AGENTS["ant"].reach_task, tilt_cost=tilt))
         td = env.reset()
         state = env.sim.get_state()
         state[1, 4:8] = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # 90 degrees about x: on its side

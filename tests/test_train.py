@@ -6,7 +6,7 @@ import torch
 
 from specrefine.errors import SpecrefineError
 from specrefine.policy import GoalPolicy, PolicyError, load_policy, save_policy
-from specrefine.train import Trainer, evaluate_reach, make_config, read_log
+from specrefine.train import Config, Trainer, evaluate_reach, main, make_config, read_log
 
 
 @pytest.fixture(scope="module")
@@ -26,6 +26,9 @@ def test_tiny_training_run_improves_success(tiny_run):
                                                                           trained["success_rate"])
     rows = read_log(out / "log.jsonl")
     assert rows[-1]["frames"] >= 61_440 and all(r["fps"] > 0 for r in rows)
+    for key in ("approx_kl", "clip_fraction", "entropy", "value_loss", "explained_variance"):  # PPO diagnostics
+        assert all(np.isfinite(r[key]) for r in rows), key
+    assert all(0.0 <= r["clip_fraction"] <= 1.0 and r["explained_variance"] <= 1.0 for r in rows)
     assert (out / "curve.png").stat().st_size > 1000 and (out / "checkpoint.pt").is_file()
 
 
@@ -107,3 +110,14 @@ def test_init_starts_from_another_runs_weights(tiny_run, tmp_path):
     (tmp_path / "junk.pt").write_bytes(b"not a checkpoint")
     with pytest.raises(SpecrefineError, match="--init .*junk.pt: not a trainer checkpoint"):
         Trainer(make_config("point", frames=2048, init=str(tmp_path / "junk.pt")), tmp_path / "ft2", progress=False)
+
+
+def test_every_config_field_is_a_documented_option(capsys):
+    from dataclasses import fields
+
+    with pytest.raises(SystemExit):
+        main(["--agent", "point", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for f in fields(Config):
+        if f.name != "agent":
+            assert "--" + f.name.replace("_", "-") in text and f.metadata["help"].split(" (")[0][:30] in text, f.name

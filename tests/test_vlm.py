@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.errors import SpecrefineError
+from specrefine.errors import ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
 from specrefine.graph import check_refines
 from specrefine.mazes import load_maze, parse_maze
 from specrefine.proposers import (
@@ -31,17 +31,10 @@ from specrefine.proposers import (
     make_proposer,
     split_messages,
 )
+from specrefine.proposers.schema import parse_graph
 from specrefine.regions import Disc
 from specrefine.spec import maze_task
-from specrefine.vlm import (
-    LiteLLMClient,
-    ReplayClient,
-    ReplayMiss,
-    VLMConfigError,
-    VLMUnavailable,
-    parse_graph,
-    request_hash,
-)
+from specrefine.vlm import LiteLLMClient, ReplayClient, request_hash
 
 KEY = "sk-test-DUMMY-5ecret-0123456789abcdef"
 MODEL = "openai/test-model"
@@ -173,7 +166,7 @@ def test_request_carries_image_prompt_and_key_header(srv, tmp_path, query):
     assert [i["image_url"]["url"] for i in images] == ["data:image/png;base64," + base64.b64encode(tiny_png()).decode()]
     text = user_text(body)
     for part in ("Maze 'split_doorway': 10 rows x 13 columns, cell size 1.0 m", "#SS...#####.#",  # environment
-                 "Agent: point", "within 0.1 m", "origin at the map centre",
+                 "Agent: point", "within 0.104 m", "origin at the map centre",  # clearance = 0.1 m + contact margin
                  "succeeded 10 times", "31.2%", "run 32 times",  # evaluation
                  '{"type": "box", "min": [1.5, -2.0], "max": [3.5, -1.0]}',  # goal region
                  "the maze walls", '"waypoints"', "at most 32"):  # avoid set, schema
@@ -369,7 +362,7 @@ def test_graph_reply_becomes_task_graph(maze):
     assert check_refines(g, original) == []  # this reply happens to be a true refinement
     bad = json.loads(graph_reply(maze))
     bad["edges"].append({"u": "G", "v": "S"})
-    from specrefine.vlm import ProposalRejected
+    from specrefine.errors import ProposalRejected
 
     with pytest.raises(ProposalRejected, match="cycle"):
         parse_graph(json.dumps(bad), maze, original)

@@ -1,4 +1,4 @@
-"""Shared pieces of the refinement algorithms: edge weights and path evaluation with start propagation."""
+"""Shared pieces of the refinement algorithms: edge weights and leg-by-leg estimates with start propagation."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from ..regions import Region
+from ..results import unreached
 
 
 class SubtaskEvaluator(Protocol):
@@ -34,17 +35,7 @@ def start_of(result):
     return result.end_states if result is not None and result.successes > 0 else None
 
 
-@dataclass(frozen=True)
-class _Unreached:
-    """Stands for a subtask that was never reached: probability 0."""
-
-    p: float = 0.0
-    successes: int = 0
-    end_states: object = None
-    ci: tuple = (0.0, 0.0)
-
-
-UNREACHED = _Unreached()
+UNREACHED = unreached()  # a subtask whose start nothing reached: p = 0, nothing simulated
 
 
 @dataclass
@@ -55,8 +46,12 @@ class Leg:
 
 
 @dataclass
-class PathEvaluation:
-    """A sequence of subtasks evaluated one after another (DiRL-style start propagation)."""
+class LegEstimates:
+    """Success estimates of a sequence of subtasks, evaluated one after another (DiRL-style start propagation).
+
+    Not a run of the compositional policy (that is ``Evaluator.run_compositional``): each leg is
+    estimated on its own ``n`` rollouts, started from the previous leg's successful end states.
+    """
 
     results: list = field(default_factory=list)
 
@@ -72,9 +67,9 @@ class PathEvaluation:
         return sum(weight(r.p, n) for r in self.results)
 
 
-def evaluate_path(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> PathEvaluation:
-    """Evaluate legs in order; a leg with no successes ends the evaluation (the rest has p = 0)."""
-    out = PathEvaluation()
+def estimate_legs(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> LegEstimates:
+    """Estimate legs in order; a leg with no successes ends the estimation (the rest has p = 0)."""
+    out = LegEstimates()
     for leg in legs:
         if start is None:
             result = UNREACHED
@@ -83,3 +78,6 @@ def evaluate_path(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> PathEv
         out.results.append(result)
         start = start_of(result)
     return out
+
+
+evaluate_path, PathEvaluation = estimate_legs, LegEstimates  # the former names (notebooks written against them)

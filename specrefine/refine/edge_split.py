@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..regions import Region
-from .common import Leg, SubtaskEvaluator, evaluate_path
+from .common import Leg, SubtaskEvaluator, estimate_legs
 from .vertex import refine_chain
 
 log = logging.getLogger(__name__)
@@ -65,7 +65,7 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
         for waypoints in (p for p in proposals if p):
             if round_ == 0:
                 legs = [Leg(x, avoid) for x in waypoints] + [Leg(goal, avoid, goal_point)]
-                path = evaluate_path(evaluator, start, legs)
+                path = estimate_legs(evaluator, start, legs)
                 outcome.evaluations += len(legs)
                 candidate = SplitCandidate(list(waypoints), path.results, round_)
             else:

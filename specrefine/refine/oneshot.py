@@ -34,7 +34,7 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
     base = shortest_path(original, evaluator, seed=seed)
     query = GraphQuery(maze=maze, agent=agent, graph=original, success=base.predicted_success, n=evaluator.n,
                        image_png=_picture(maze, evaluator, original, base), edge_success=_edge_success(base),
-                       body_radius=evaluator.body_radius)
+                       facts=evaluator.facts())
     log("input-evaluated", predicted_success=base.predicted_success, path=base.path)
     best, feedback = None, []
     for round_, graphs in enumerate(_rounds(proposer, query, w, rounds, feedback, evaluator, budget)):
@@ -84,7 +84,8 @@ def _picture(maze, evaluator, graph, result):
     from ..evaluate import path_legs
 
     n = min(evaluator.n, 32)
-    pr = evaluator.run_path(graph.region(graph.initial), path_legs(graph, result.path), n=n, seed=evaluator.seed)
+    legs = path_legs(graph, result.path)
+    pr = evaluator.run_compositional(graph.region(graph.initial), legs, n=n, seed=evaluator.seed)
     fig = render_task(maze, graph, trajectories=pr.trajectories, success=np.asarray(pr.success), lengths=pr.lengths,
                       path=result.path, title=f"predicted success {result.predicted_success:.0%}")
     return to_png(fig)

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..graph import TaskGraph, assert_refines
-from .common import Leg, SubtaskEvaluator, evaluate_path, start_of, weight
+from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .vertex import refine_chain
 
@@ -144,7 +144,7 @@ class RefinementSearch:
 
     def _evaluate(self, start, v: str, edge):
         g = self.graph
-        return evaluate_path(self.evaluator, start, [Leg(g.region(v), g.avoid(*edge), g.goal_point(v))]).results[0]
+        return estimate_legs(self.evaluator, start, [Leg(g.region(v), g.avoid(*edge), g.goal_point(v))]).results[0]
 
     def _refine(self) -> None:
         f = self.f
@@ -186,7 +186,7 @@ class RefinementSearch:
 
     def _vertex_eligible(self, v) -> bool:
         g = self.graph
-        if v in g.finals or v == g.initial or g.g.in_degree(v) != 1 or g.g.out_degree(v) != 1:
+        if v in g.finals or v == g.initial or g.in_degree(v) != 1 or g.out_degree(v) != 1:
             return False
         return g.successors(v)[0] not in self.f.closed
 
@@ -220,7 +220,7 @@ class RefinementSearch:
         avoids = [g.avoid(u, v), g.avoid(v, w)]
         choice = refine_chain(self.evaluator, f.arrivals[u], [g.region(v)], g.region(w), avoids, self.cfg.k,
                               self.rng, g.goal_point(w))
-        current = evaluate_path(self.evaluator, f.arrivals[u],
+        current = estimate_legs(self.evaluator, f.arrivals[u],
                                 [Leg(g.region(v), avoids[0], g.goal_point(v)), Leg(g.region(w), avoids[1],
                                                                                    g.goal_point(w))])
         n = self.evaluator.n
@@ -235,16 +235,11 @@ class RefinementSearch:
     def _apply(self, ref: Refinement) -> None:
         g = self.graph
         if ref.kind == "split":
-            avoid, parent = g.avoid(ref.u, ref.v), g.g.edges[ref.u, ref.v]["parent"]
-            g.g.remove_edge(ref.u, ref.v)
             self.results.pop((ref.u, ref.v), None)
-            chain = [ref.u] + [g.add_vertex(None, x, refines=None) for x in ref.data.waypoints] + [ref.v]
-            for a, b in zip(chain, chain[1:]):
-                g.add_edge(a, b, avoid, parent=parent)
-            self.results[(chain[0], chain[1])] = ref.data.results[0]
+            names = g.split_edge(ref.u, ref.v, ref.data.waypoints)
+            self.results[(ref.u, (names or [ref.v])[0])] = ref.data.results[0]
         else:
-            node = g.g.nodes[ref.v]
-            node["region"], node["point"] = ref.data.regions[0], None
+            g.narrow_vertex(ref.v, ref.data.regions[0])
             self.results[(ref.u, ref.v)] = ref.data.results[0]
         self.accepted += 1
         assert_refines(g, self.original)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..regions import Box, Disc, Region
-from .common import UNREACHED, Leg, SubtaskEvaluator, evaluate_all, evaluate_path, start_of
+from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, evaluate_all, start_of
 
 
 def sample_subsets(region: Region, k: int, rng: np.random.Generator, shrink=(0.3, 0.7)) -> list[Region]:
@@ -61,7 +61,7 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
     if len(avoids) != len(inner) + 1:
         raise ValueError("refine_chain needs one avoid set per subtask")
     options = [[region] + sample_subsets(region, k, rng) for region in inner]
-    unrefined = evaluate_path(evaluator, start, [Leg(x, a) for x, a in zip(inner, avoids)] + [Leg(goal, avoids[-1],
+    unrefined = estimate_legs(evaluator, start, [Leg(x, a) for x, a in zip(inner, avoids)] + [Leg(goal, avoids[-1],
                                                                                                  goal_point)])
     calls = len(avoids)
     if unrefined.p >= 1.0:  # the DP cannot beat a chain that never failed

@@ -4,7 +4,7 @@ It plans the route the ``geometric`` stand-in would (the turns of the shortest f
 corrupts it the way vision-language models get spatial plans wrong, and writes the answer as the
 JSON text a VLM would send. That text goes through the same parsing, validation, re-ask and
 validity checks as a real reply (it is answered by a :class:`~specrefine.vlm.VLMClient` inside a
-:class:`~specrefine.proposers.VLMProposer`), so a waypoint inside a wall is rejected exactly as a
+:class:`~specrefine.proposers.vlm.VLMProposer`), so a waypoint inside a wall is rejected exactly as a
 real one would be. Its random stream is its own (seeded from ``--seed``), separate from the
 evaluator's.
 
@@ -40,10 +40,12 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from .errors import SpecrefineError
-from .proposers import GeometricProposer, VLMProposer, reach_cells
-from .regions import Box, Disc
-from .vlm import VLMClient, region_json
+from ..errors import SpecrefineError
+from ..regions import Box, Disc
+from ..vlm import VLMClient
+from .geometric import GeometricProposer, reach_cells
+from .schema import region_json
+from .vlm import VLMProposer
 
 
 @dataclass(frozen=True)
@@ -344,7 +346,7 @@ def _near_line_cost(maze, a, b):
 
 def _falsely_opened(maze, a, b):
     """The maze with the thin wall cell nearest the straight line a-b opened (or the maze, if none)."""
-    from .mazes import Maze
+    from ..mazes import Maze
 
     thin = [(r, c) for r in range(1, maze.rows - 1) for c in range(1, maze.cols - 1)
             if maze.grid[r][c] == "#" and ((maze.is_free(r - 1, c) and maze.is_free(r + 1, c))

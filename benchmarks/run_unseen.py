@@ -1,0 +1,60 @@
+"""Run the off-suite mazes in data/mazes/unseen/ into a sweep-style table (data/results/unseen/).
+
+    .venv/bin/python benchmarks/run_unseen.py --out runs/unseen            # point, ours, geometric, seed 0
+    cp runs/unseen/results.csv data/results/unseen/
+
+Why not ``python -m specrefine.sweep --mazes data/mazes/unseen/*.maze``: the sweep keeps only a maze
+file's stem and loads that name from data/mazes/, so it cannot load files from a subfolder (a known
+bug, being fixed separately). This script runs the same cells one at a time with the full path and
+writes the same layout as the sweep: ``OUT/results.csv`` (columns ``specrefine.sweep.COLUMNS``, one
+row per run, built by ``specrefine.sweep.result_row``) and ``OUT/cells/<cell id>/`` (each run's
+``result.json``, pictures, step log, cache). Cells that already have an ``ok`` row are skipped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import asdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from specrefine.pipeline import refine_maze  # noqa: E402
+from specrefine.sweep import Cell, _append, pending, result_row  # noqa: E402
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--mazes", nargs="+", default=sorted(str(f) for f in (ROOT / "data/mazes/unseen").glob("*.maze")))
+    p.add_argument("--agent", default="point")
+    p.add_argument("--method", default="ours")
+    p.add_argument("--proposer", default="geometric")
+    p.add_argument("--seeds", nargs="+", type=int, default=[0])
+    p.add_argument("--rollouts", type=int, default=32)
+    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--out", default="runs/unseen")
+    args = p.parse_args(argv)
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    table = out / "results.csv"
+    files = {Path(m).stem: Path(m) for m in args.mazes}
+    cells = [Cell(name, args.agent, args.method, args.proposer, seed, args.rollouts, args.episodes)
+             for name in files for seed in args.seeds]
+    for cell in pending(cells, table):
+        result = refine_maze(files[cell.maze], agent=cell.agent, method=cell.method, proposer=cell.proposer,
+                             seed=cell.seed, out=out / "cells" / cell.id, rollouts=cell.rollouts,
+                             episodes=cell.episodes)
+        d = result.data
+        # the row as specrefine.sweep.run_cell builds it
+        _append(table, result_row(d, {**asdict(cell), "cell": cell.id}) | {"proposer_is_vlm": d["proposer_is_vlm"]})
+        lo, hi = d["success_ci"]
+        print(f"{cell.id}: {d['success_rate']:.3f} [{lo:.3f}, {hi:.3f}] over {d['episodes']} episodes, "
+              f"{d['evaluations']} evaluations, {d['wall_seconds']:.0f} s", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,255 @@
+"""One client for any vision-language model LiteLLM speaks.
+
+:class:`LiteLLMClient` calls ``litellm.completion`` for any model string (``gpt-4o``,
+``gemini/gemini-2.0-flash``, ``anthropic/claude-sonnet-4-5``, ``ollama/llava``, ...): images go as
+base64 PNG data URLs, ``w`` samples per query (``n`` where the provider has it, else ``w`` calls),
+JSON response format where supported, timeouts, and logged retries with back-off on rate limits,
+server errors and dropped connections.  Tokens and cost are counted per call (cost 0 for models
+LiteLLM has no price for).  Keys are read by LiteLLM from the environment only; nothing this
+module writes (recordings, logs, error messages) ever contains them.  Every real call is appended
+to a recording (:mod:`specrefine.vlm.recording`).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from ..errors import VLMConfigError, VLMError, VLMUnavailable
+from .messages import VLMClient, one_line, request_hash
+from .recording import RECORD_VERSION, Recorder, default_record_path
+
+log = logging.getLogger(__name__)
+
+
+_LOCAL_PROVIDERS = {"ollama", "ollama_chat", "vllm", "hosted_vllm", "lm_studio", "llamafile", "openai_like"}
+_KEY_VARS = {"openai": "OPENAI_API_KEY", "gemini": "GEMINI_API_KEY", "anthropic": "ANTHROPIC_API_KEY",
+             "ollama": "OLLAMA_API_BASE", "ollama_chat": "OLLAMA_API_BASE", "mistral": "MISTRAL_API_KEY",
+             "groq": "GROQ_API_KEY", "openrouter": "OPENROUTER_API_KEY", "azure": "AZURE_API_KEY",
+             "together_ai": "TOGETHERAI_API_KEY", "deepseek": "DEEPSEEK_API_KEY", "xai": "XAI_API_KEY"}
+_MODEL_HINT = "use a LiteLLM model string such as gpt-4o, gemini/gemini-2.0-flash, anthropic/claude-sonnet-4-5 " \
+              "or ollama/llava"
+
+
+def _litellm():
+    os.environ.setdefault("LITELLM_LOCAL_MODEL_COST_MAP", "True")  # never fetch the price list at import
+    import litellm
+
+    litellm.suppress_debug_info = True
+    return litellm
+
+
+def _priced(lt, model: str) -> bool:
+    try:
+        info = lt.get_model_info(model)
+    except Exception:  # noqa: BLE001 - unknown to LiteLLM
+        return False
+    return bool(info.get("input_cost_per_token") or info.get("output_cost_per_token"))
+
+
+def _safe_url(url: str | None) -> str | None:
+    """``url`` without any ``user:password@`` part or query string."""
+    if not url:
+        return url
+    url = re.sub(r"//[^/@]*@", "//", url)
+    return url.split("?", 1)[0]
+
+
+class LiteLLMClient(VLMClient):
+    """``litellm.completion`` for any model; see the module docstring."""
+
+    def __init__(self, model: str, *, record_path: str | Path | None = None, record: bool = True,
+                 api_base: str | None = None, timeout: float = 120.0, num_retries: int = 3,
+                 retry_wait: float = 2.0, json_mode: bool = True, temperature: float | None = None,
+                 max_tokens: int | None = None, check_env: bool = True):
+        super().__init__()
+        self.model = model
+        self.name = f"litellm:{model}"
+        self.api_base = api_base
+        self.timeout = float(timeout)
+        self.num_retries = int(num_retries)
+        self.retry_wait = float(retry_wait)
+        self.temperature, self.max_tokens = temperature, max_tokens
+        self.recorder = Recorder(record_path or default_record_path(model)) if record else None
+        lt = _litellm()
+        try:
+            _, self.provider, _, _ = lt.get_llm_provider(model, api_base=api_base)
+        except Exception:
+            raise VLMConfigError(f"unknown model litellm:{model}: LiteLLM cannot tell its provider; "
+                                 f"{_MODEL_HINT}") from None
+        self.key_var = _KEY_VARS.get(self.provider, f"{self.provider.upper()}_API_KEY")
+        if check_env:
+            self._check_env(lt)
+        try:
+            params = lt.get_supported_openai_params(model=model, custom_llm_provider=self.provider) or []
+        except Exception:
+            params = []
+        self._n_ok = "n" in params
+        self._json_ok = bool(json_mode) and "response_format" in params
+        local = self.provider in _LOCAL_PROVIDERS or bool(api_base and re.search(r"//(localhost|127\.|\[::1\])",
+                                                                                  api_base))
+        if local and not _priced(lt, model):  # a local model LiteLLM has no price for: register it as free
+            try:
+                lt.register_model({model: {"input_cost_per_token": 0.0, "output_cost_per_token": 0.0,
+                                           "litellm_provider": self.provider, "mode": "chat"}})
+            except Exception:  # pragma: no cover - registration is a nicety
+                pass
+        self._unpriced_warned = False
+
+    def _check_env(self, lt) -> None:
+        try:
+            env = lt.validate_environment(model=self.model, api_base=self.api_base)
+        except TypeError:  # older signature
+            env = lt.validate_environment(model=self.model)
+        except Exception:
+            return
+        missing = [k for k in env.get("missing_keys", []) if not k.endswith("_API_BASE")]  # bases have defaults
+        if missing and not env.get("keys_in_environment", False):
+            if self.provider == "gemini":  # either name works
+                what = "GEMINI_API_KEY (or GOOGLE_API_KEY)"
+            else:
+                what = " and ".join(sorted(missing, key=lambda k: k != self.key_var))
+            raise VLMConfigError(f"no API key for litellm:{self.model}: set {what} in the environment "
+                                 f"(keys are read from the environment only)")
+
+    # -- one request -------------------------------------------------------------------------
+    def complete(self, messages: list[dict], n: int = 1) -> list[str]:
+        texts: list[str] = []
+        for _ in range(n + 1):  # n calls at most when the provider has no `n`, plus one spare
+            if len(texts) >= n:
+                break
+            want = n - len(texts) if self._n_ok else 1
+            texts += self._call(messages, want)
+        return texts[:n]
+
+    def _kwargs(self, messages, n) -> dict:
+        kw: dict[str, Any] = {"model": self.model, "messages": messages, "timeout": self.timeout,
+                              "num_retries": 0, "max_retries": 0}  # retries are ours (logged), not nested
+        if self.api_base:
+            kw["api_base"] = self.api_base
+        if n > 1:
+            kw["n"] = n
+        if self._json_ok:
+            kw["response_format"] = {"type": "json_object"}
+        if self.temperature is not None:
+            kw["temperature"] = self.temperature
+        if self.max_tokens is not None:
+            kw["max_tokens"] = self.max_tokens
+        return kw
+
+    def _call(self, messages: list[dict], n: int) -> list[str]:
+        lt = _litellm()
+        retryable = tuple(c for c in (getattr(lt, name, None) for name in (
+            "RateLimitError", "InternalServerError", "ServiceUnavailableError", "APIConnectionError", "Timeout",
+            "BadGatewayError")) if isinstance(c, type))
+        auth = tuple(c for c in (getattr(lt, "AuthenticationError", None), getattr(lt, "PermissionDeniedError", None))
+                     if isinstance(c, type))
+        not_found = getattr(lt, "NotFoundError", ())
+        bad_request = getattr(lt, "BadRequestError", ())
+        rate_limit = getattr(lt, "RateLimitError", ())
+        key, text_key = request_hash(messages), request_hash(messages, images=False)
+        attempt = 0
+        while True:
+            attempt += 1
+            self.attempts += 1
+            kw = self._kwargs(messages, n)
+            t0 = time.time()
+            try:
+                resp = lt.completion(**kw)
+            except Exception as exc:  # noqa: BLE001 - every provider failure becomes one line or a retry
+                latency = time.time() - t0
+                self._record(kw, messages, key, text_key, None, 0.0, latency, attempt, error=one_line(exc))
+                if isinstance(exc, bad_request) and not isinstance(exc, (not_found, *auth)) and (
+                        "n" in kw or "response_format" in kw):
+                    dropped = "response_format" if "response_format" in kw else "n"  # one at a time
+                    log.warning("VLM %s rejected the request (%s); retrying without %s", self.model,
+                                one_line(exc, 120), dropped)
+                    if dropped == "response_format":
+                        self._json_ok = False
+                    else:
+                        self._n_ok, n = False, 1
+                    continue
+                if isinstance(exc, auth):
+                    raise VLMConfigError(f"litellm:{self.model}: the provider rejected the API key "
+                                         f"({type(exc).__name__}); check {self.key_var}") from None
+                if isinstance(exc, not_found):
+                    raise VLMConfigError(f"unknown model litellm:{self.model}: the provider does not know it "
+                                         f"(404); {_MODEL_HINT}") from None
+                if isinstance(exc, retryable) and attempt <= self.num_retries:
+                    wait = self._wait(exc, attempt)
+                    log.warning("VLM %s: %s (%s); retry %d/%d in %.1fs", self.model, type(exc).__name__,
+                                one_line(exc, 100), attempt, self.num_retries, wait)
+                    time.sleep(wait)
+                    continue
+                if isinstance(exc, rate_limit):
+                    raise VLMUnavailable(f"litellm:{self.model}: rate-limited by the provider after {attempt} "
+                                         f"attempts; wait and rerun, or lower -w / the number of edges") from None
+                if isinstance(exc, retryable):
+                    where = f" at {_safe_url(self.api_base)}" if self.api_base else ""
+                    if self.provider.startswith("ollama") and not self.api_base:
+                        where = " (is `ollama serve` running? set OLLAMA_API_BASE if it is not at localhost:11434)"
+                    raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where} after "
+                                         f"{attempt} attempts ({one_line(exc, 120)})") from None
+                raise VLMError(f"litellm:{self.model}: call failed: {one_line(exc, 160)}") from None
+            latency = time.time() - t0
+            texts, finish = [], []
+            for choice in getattr(resp, "choices", None) or []:
+                msg = getattr(choice, "message", None)
+                content = getattr(msg, "content", None)
+                if isinstance(content, list):  # some providers return content parts
+                    content = "".join(p.get("text", "") if isinstance(p, dict) else str(p) for p in content)
+                texts.append(content if isinstance(content, str) else "")
+                finish.append(getattr(choice, "finish_reason", None))
+            usage = getattr(resp, "usage", None)
+            pt = int(getattr(usage, "prompt_tokens", 0) or 0)
+            ct = int(getattr(usage, "completion_tokens", 0) or 0)
+            cost = self._cost(lt, resp)
+            self.calls += 1
+            self.prompt_tokens += pt
+            self.completion_tokens += ct
+            self.cost_usd += cost
+            response = {"id": getattr(resp, "id", None), "model": getattr(resp, "model", None),
+                        "choices": [{"text": t, "finish_reason": f} for t, f in zip(texts, finish)],
+                        "usage": {"prompt_tokens": pt, "completion_tokens": ct}}
+            self._record(kw, messages, key, text_key, response, cost, latency, attempt)
+            log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(texts), pt, ct, cost,
+                     latency)
+            return texts
+
+    def _wait(self, exc, attempt: int) -> float:
+        wait = self.retry_wait * (2 ** (attempt - 1))
+        headers = getattr(getattr(exc, "response", None), "headers", None) or {}
+        try:
+            after = float(headers.get("retry-after"))
+            wait = max(wait, min(after, 60.0))
+        except (TypeError, ValueError, AttributeError):
+            pass
+        return wait
+
+    def _cost(self, lt, resp) -> float:
+        try:
+            return float(lt.completion_cost(completion_response=resp) or 0.0)
+        except Exception:  # noqa: BLE001 - unknown or local model: no price, count 0
+            if not self._unpriced_warned:
+                log.info("VLM %s: LiteLLM has no price for this model; counting its cost as $0", self.model)
+                self._unpriced_warned = True
+            return 0.0
+
+    def _record(self, kw, messages, key, text_key, response, cost, latency, attempt, error=None) -> None:
+        if self.recorder is None:
+            return
+        params = {k: v for k, v in kw.items() if k not in ("messages", "model", "api_base")}
+        record = {"v": RECORD_VERSION, "time": datetime.now(UTC).isoformat(timespec="seconds"),
+                  "model": self.model, "provider": self.provider, "key": key, "text_key": text_key,
+                  "request": {"params": params, "api_base": _safe_url(self.api_base)},
+                  "response": response, "cost_usd": cost, "latency_s": round(latency, 3), "attempt": attempt,
+                  "error": error}
+        try:
+            self.recorder.write(record, messages)
+        except OSError as exc:
+            log.warning("cannot append to VLM recording %s: %s", self.recorder.path, exc)

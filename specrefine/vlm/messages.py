@@ -1,0 +1,145 @@
+"""Chat messages as the VLM clients see them: text and PNG parts, a stable request hash, a readable
+transcript, the scrubbing of secrets, and :class:`VLMClient`, what a proposer needs from a model.
+
+Keys are read by LiteLLM from the environment only; :func:`scrub` keeps every key-like value out
+of anything this package writes (recordings, logs, error messages).
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import os
+import re
+from typing import Any
+
+_SECRET_ENV = re.compile(r"(API_?KEY|_KEY$|TOKEN|SECRET|PASSWORD|CREDENTIAL)", re.IGNORECASE)
+_SECRET_FIELDS = {"api_key", "apikey", "authorization", "x-api-key", "x-goog-api-key", "api-key", "access_token",
+                  "proxy-authorization", "aws_secret_access_key", "aws_session_token"}
+
+
+def _secret_values() -> list[str]:
+    vals = {v for k, v in os.environ.items() if _SECRET_ENV.search(k) and isinstance(v, str) and len(v) >= 8}
+    return sorted(vals, key=len, reverse=True)
+
+
+def scrub(obj: Any, secrets: list[str] | None = None) -> Any:
+    """Copy of ``obj`` with key-like fields dropped and every secret env value replaced by ``***``."""
+    secrets = _secret_values() if secrets is None else secrets
+    if isinstance(obj, dict):
+        return {k: scrub(v, secrets) for k, v in obj.items() if str(k).lower() not in _SECRET_FIELDS}
+    if isinstance(obj, (list, tuple)):
+        return [scrub(v, secrets) for v in obj]
+    if isinstance(obj, str):
+        for s in secrets:
+            if s in obj:
+                obj = obj.replace(s, "***")
+        return obj
+    return obj
+
+
+def one_line(exc: BaseException | str, limit: int = 240) -> str:
+    text = str(exc).strip().replace("\r", " ")
+    text = " ".join(part.strip() for part in text.splitlines() if part.strip()) or type(exc).__name__
+    text = scrub(text)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def text_part(text: str) -> dict:
+    return {"type": "text", "text": text}
+
+
+def image_part(png: bytes) -> dict:
+    return {"type": "image_url", "image_url": {"url": "data:image/png;base64," + base64.b64encode(png).decode()}}
+
+
+_IMAGE_MARK = re.compile(r"\[\[image:(\w+)\]\]")
+
+
+def build_content(text: str, images: dict[str, bytes | None]) -> list[dict]:
+    """Split ``text`` at ``[[image:NAME]]`` markers into text parts and PNG image parts."""
+    parts: list[dict] = []
+    pos = 0
+    for m in _IMAGE_MARK.finditer(text):
+        chunk = text[pos:m.start()].strip()
+        if chunk:
+            parts.append(text_part(chunk))
+        png = images.get(m.group(1))
+        parts.append(image_part(png) if png else text_part("(no picture available for this item)"))
+        pos = m.end()
+    tail = text[pos:].strip()
+    if tail:
+        parts.append(text_part(tail))
+    return parts
+
+
+def _image_digest(url: str) -> str | None:
+    if url.startswith("data:") and ";base64," in url:
+        return "sha256:" + hashlib.sha256(base64.b64decode(url.split(";base64,", 1)[1])).hexdigest()
+    return None
+
+
+def _map_parts(messages: list[dict], image_part, other_part) -> list[dict]:
+    """A copy of ``messages`` with each image part replaced by ``image_part(url)``, any other by ``other_part(p)``."""
+    out = []
+    for msg in messages:
+        content = msg.get("content")
+        if isinstance(content, list):
+            content = [image_part(_image_url(p)) if p.get("type") == "image_url" else other_part(p) for p in content]
+        out.append({"role": msg.get("role"), "content": content})
+    return out
+
+
+def _image_url(part: dict) -> str:
+    url = part.get("image_url")
+    return url["url"] if isinstance(url, dict) else url
+
+
+def _canonical(messages: list[dict], images: bool) -> list[dict]:
+    return _map_parts(
+        messages,
+        lambda url: {"type": "image_url", "image": (_image_digest(url) or url) if images else "image"},
+        lambda p: {"type": p.get("type"), "text": p.get("text")})
+
+
+def request_hash(messages: list[dict], images: bool = True) -> str:
+    """Stable SHA-256 of the request messages; images enter by the hash of their PNG bytes."""
+    blob = json.dumps(_canonical(messages, images), sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def messages_to_text(messages: list[dict]) -> str:
+    """Readable transcript of a request (images shown as ``[image]``): for notebooks and logs."""
+    lines = []
+    for msg in messages:
+        lines.append(f"=== {msg.get('role')} ===")
+        content = msg.get("content")
+        if isinstance(content, str):
+            lines.append(content)
+            continue
+        for p in content or []:
+            lines.append("[image]" if p.get("type") == "image_url" else p.get("text", ""))
+    return "\n".join(lines)
+
+
+class VLMClient:
+    """What a proposer needs from a model: ``complete(messages, n) -> n reply texts``."""
+
+    model: str = "?"
+    name: str = "?"
+
+    def __init__(self):
+        self.calls = 0  # completion calls that returned an answer
+        self.attempts = 0  # including failed and retried ones
+        self.prompt_tokens = 0
+        self.completion_tokens = 0
+        self.cost_usd = 0.0
+
+    def complete(self, messages: list[dict], n: int = 1) -> list[str]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def stats(self) -> dict:
+        return {"model": self.model, "calls": self.calls, "attempts": self.attempts,
+                "prompt_tokens": self.prompt_tokens, "completion_tokens": self.completion_tokens,
+                "cost_usd": round(self.cost_usd, 6)}

@@ -1,0 +1,145 @@
+"""Record and replay: every real VLM call appended to a JSONL file, and a client that answers from one.
+
+A recording (see ``data/vlm/README.md``) holds one JSON line per call; PNG images go once each to
+``<stem>.images/<sha256>.png``.  :class:`ReplayClient` answers deterministically, matching requests
+by :func:`~specrefine.vlm.messages.request_hash` (text and images).
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import logging
+import re
+from pathlib import Path
+
+from ..errors import ReplayMiss, VLMConfigError
+from ..paths import data_dir
+from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub
+
+log = logging.getLogger(__name__)
+
+RECORD_VERSION = 1
+
+
+def record_dir() -> Path:
+    """Where recordings go by default: ``data/vlm/`` (of the checkout, or of the installed package)."""
+    return data_dir() / "vlm"
+
+
+def slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("_") or "model"
+
+
+def default_record_path(model: str) -> Path:
+    return record_dir() / f"{slug(model)}.jsonl"
+
+
+class Recorder:
+    """Appends one JSON line per real call; PNG images go once each to ``<stem>.images/<sha256>.png``."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.image_dir = self.path.with_suffix("").with_name(self.path.stem + ".images")
+
+    def _store_messages(self, messages: list[dict]) -> list[dict]:
+        """Messages as recorded: each image stored once as a PNG file and referred to by its digest."""
+        return _map_parts(messages, lambda url: {"type": "image_url", "image_url": {"url": self._store_image(url)}},
+                          dict)
+
+    def _store_image(self, url: str) -> str:
+        digest = _image_digest(url)
+        if not digest:
+            return url
+        self.image_dir.mkdir(parents=True, exist_ok=True)
+        target = self.image_dir / f"{digest.split(':', 1)[1]}.png"
+        if not target.exists():
+            target.write_bytes(base64.b64decode(url.split(";base64,", 1)[1]))
+        return digest
+
+    def write(self, record: dict, messages: list[dict]) -> None:
+        record = dict(record)
+        record["request"] = dict(record.get("request", {}), messages=self._store_messages(messages))
+        secrets = _secret_values()
+        line = json.dumps(scrub(record, secrets), ensure_ascii=False, sort_keys=False)
+        for s in secrets:  # belt and braces: no secret value survives, whatever field it hid in
+            line = line.replace(s, "***")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with self.path.open("a", encoding="utf-8") as fh:
+            fh.write(line + "\n")
+
+
+class ReplayClient(VLMClient):
+    """Answers from a JSONL recording; request ``i`` with hash ``h`` gets the ``i``-th recorded answers for ``h``.
+
+    When no recorded request has the same hash, a request whose text (ignoring images) matches is
+    used instead with a logged warning, unless ``strict``; with no match at all it raises
+    :class:`ReplayMiss`.
+    """
+
+    def __init__(self, path: str | Path, *, strict: bool = False):
+        super().__init__()
+        self.path = Path(path)
+        self.strict = strict
+        try:
+            lines = self.path.read_text(encoding="utf-8").splitlines()
+        except OSError as exc:
+            raise VLMConfigError(f"replay:{path}: cannot read the recording ({exc.strerror or exc})") from None
+        self.records: list[dict] = []
+        for lineno, line in enumerate(lines, start=1):
+            if not line.strip():
+                continue
+            try:
+                rec = json.loads(line)
+            except json.JSONDecodeError:
+                log.warning("replay %s:%d: not JSON, skipped", path, lineno)
+                continue
+            if rec.get("error") or not rec.get("response"):
+                continue
+            self.records.append(rec)
+        if not self.records:
+            raise VLMConfigError(f"replay:{path}: the recording holds no answered calls")
+        models = sorted({r.get("model", "?") for r in self.records})
+        self.model = models[0] if len(models) == 1 else "+".join(models)
+        self.name = f"replay:{path}"
+        self._entries: list[tuple[int, str]] = []  # (record index, text)
+        self._by_key: dict[str, list[int]] = {}
+        self._by_text: dict[str, list[int]] = {}
+        for i, rec in enumerate(self.records):
+            for choice in rec["response"].get("choices", []):
+                e = len(self._entries)
+                self._entries.append((i, choice.get("text", "")))
+                self._by_key.setdefault(rec.get("key"), []).append(e)
+                self._by_text.setdefault(rec.get("text_key"), []).append(e)
+        self._used: set[int] = set()
+        self._charged: set[int] = set()
+        self._warned_text_match = False
+
+    def complete(self, messages: list[dict], n: int = 1) -> list[str]:
+        key = request_hash(messages)
+        picked = [e for e in self._by_key.get(key, []) if e not in self._used][:n]
+        if len(picked) < n and not self.strict:
+            extra = [e for e in self._by_text.get(request_hash(messages, images=False), [])
+                     if e not in self._used and e not in picked][: n - len(picked)]
+            if extra and not self._warned_text_match:
+                log.warning("replay %s: answering from a recording whose text matches but whose pictures differ "
+                            "(rendering or rollouts changed since recording)", self.path)
+                self._warned_text_match = True
+            picked += extra
+        if not picked:
+            raise ReplayMiss(f"replay:{self.path}: no recorded answer for this request (hash {key[:12]}); "
+                             f"the run differs from the recorded one: record it again with --proposer litellm:MODEL")
+        if len(picked) < n:
+            log.warning("replay %s: only %d of %d answers recorded for request %s", self.path, len(picked), n,
+                        key[:12])
+        self._used.update(picked)
+        self.attempts += 1
+        for rec_i in sorted({self._entries[e][0] for e in picked} - self._charged):
+            self._charged.add(rec_i)
+            rec = self.records[rec_i]
+            usage = rec["response"].get("usage", {})
+            self.calls += 1
+            self.prompt_tokens += int(usage.get("prompt_tokens", 0) or 0)
+            self.completion_tokens += int(usage.get("completion_tokens", 0) or 0)
+            self.cost_usd += float(rec.get("cost_usd", 0.0) or 0.0)  # what the recorded run spent
+        return [self._entries[e][1] for e in picked]

@@ -1,0 +1,34 @@
+"""Shipped results stay reproducible: rerunning cheap point runs of data/results/results.csv gives the same outcomes."""
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from specrefine.pipeline import refine_maze
+
+TABLE = Path(__file__).resolve().parent.parent / "data" / "results" / "results.csv"
+CELLS = ["u_maze__point__ours__geometric__s3", "u_chain_1__point__ours__geometric__s0"]
+EXACT = ["episodes", "evaluations", "sim_steps", "vlm_calls", "refinements", "refines_input", "graph_vertices",
+         "graph_edges", "path_edges", "rollouts_per_evaluation"]
+CLOSE = ["success_rate", "predicted_success", "path_success_rate"]
+
+
+def _shipped(cell: str) -> dict:
+    with TABLE.open() as fh:
+        return next(row for row in csv.DictReader(fh) if row["cell"] == cell)
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_rerun_reproduces_the_shipped_row(cell, tmp_path):
+    row = _shipped(cell)
+    got = refine_maze(row["maze"], agent=row["agent"], method=row["method"], proposer=row["proposer"],
+                      seed=int(row["seed"]), out=tmp_path, rollouts=int(row["rollouts_per_evaluation"]),
+                      episodes=int(row["episodes"])).data
+    for key in EXACT:
+        assert str(got[key]) == row[key], (key, got[key], row[key])
+    successes = round(got["success_rate"] * got["episodes"])
+    assert successes == round(float(row["success_rate"]) * int(row["episodes"]))  # a count: exact
+    for key in CLOSE:
+        assert got[key] == pytest.approx(float(row[key]), abs=1e-9), key
+    assert got["success_ci"] == pytest.approx([float(row["success_ci_low"]), float(row["success_ci_high"])])
