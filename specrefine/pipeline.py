@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .calibrate import predict
 from .errors import SpecrefineError
 from .graph import check_refines
 from .spec import maze_spec_text
@@ -47,7 +48,8 @@ class RunResult:
         return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
                 f"seed={d['seed']}\n"
                 f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
-                f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f}\n"
+                f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f} (95% CI "
+                f"{d['predicted_ci'][0]:.3f}-{d['predicted_ci'][1]:.3f}; the search's own {d['search_estimate']:.3f})\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
                 f"subtasks; refines input: {d['refines_input']}\n"
                 f"  {d['evaluations']} subtask evaluations, {d['sim_steps']} sim steps, "
@@ -76,7 +78,10 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
 
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
     measured = _measure(evaluator, original, search, episodes, seed)
+    prediction = predict(evaluator, search.graph, search.path, original.region(original.initial), seed)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
+    data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
+    data.update(prediction.to_dict())  # calibrated: held-out legs, Jeffreys posterior of the product
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)

@@ -36,7 +36,7 @@ COLUMNS = [
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
-    "proposer_calls",
+    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high",
 ]
 
 
@@ -118,6 +118,8 @@ def result_row(data: dict, row: dict | None = None) -> dict:
     lo, hi = data["success_ci"]
     row.update({k: data[k] for k in COLUMNS if k in data and k not in row})
     row.update(status="ok", error="", success_ci_low=lo, success_ci_high=hi)
+    if "predicted_ci" in data:
+        row.update(predicted_ci_low=data["predicted_ci"][0], predicted_ci_high=data["predicted_ci"][1])
     return row
 
 
