@@ -78,7 +78,7 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
 
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
     measured = _measure(evaluator, original, search, episodes, seed)
-    prediction = predict(evaluator, search.graph, search.path, original.region(original.initial), seed)
+    prediction = predict(evaluator, search.graph, search.path, original.region(original.initial), seed, episodes)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out legs, Jeffreys posterior of the product

@@ -17,6 +17,9 @@ def test_each_leg_is_charged_even_at_32_of_32():
     p15, (lo15, _) = product_posterior([32] * 15, [32] * 15)
     assert p15 == pytest.approx((32.5 / 33) ** 15) and p15 < 0.8 and lo15 < 0.7
     assert product_posterior([], []) == (0.0, (0.0, 0.0))
+    _, (plo, phi) = product_posterior([32] * 4, [32] * 4, episodes=200)  # what 200 episodes would measure
+    post_lo, post_hi = product_posterior([32] * 4, [32] * 4)[1]
+    assert plo < post_lo and phi > post_hi  # wider: the measurement's own noise is added
 
 
 def test_the_interval_covers_the_true_product():
@@ -38,7 +41,8 @@ def test_result_json_carries_the_calibrated_prediction(tmp_path):
     on_disk = json.loads((tmp_path / "result.json").read_text())
     assert on_disk["predicted_ci"] == data["predicted_ci"]
     lo, hi = data["predicted_ci"]
-    assert 0.0 <= lo <= data["predicted_success"] <= hi <= 1.0
+    p_lo, p_hi = data["predicted_p_ci"]
+    assert 0.0 <= lo <= hi <= 1.0 and p_lo <= data["predicted_success"] <= p_hi
     assert len(data["predicted_leg_successes"]) == data["path_edges"] == len(data["predicted_leg_rollouts"])
     assert data["search_estimate"] == pytest.approx(np.prod(data["edge_probabilities"]))
     assert data["prediction_sim_steps"] > 0
