@@ -1,12 +1,14 @@
-"""PPO training (tiny seeded point run), policy checkpoints, one-line errors on bad files."""
+"""PPO training (tiny seeded point run), policy checkpoints, one-line errors on bad files; open-floor evaluation."""
 
 import numpy as np
 import pytest
 import torch
 
+from specrefine.curves import read_log
 from specrefine.errors import SpecrefineError
 from specrefine.policy import GoalPolicy, PolicyError, load_policy, save_policy
-from specrefine.train import Config, Trainer, evaluate_reach, main, make_config, read_log
+from specrefine.policy_eval import evaluate_reach
+from specrefine.train import Config, Trainer, main, make_config
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +94,7 @@ def test_shipped_point_policy_loads():
 
 
 def test_chained_goal_evaluation_accounts_for_every_episode():
-    from specrefine.train import evaluate_chain
+    from specrefine.policy_eval import evaluate_chain
 
     res = evaluate_chain(load_policy("point"), episodes=64, goals=4, seed=3)
     arrived = [res["episodes"]] + res["reached"][:-1]  # episodes that set out for each goal
@@ -121,3 +123,13 @@ def test_every_config_field_is_a_documented_option(capsys):
     for f in fields(Config):
         if f.name != "agent":
             assert "--" + f.name.replace("_", "-") in text and f.metadata["help"].split(" (")[0][:30] in text, f.name
+
+
+def test_notebook_imports_from_train_still_work():
+    """Notebook 01 imports the evaluation and its figures from specrefine.train; they live in policy_eval, curves."""
+    from specrefine import curves, policy_eval, train
+
+    for name in ("evaluate_chain", "evaluate_reach", "summary", "success_by_distance"):
+        assert getattr(train, name) is getattr(policy_eval, name)
+    for name in ("plot_curve", "plot_rollouts", "plot_success_by_distance", "read_log"):
+        assert getattr(train, name) is getattr(curves, name)

@@ -25,7 +25,8 @@ def reference_overrides() -> dict:
 
 
 def measure(agent: str, batches: int, **overrides) -> dict:
-    from ..train import Trainer, make_config, read_log
+    from ..curves import read_log
+    from ..train import Trainer, make_config
 
     cfg = make_config(agent, checkpoint_every_s=1e9, **overrides)
     cfg.frames = cfg.frames_per_batch * (batches + 1)
