@@ -20,23 +20,33 @@ def read_log(path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines() if line.strip()] if path.is_file() else []
 
 
+#: the panels of the training curve, log.jsonl keys: progress, then the PPO diagnostics of specrefine.train
+CURVE_PANELS = ("success_rate", "return", "fps", "approx_kl", "clip_fraction", "entropy", "explained_variance",
+                "value_loss")
+
+
 def plot_curve(log_path, png_path=None, window: int = 10):
-    """Success rate, return and frames/s against frames; saved to ``png_path`` when given."""
+    """One panel per :data:`CURVE_PANELS` key against frames (success rate, return, frames/s and the PPO
+    diagnostics: approximate KL, clip fraction, entropy, explained variance, value loss); raw values faint,
+    a ``window``-batch moving average on top; saved to ``png_path`` when given."""
     from .render import PngFigure as Figure  # not pyplot: no global state; shows as a PNG in notebooks
 
     rows = read_log(log_path)
-    fig = Figure(figsize=(13, 3.4))
-    axes = fig.subplots(1, 3)
-    if rows:
-        f = np.array([r["frames"] for r in rows])
-        for ax, key in zip(axes, ("success_rate", "return", "fps"), strict=True):
-            y = np.array([np.nan if r.get(key) is None else r[key] for r in rows], dtype=float)
+    fig = Figure(figsize=(13, 6.4))
+    axes = fig.subplots(2, 4).ravel()
+    f = np.array([r["frames"] for r in rows])
+    for ax, key in zip(axes, CURVE_PANELS, strict=True):
+        y = np.array([np.nan if r.get(key) is None else r[key] for r in rows], dtype=float)
+        if any(key in r for r in rows):
             ax.plot(f, y, alpha=0.3, color="C0")
             if len(y) >= window:
                 ax.plot(f[window - 1:], np.convolve(np.nan_to_num(y), np.ones(window) / window, "valid"), color="C0")
-            ax.set_xlabel("frames")
-            ax.set_title(key)
-            ax.grid(alpha=0.3)
+        elif rows:  # a log from before the diagnostics were logged
+            ax.text(0.5, 0.5, "not in this log", ha="center", va="center", transform=ax.transAxes, color="0.5")
+        ax.set_xlabel("frames")
+        ax.locator_params(axis="x", nbins=4)  # frame counts are wide labels
+        ax.set_title(key)
+        ax.grid(alpha=0.3)
     fig.tight_layout()
     if png_path is not None:
         fig.savefig(png_path, dpi=90)
