@@ -18,7 +18,7 @@ demo: $(VENV)/.installed
 	$(BIN)/specrefine refine $(MAZE) --agent point --method ours --proposer geometric --seed 0 --out runs/demo
 
 test: $(VENV)/.installed
-	$(BIN)/ruff check specrefine tests benchmarks
+	$(BIN)/ruff check specrefine tests scripts
 	$(BIN)/python -m pytest -q
 
 # Notebooks: the full-parameter tier (notebooks/full.json, minutes per notebook) and its expected values,

@@ -10,6 +10,10 @@ explained variance) go into the curves.
 Task: reach a goal sampled on the open floor (``specrefine.sim.GoalReachEnv``); the policy never
 sees a maze.  ``OUT/`` receives ``checkpoint.pt`` (everything needed to resume), ``policy.pt``
 (the shippable policy), ``log.jsonl`` (one line per batch) and ``curve.png``.
+
+This module is the config, the PPO loop and its checkpoints, and the command line.  ``--evaluate`` runs the
+open-floor evaluation of :mod:`specrefine.policy_eval`; the figures (``curve.png``, success against distance,
+rollouts) are drawn by :mod:`specrefine.curves`.  Their functions are importable from here too (notebook 01).
 """
 
 from __future__ import annotations
@@ -28,10 +32,17 @@ from torch import nn
 from tqdm.auto import tqdm
 
 from .agents import AGENTS, get_agent
+from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .errors import SpecrefineError
 from .policy import GoalPolicy, load_policy, mlp, save_policy
-from .results import wilson_ci
-from .sim import BatchedSim, GoalReachEnv, sample_goals
+from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
+from .sim import GoalReachEnv
+
+__all__ = ["PPO_DIAGNOSTICS", "Config", "Trainer", "config_arguments", "explained_variance", "make_config", "main",
+           "make_modules", "train",
+           # the evaluation and its figures live in policy_eval and curves; importable from here (notebook 01)
+           "evaluate_chain", "evaluate_reach", "plot_curve", "plot_rollouts", "plot_success_by_distance", "read_log",
+           "success_by_distance", "summary"]
 
 
 def knob(default, help: str):
@@ -251,168 +262,6 @@ class Trainer:
 def train(agent: str, frames: int, out, resume: bool = False, progress: bool = True, **overrides) -> Path:
     """Train (or continue) a policy; returns the path of ``OUT/policy.pt``."""
     return Trainer(make_config(agent, frames=frames, **overrides), out, resume, progress).train()
-
-
-# --- evaluation ---------------------------------------------------------------------------------
-def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
-    """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
-    task = get_agent(policy.agent).reach_task
-    lo = task.goal_min if lo is None else lo
-    hi = task.goal_max if hi is None else hi
-    rng = np.random.default_rng(seed)
-    sim = BatchedSim(policy.agent, None, episodes, nthread=nthread)
-    sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
-    return task, lo, hi, rng, sim, horizon or sim.default_horizon, sample_goals(sim.xy, lo, hi, rng)
-
-
-def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = None, hi: float | None = None,
-                   seed: int = 0, horizon: int | None = None, nthread: int | None = None) -> dict:
-    """Deterministic policy, open floor, goals at uniform distance in [lo, hi]: success within the horizon."""
-    task, lo, hi, rng, sim, horizon, goals = _open_floor(policy, episodes, lo, hi, seed, horizon, nthread)
-    dist0 = np.linalg.norm(goals - sim.xy, axis=1)
-    active = np.ones(episodes, dtype=bool)
-    success, flipped = np.zeros(episodes, bool), np.zeros(episodes, bool)
-    steps = np.full(episodes, horizon)
-    traj = np.zeros((episodes, horizon + 1, 2))
-    traj[:, 0] = sim.xy
-    for t in range(horizon):
-        sim.step(np.where(active[:, None], policy.act(sim.observe(goals)), 0.0))
-        xy = sim.xy
-        traj[:, t + 1] = np.where(active[:, None], xy, traj[:, t])
-        hit = active & (np.linalg.norm(goals - xy, axis=1) < task.success_radius)
-        flip = active & sim.flipped & ~hit
-        success |= hit
-        flipped |= flip
-        steps[hit | flip] = t + 1
-        active &= ~(hit | flip)
-        if not active.any():
-            break
-    sim.close()
-    k = int(success.sum())
-    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goal_range_m": [lo, hi], "horizon": horizon,
-            "success_radius_m": task.success_radius, "success_rate": k / episodes,
-            "success_ci95": wilson_ci(k, episodes), "flip_rate": float(flipped.mean()),
-            "mean_steps_success": float(steps[success].mean()) if k else None,
-            "distance": dist0, "success": success, "flipped": flipped, "steps": steps, "trajectories": traj,
-            "goals": goals}
-
-
-def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
-                   hi: float | None = None, seed: int = 0, horizon: int | None = None) -> dict:
-    """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
-
-    This is how a compositional policy uses the goal policy (the next subtask starts from a moving
-    state); per goal it reports how many episodes got there and how many flipped on the way.
-    """
-    task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
-    index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
-    alive = np.ones(episodes, dtype=bool)
-    reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
-    with torch.inference_mode():
-        while alive.any():
-            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal)), 0.0))
-            t += 1
-            flip = alive & sim.flipped
-            np.add.at(flips, index[flip], 1)
-            alive &= ~flip
-            hit = alive & (np.linalg.norm(sim.xy - goal, axis=1) < task.success_radius)
-            np.add.at(reached, index[hit], 1)
-            index[hit] += 1
-            t[hit] = 0
-            goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
-            alive &= index < goals
-            late = alive & (t >= horizon)
-            np.add.at(timeouts, index[late], 1)
-            alive &= ~late
-    sim.close()
-    k = int(reached[-1])
-    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
-            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
-            "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
-            "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
-
-
-def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
-    lo, hi = result["goal_range_m"]
-    edges = np.linspace(lo, hi, bins + 1)
-    rows = []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
-        m = (result["distance"] >= a) & (result["distance"] < b if b < hi else result["distance"] <= b)
-        k, n = int(result["success"][m].sum()), int(m.sum())
-        rows.append({"from_m": round(float(a), 3), "to_m": round(float(b), 3), "n": n,
-                     "success_rate": k / n if n else None, "ci95": wilson_ci(k, n)})
-    return rows
-
-
-def summary(result: dict) -> dict:
-    keep = ("agent", "episodes", "seed", "goal_range_m", "horizon", "success_radius_m", "success_rate",
-            "success_ci95", "flip_rate", "mean_steps_success")
-    return {k: result[k] for k in keep} | {"by_distance": success_by_distance(result)}
-
-
-# --- plots ------------------------------------------------------------------------------------
-def read_log(path) -> list[dict]:
-    path = Path(path)
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()] if path.is_file() else []
-
-
-def plot_curve(log_path, png_path=None, window: int = 10):
-    """Success rate, return and frames/s against frames; saved to ``png_path`` when given."""
-    from .render import PngFigure as Figure  # not pyplot: no global state; shows as a PNG in notebooks
-
-    rows = read_log(log_path)
-    fig = Figure(figsize=(13, 3.4))
-    axes = fig.subplots(1, 3)
-    if rows:
-        f = np.array([r["frames"] for r in rows])
-        for ax, key in zip(axes, ("success_rate", "return", "fps"), strict=True):
-            y = np.array([np.nan if r.get(key) is None else r[key] for r in rows], dtype=float)
-            ax.plot(f, y, alpha=0.3, color="C0")
-            if len(y) >= window:
-                ax.plot(f[window - 1:], np.convolve(np.nan_to_num(y), np.ones(window) / window, "valid"), color="C0")
-            ax.set_xlabel("frames")
-            ax.set_title(key)
-            ax.grid(alpha=0.3)
-    fig.tight_layout()
-    if png_path is not None:
-        fig.savefig(png_path, dpi=90)
-    return fig
-
-
-def plot_success_by_distance(result: dict, bins: int = 8):
-    from .render import PngFigure as Figure
-
-    rows = success_by_distance(result, bins)
-    mid = [(r["from_m"] + r["to_m"]) / 2 for r in rows]
-    p = np.array([np.nan if r["success_rate"] is None else r["success_rate"] for r in rows])
-    lo, hi = np.array([r["ci95"][0] for r in rows]), np.array([r["ci95"][1] for r in rows])
-    fig = Figure(figsize=(5, 3.2))
-    ax = fig.subplots()
-    ax.errorbar(mid, p, yerr=np.clip([p - lo, hi - p], 0, None), fmt="o-", capsize=3)
-    ax.set(xlabel="goal distance (m)", ylabel="success rate", ylim=(0, 1.05),
-           title=f"{result['agent']}: {result['success_rate']:.3f} over {result['episodes']} episodes")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    return fig
-
-
-def plot_rollouts(result: dict, n: int = 24):
-    """Open-floor trajectories of ``evaluate_reach``: green success, red failure, x = goal."""
-    from .render import PngFigure as Figure
-
-    fig = Figure(figsize=(5, 5))
-    ax = fig.subplots()
-    for i in range(min(n, result["episodes"])):
-        c = "tab:green" if result["success"][i] else "tab:red"
-        tr = result["trajectories"][i, : result["steps"][i] + 1]
-        ax.plot(tr[:, 0], tr[:, 1], color=c, lw=1)
-        ax.plot(*result["goals"][i], "x", color=c)
-    ax.plot(0, 0, "ko")
-    ax.set_aspect("equal")
-    ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{result['agent']}: {min(n, result['episodes'])} rollouts")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    return fig
 
 
 # --- command line -----------------------------------------------------------------------------

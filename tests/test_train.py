@@ -1,12 +1,16 @@
-"""PPO training (tiny seeded point run), policy checkpoints, one-line errors on bad files."""
+"""PPO training (tiny seeded point run), policy checkpoints, one-line errors on bad files; open-floor evaluation."""
+
+import json
 
 import numpy as np
 import pytest
 import torch
 
+from specrefine.curves import read_log
 from specrefine.errors import SpecrefineError
 from specrefine.policy import GoalPolicy, PolicyError, load_policy, save_policy
-from specrefine.train import Config, Trainer, evaluate_reach, main, make_config, read_log
+from specrefine.policy_eval import evaluate_reach
+from specrefine.train import Config, Trainer, main, make_config
 
 
 @pytest.fixture(scope="module")
@@ -30,6 +34,24 @@ def test_tiny_training_run_improves_success(tiny_run):
         assert all(np.isfinite(r[key]) for r in rows), key
     assert all(0.0 <= r["clip_fraction"] <= 1.0 and r["explained_variance"] <= 1.0 for r in rows)
     assert (out / "curve.png").stat().st_size > 1000 and (out / "checkpoint.pt").is_file()
+
+
+def test_training_curve_has_the_ppo_diagnostics_panels(tiny_run, tmp_path):
+    from specrefine.curves import plot_curve
+
+    out, _ = tiny_run
+    rows = read_log(out / "log.jsonl")
+    fig = plot_curve(out / "log.jsonl")
+    panels = {ax.get_title(): ax for ax in fig.axes}
+    for key in ("approx_kl", "clip_fraction", "entropy", "explained_variance", "value_loss", "success_rate"):
+        assert key in panels, (key, sorted(panels))
+        raw = panels[key].get_lines()[0].get_ydata()  # the faint line: the log's values, one per batch
+        np.testing.assert_allclose(raw, [r[key] for r in rows])
+    old = tmp_path / "log.jsonl"  # a log from before the diagnostics: those panels say so, no error
+    old.write_text("\n".join(json.dumps({"frames": i, "success_rate": 0.5, "return": 1.0, "fps": 9.0})
+                             for i in (10, 20, 30)))
+    panels = {ax.get_title(): ax for ax in plot_curve(old).axes}
+    assert not panels["approx_kl"].get_lines() and panels["approx_kl"].texts[0].get_text() == "not in this log"
 
 
 def test_resume_continues_from_checkpoint(tiny_run, tmp_path):
@@ -92,7 +114,7 @@ def test_shipped_point_policy_loads():
 
 
 def test_chained_goal_evaluation_accounts_for_every_episode():
-    from specrefine.train import evaluate_chain
+    from specrefine.policy_eval import evaluate_chain
 
     res = evaluate_chain(load_policy("point"), episodes=64, goals=4, seed=3)
     arrived = [res["episodes"]] + res["reached"][:-1]  # episodes that set out for each goal
@@ -121,3 +143,13 @@ def test_every_config_field_is_a_documented_option(capsys):
     for f in fields(Config):
         if f.name != "agent":
             assert "--" + f.name.replace("_", "-") in text and f.metadata["help"].split(" (")[0][:30] in text, f.name
+
+
+def test_notebook_imports_from_train_still_work():
+    """Notebook 01 imports the evaluation and its figures from specrefine.train; they live in policy_eval, curves."""
+    from specrefine import curves, policy_eval, train
+
+    for name in ("evaluate_chain", "evaluate_reach", "summary", "success_by_distance"):
+        assert getattr(train, name) is getattr(policy_eval, name)
+    for name in ("plot_curve", "plot_rollouts", "plot_success_by_distance", "read_log"):
+        assert getattr(train, name) is getattr(curves, name)

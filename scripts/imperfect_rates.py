@@ -1,6 +1,6 @@
 """What each `imperfect` preset injects, measured on its own replies (no rollouts, no comparison).
 
-    python benchmarks/imperfect_rates.py > data/results/imperfect_rates.json
+    python scripts/imperfect_rates.py > data/results/imperfect_rates.json
 
 For every preset and every maze in data/mazes: edge queries S -> G of the maze's first edge and
 whole-graph queries of the maze's task graph, 100 replies each (seed 0), each reply checked by the

@@ -1,6 +1,7 @@
-"""Throughput benchmarks.  ``python -m specrefine.bench evaluator --agent {point,ant} [--batch 32]``
+"""Evaluator throughput.  ``python -m specrefine.bench evaluator --agent {point,ant} [--batch 32]``
 
-Prints ONE JSON line.  ``env_steps_per_s`` is measured through the evaluator's real code path
+:func:`bench_evaluator` returns one dict (the subcommand prints it as ONE JSON line).
+``env_steps_per_s`` is measured through the evaluator's real code path
 (:meth:`specrefine.evaluate.Evaluator.evaluate`: start sampling, policy in the loop, observation,
 batched physics, region checks, bookkeeping), counting every simulated environment step.  In the
 same run it measures the raw ceiling of the same MuJoCo model: ``mujoco.rollout`` stepping the same
@@ -9,22 +10,22 @@ control step (``raw_per_step_steps_per_s``, what any step-wise loop pays), and r
 The two are interleaved over a few rounds (medians reported).  Because wall-clock rates swing when
 other jobs share the cores, the same work is also reported per CPU-second of this process
 (``*_per_cpu_s``, ``cpu_ratio_vs_raw_rollout``).
+
+:func:`bench_gymenv` (``python -m specrefine.bench gymenv``) is the usual "one gym env per rollout" way for
+comparison: ``torchrl.envs.GymEnv`` around Gymnasium-Robotics' maze, one environment, random actions.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from .agents import AGENTS, get_agent
-from .mazes import load_maze
+from ..agents import get_agent
+from ..mazes import load_maze
 
 
 def open_room(agent: str, cells: int | None = None):
@@ -33,7 +34,7 @@ def open_room(agent: str, cells: int | None = None):
     Rollouts of an untrained (or trained) policy neither hit walls nor reach G within the horizon, so
     every batch runs full length: the loop's steady-state cost, not early exits, is measured.
     """
-    from .mazes import parse_maze
+    from ..mazes import parse_maze
 
     cells = cells or get_agent(agent).bench_room_cells
     rows = ["#" * cells] + ["#" + "." * (cells - 2) + "#" for _ in range(cells - 2)] + ["#" * cells]
@@ -54,7 +55,7 @@ def _cpu_name() -> str:
 
 
 def _policy(agent: str):
-    from .policy import POLICY_DIR, GoalPolicy, load_policy
+    from ..policy import POLICY_DIR, GoalPolicy, load_policy
 
     path = POLICY_DIR / f"{agent}.pt"
     if path.exists():
@@ -101,7 +102,7 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
     import mujoco
     import torch
 
-    from .evaluate import Evaluator
+    from ..evaluate import Evaluator
 
     torch.set_num_threads(torch_threads)
     maze = open_room(agent) if scenario == "open" else load_maze(scenario).for_agent(agent)
@@ -150,28 +151,24 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
     }
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m specrefine.bench", description=__doc__.splitlines()[0])
-    sub = ap.add_subparsers(dest="what", required=True)
-    e = sub.add_parser("evaluator", help="env steps/s of the subtask evaluator vs raw mujoco.rollout")
-    e.add_argument("--agent", choices=list(AGENTS), default="point")
-    e.add_argument("--batch", type=int, default=32)
-    e.add_argument("--seconds", type=float, default=6.0, help="time spent in the evaluator measurement")
-    e.add_argument("--horizon", type=int, default=None)
-    e.add_argument("--torch-threads", type=int, default=1)
-    e.add_argument("--nthread", type=int, default=None, help="mujoco.rollout threads (default: up to 2)")
-    e.add_argument("--scenario", default="open",
-                   help="'open' (open room, full-length rollouts) or a maze name (S -> G, early exits)")
-    e.add_argument("--rounds", type=int, default=3)
-    args = ap.parse_args(argv)
-    import warnings
 
-    warnings.filterwarnings("ignore")
-    out = bench_evaluator(args.agent, args.batch, args.seconds, args.horizon, args.torch_threads, args.nthread,
-                          args.scenario, args.rounds)
-    print(json.dumps(out), flush=True)
-    return 0
+GYM_IDS = {"ant": "AntMaze_UMaze-v5", "point": "PointMaze_UMaze-v3"}
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def bench_gymenv(agent: str, steps: int = 2000) -> dict:
+    try:
+        import gymnasium as gym
+        import gymnasium_robotics
+        from torchrl.envs import GymEnv
+
+        gym.register_envs(gymnasium_robotics)
+        env = GymEnv(GYM_IDS[agent])
+        env.set_seed(0)
+        env.rollout(50, break_when_any_done=False)  # warm-up
+        t = time.perf_counter()
+        env.rollout(steps, break_when_any_done=False)
+        dt = time.perf_counter() - t
+        env.close()
+        return {"env": GYM_IDS[agent], "steps": steps, "env_steps_per_s": round(steps / dt, 1)}
+    except Exception as e:  # not installed / cannot build here
+        return {"env": GYM_IDS[agent], "skipped": f"{type(e).__name__}: {str(e)[:200]}"}

@@ -1,6 +1,6 @@
 """Run the off-suite mazes in data/mazes/unseen/ into a sweep-style table (data/results/unseen/).
 
-    .venv/bin/python benchmarks/run_unseen.py --out runs/unseen            # point, ours, geometric, seed 0
+    .venv/bin/python scripts/run_unseen.py --out runs/unseen            # point, ours, geometric, seed 0
     cp runs/unseen/results.csv data/results/unseen/
 
 Why not ``python -m specrefine.sweep --mazes data/mazes/unseen/*.maze``: the sweep keeps only a maze
