@@ -13,7 +13,6 @@ other jobs share the cores, the same work is also reported per CPU-second of thi
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
@@ -24,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .agents import AGENTS, get_agent
+from .argtypes import OneLineParser, bounded_int, positive_float
 from .mazes import load_maze
 
 
@@ -151,18 +151,19 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m specrefine.bench", description=__doc__.splitlines()[0])
+    ap = OneLineParser(prog="python -m specrefine.bench", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
     e = sub.add_parser("evaluator", help="env steps/s of the subtask evaluator vs raw mujoco.rollout")
     e.add_argument("--agent", choices=list(AGENTS), default="point")
-    e.add_argument("--batch", type=int, default=32)
-    e.add_argument("--seconds", type=float, default=6.0, help="time spent in the evaluator measurement")
-    e.add_argument("--horizon", type=int, default=None)
-    e.add_argument("--torch-threads", type=int, default=1)
-    e.add_argument("--nthread", type=int, default=None, help="mujoco.rollout threads (default: up to 2)")
+    e.add_argument("--batch", type=bounded_int("batch"), default=32)
+    e.add_argument("--seconds", type=positive_float, default=6.0, help="time spent in the evaluator measurement")
+    e.add_argument("--horizon", type=bounded_int("horizon"), default=None)
+    e.add_argument("--torch-threads", type=bounded_int("torch_threads"), default=1)
+    e.add_argument("--nthread", type=bounded_int("nthread"), default=None,
+                   help="mujoco.rollout threads (default: up to 2)")
     e.add_argument("--scenario", default="open",
                    help="'open' (open room, full-length rollouts) or a maze name (S -> G, early exits)")
-    e.add_argument("--rounds", type=int, default=3)
+    e.add_argument("--rounds", type=bounded_int("rounds"), default=3)
     args = ap.parse_args(argv)
     import warnings
 

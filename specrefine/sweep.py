@@ -30,6 +30,7 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from .agents import AGENTS
+from .argtypes import OneLineParser, bounded_int
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -247,11 +248,9 @@ def _check_specs(cells: list[Cell]) -> str | None:
 
 
 def main(argv=None) -> int:
-    import argparse
-
     from .mazes import benchmark_mazes
 
-    p = argparse.ArgumentParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
     p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
                    help="maze names or files; MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
@@ -259,14 +258,14 @@ def main(argv=None) -> int:
                         "'' = the maze's own task; default: the maze's own task)")
     p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
     p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
-    p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
+    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
-    p.add_argument("--rollouts", type=int, default=32)
-    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
+    p.add_argument("--episodes", type=bounded_int("episodes"), default=200)
     p.add_argument("--out", default="runs/sweep")
     p.add_argument("--backend", choices=["local", "ray"], default="local")
     p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
-    p.add_argument("--workers", type=int, default=None, help="local processes (default: CPU count)")
+    p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                  episodes=args.episodes, specs=args.specs)
