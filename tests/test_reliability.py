@@ -201,3 +201,20 @@ def test_out_that_is_not_a_writable_folder_is_one_line(tmp_path, capsys, where):
     out = where.replace("{file}", str(tmp_path / "file"))
     assert_one_line_exit_2(cli_main, refine(out), capsys, out)
     assert_one_line_exit_2(sweep.main, ["--mazes", "u_maze", "--out", out, *SWEEP], capsys, out)
+
+
+# --- secrets: every configured key is scrubbed, whatever its length -----------------------------------
+def test_short_api_keys_are_scrubbed_without_mangling_text(monkeypatch, tmp_path):
+    from specrefine.vlm.messages import one_line
+    from specrefine.vlm.recording import Recorder
+
+    monkeypatch.setenv("OPENAI_API_KEY", "sk-12")
+    monkeypatch.setenv("MY_SERVICE_TOKEN", "ab")
+    monkeypatch.setenv("TOKENIZERS_PARALLELISM", "false")  # a flag, not a key
+    msg = one_line("auth failed for key sk-12 (token ab); the table is false")
+    assert "sk-12" not in msg and " ab)" not in msg, msg
+    assert msg == "auth failed for key *** (token ***); the table is false"
+    rec = Recorder(tmp_path / "r.jsonl")
+    rec.write({"error": "key sk-12 rejected", "n": 2}, [{"role": "user", "content": "go to ab then b"}])
+    line = (tmp_path / "r.jsonl").read_text()
+    assert "sk-12" not in line and "to ab " not in line and json.loads(line)["n"] == 2

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ..errors import ReplayMiss, VLMConfigError
 from ..paths import data_dir
-from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub
+from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub, scrub_text
 
 log = logging.getLogger(__name__)
 
@@ -62,8 +62,8 @@ class Recorder:
         record["request"] = dict(record.get("request", {}), messages=self._store_messages(messages))
         secrets = _secret_values()
         line = json.dumps(scrub(record, secrets), ensure_ascii=False, sort_keys=False)
-        for s in secrets:  # belt and braces: no secret value survives, whatever field it hid in
-            line = line.replace(s, "***")
+        # belt and braces: no long secret survives, whatever field it hid in (short ones could match JSON syntax)
+        line = scrub_text(line, secrets, long_only=True)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with self.path.open("a", encoding="utf-8") as fh:
             fh.write(line + "\n")
