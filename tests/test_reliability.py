@@ -2,15 +2,21 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from specrefine import bench, sweep
 from specrefine.cli import main as cli_main
@@ -218,3 +224,50 @@ def test_short_api_keys_are_scrubbed_without_mangling_text(monkeypatch, tmp_path
     rec.write({"error": "key sk-12 rejected", "n": 2}, [{"role": "user", "content": "go to ab then b"}])
     line = (tmp_path / "r.jsonl").read_text()
     assert "sk-12" not in line and "to ab " not in line and json.loads(line)["n"] == 2
+
+
+# --- property: any argument vector gives a valid result or exactly one line, never a traceback --------
+def values(valid, invalid):
+    """An option's value: as often valid as not."""
+    return st.one_of(st.sampled_from(valid), st.sampled_from(invalid))
+
+
+NUMBER = values(["1", "2"], ["0", "-1", "21", "2147483648", "x", "", "1.5"])
+OPTIONS = {
+    "--method": values(["dirl", "symbolic", "ours", "vlm-oneshot"], ["best"]),
+    "--proposer": values(["geometric", "random", "imperfect:mild"], ["imperfect:nope", "replay:/no/file", "gpt"]),
+    "--agent": values(["point"], ["walker"]),
+    "--spec": values(["G"], ["a -> G", "->", "(G"]),
+    "--seed": values(["0", "7", "2147483647"], ["-1", "2147483648", "x"]),
+    "--rollouts": values(["1", "2"], ["0", "-2", "y"]), "--episodes": values(["1", "2"], ["0", "z"]),
+    "-w": NUMBER, "-d": NUMBER, "-k": NUMBER, "--policy": values(["data/policies/point.pt"], ["/no/policy.pt"]),
+}
+
+
+@st.composite
+def argv(draw):
+    maze = draw(values(["u_maze", "data/mazes/u_maze.maze"], ["no_such_maze", "/dev/null"]))
+    args = ["refine", maze, "--rollouts", "2", "--episodes", "2"]
+    for name in draw(st.lists(st.sampled_from(sorted(OPTIONS)), max_size=3, unique=True)):
+        args += [name, draw(OPTIONS[name])]
+    extra = draw(st.sampled_from([None, None, None, "--bogus", "extra", "-w"]))
+    return args + ([extra] if extra else [])
+
+
+@settings(max_examples=30, deadline=None, derandomize=True)
+@given(args=argv())
+def test_any_argument_vector_gives_a_result_or_one_line(args):
+    out = Path(tempfile.mkdtemp(prefix="prop_"))
+    err = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            code = exit_code(cli_main, [*args, "--out", str(out)])
+        if code == 0:
+            data = json.loads((out / "result.json").read_text())
+            lo, hi = data["success_ci"]
+            assert 0 <= lo <= data["success_rate"] <= hi <= 1 and data["episodes"] <= 2, data
+        else:
+            lines = err.getvalue().strip().splitlines()
+            assert code == 2 and len(lines) == 1 and "Traceback" not in lines[0], (args, err.getvalue())
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
