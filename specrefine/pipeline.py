@@ -64,8 +64,9 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
     ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
     """
+    from .experiment import setup
     from .mazes import Maze, load_maze
-    from .runfolder import claim
+    from .runfolder import claim, write_record
 
     t0 = time.time()
     maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
@@ -74,17 +75,15 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
             "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,
             "k": k, "spec": spec}
     with claim(out, args) as out:
-        return _refine(maze, agent, method, proposer, seed, out, rollouts, episodes, policy_path, w, d, k, evaluator,
-                       spec, t0)
+        exp = setup(maze, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
+                    rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
+                    record_path=out / "vlm_recording.jsonl", spec=spec)
+        write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
+        return _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0)
 
 
-def _refine(maze_path, agent, method, proposer, seed, out, rollouts, episodes, policy_path, w, d, k, evaluator, spec,
-            t0) -> RunResult:
-    from .experiment import setup
-
-    exp = setup(maze_path, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
-                rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
-                record_path=out / "vlm_recording.jsonl", spec=spec)
+def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0) -> RunResult:
+    agent = exp.agent
     maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
 

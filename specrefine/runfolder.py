@@ -7,7 +7,8 @@
   :class:`~specrefine.errors.RunFolderError`.
 * ``out/.lock`` holds the pid (and start time) of the run using the folder; another live run's lock is
   refused, a lock left by a dead process (killed run) is taken over.
-* ``out/run.json`` records the run's arguments.  A rerun with the same arguments resumes (its cache is
+* ``out/run.json`` records the run's arguments (written by the caller with :func:`write_record` once they
+  proved usable, so that a refused run leaves none).  A rerun with the same arguments resumes (its cache is
   reused); a rerun with OTHER arguments into a folder that holds another run is refused with one line
   naming what differs: nothing is overwritten or moved, the user picks another ``--out`` or removes the
   old folder.  A folder from before run.json existed is taken as it is and gets a run.json.
@@ -97,19 +98,27 @@ def _unlock(out: Path, me: str) -> None:
 
 
 def _check_record(out: Path, args: dict) -> None:
+    """Refuse ``out`` if its run.json records other arguments."""
     record = out / RECORD
     try:
         old = json.loads(record.read_text())
     except FileNotFoundError:
         old = None
     except (OSError, ValueError):
-        raise RunFolderError(f"{record}: unreadable run record: remove it or use another --out") from None
+        old = []  # unreadable: refused below
+    if old is not None and not isinstance(old, dict):
+        raise RunFolderError(f"{record}: unreadable run record: remove it or use another --out")
     if old is not None:
         diff = [k for k in sorted(set(old) | set(args)) if old.get(k) != args.get(k)]
         if diff:
             what = ", ".join(f"{k} {old.get(k)!r} (now {args.get(k)!r})" for k in diff[:3])
             raise RunFolderError(f"{out} holds another run ({what}{', ...' if len(diff) > 3 else ''}): use "
                                  f"another --out, or remove the folder to start over")
+
+
+def write_record(out: Path, args: dict) -> None:
+    """``out/run.json``: the arguments of the run now using ``out`` (written atomically)."""
+    record = out / RECORD
     tmp = record.with_name(RECORD + ".tmp")
     tmp.write_text(json.dumps(args, indent=1, sort_keys=True))
     os.replace(tmp, record)
