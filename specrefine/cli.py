@@ -9,6 +9,7 @@ Bad input exits 2 with one line on stderr; never a traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -96,7 +97,10 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("specrefine: interrupted; evaluations so far are kept in the cache under --out", file=sys.stderr)
         return 130
-    print(result.summary())
+    try:
+        print(result.summary(), flush=True)
+    except BrokenPipeError:  # `specrefine refine ... | head`: the run is done and written; no traceback at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 

@@ -271,3 +271,41 @@ def test_any_argument_vector_gives_a_result_or_one_line(args):
             assert code == 2 and len(lines) == 1 and "Traceback" not in lines[0], (args, err.getvalue())
     finally:
         shutil.rmtree(out, ignore_errors=True)
+
+
+# --- more bad input: one line each ----------------------------------------------------------------------
+@pytest.mark.parametrize("agent,policy", [("ant", "point"), ("point", "ant")])
+def test_a_policy_for_the_other_agent_is_one_line(tmp_path, capsys, agent, policy):
+    from specrefine.paths import data_dir
+
+    path = data_dir() / "policies" / f"{policy}.pt"
+    assert_one_line_exit_2(cli_main, refine(tmp_path, "--agent", agent, "--policy", str(path)), capsys,
+                           f"holds a {policy} policy")
+    assert not (tmp_path / "run.json").exists()  # a refused run leaves no record
+
+
+@pytest.mark.parametrize("lines", [[b"\xff\xfe not utf-8"], [b"[1, 2]", b'"text"', b'{"response": "x"}',
+                                                              b'{"response": {"choices": "no"}}',
+                                                              b'{"response": {"choices": [{"text": 3}]}}']])
+def test_a_replay_file_of_the_wrong_shape_is_one_line(tmp_path, capsys, lines):
+    rec = tmp_path / "rec.jsonl"
+    rec.write_bytes(b"\n".join(lines) + b"\n")
+    assert_one_line_exit_2(cli_main, ["refine", "u_maze", "--out", str(tmp_path / "o"), *TINY, "--proposer",
+                                      f"replay:{rec}"], capsys, "unreadable lines")
+
+
+def test_a_maze_file_with_a_utf8_bom_is_read(tmp_path, capsys):
+    maze = tmp_path / "bom.maze"
+    maze.write_bytes(b"\xef\xbb\xbf" + ROOM.encode())
+    assert cli_main(["refine", str(maze), "--method", "dirl", "--out", str(tmp_path / "o"), *TINY]) == 0, \
+        capsys.readouterr().err
+    assert json.loads((tmp_path / "o" / "run.json").read_text())["maze_grid"] == ROOM.splitlines()[1:]
+
+
+def test_a_closed_stdout_is_no_traceback(tmp_path):
+    cmd = [sys.executable, "-c", "import sys; from specrefine.cli import main; sys.exit(main())",
+           *refine(tmp_path)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # as `| head` does once it has its lines
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 0 and "Traceback" not in err, err
