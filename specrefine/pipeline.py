@@ -67,9 +67,11 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
     from .experiment import setup
     from .mazes import Maze, load_maze
     from .runfolder import claim, write_record
+    from .spec import maze_task
 
     t0 = time.time()
     maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
+    maze_task(maze.for_agent(agent), spec)  # a bad agent or spec fails before the folder is touched
     args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": agent,
             "method": method, "proposer": proposer if method in PROPOSER_METHODS else None, "seed": seed,
             "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,
