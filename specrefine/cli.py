@@ -9,10 +9,12 @@ Bad input exits 2 with one line on stderr; never a traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
+from .argtypes import OneLineParser, bounded_int
 from .errors import SpecrefineError
 from .pipeline import METHODS
 
@@ -37,11 +39,7 @@ def proposer_arg(text: str) -> str:
         f"invalid proposer {text!r}: use geometric, random, imperfect:PRESET, replay:PATH or litellm:MODEL")
 
 
-class _OneLineParser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line (no usage block), still exit code 2."""
-
-    def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+_OneLineParser = OneLineParser  # the name other modules and tests know
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -66,17 +64,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the task as an expression over the maze's letters: a..z its subgoal regions, G the goal, "
                         "S implicit; '->' sequence, '|' choice (binds tighter), parentheses; must end in G; e.g. "
                         "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
-    r.add_argument("--seed", type=int, default=0, help="random seed for rollouts and proposers (default: 0)")
+    r.add_argument("--seed", type=bounded_int("seed"), default=0,
+                   help="random seed for rollouts and proposers (default: 0)")
     r.add_argument("--out", type=Path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
-    r.add_argument("--rollouts", type=int, default=32, help="rollouts per subtask evaluation (paper: 32)")
-    r.add_argument("--episodes", type=int, default=200,
+    r.add_argument("--rollouts", type=bounded_int("rollouts"), default=32,
+                   help="rollouts per subtask evaluation (paper: 32)")
+    r.add_argument("--episodes", type=bounded_int("episodes"), default=200,
                    help="fresh end-to-end episodes to measure the final policy on the original task")
     r.add_argument("--policy", type=Path, default=None,
                    help="policy checkpoint (default: the shipped data/policies/AGENT.pt)")
-    r.add_argument("-w", type=int, default=3, help="candidate edge splits per VLM query (paper: 3)")
-    r.add_argument("-d", type=int, default=2, help="VLM query rounds per edge split (paper: 2)")
-    r.add_argument("-k", type=int, default=5, help="subsets sampled per vertex refinement (paper: 5)")
+    r.add_argument("-w", type=bounded_int("w"), default=3,
+                   help="candidate edge splits per VLM query (paper: 3; at most 20)")
+    r.add_argument("-d", type=bounded_int("d"), default=2,
+                   help="VLM query rounds per edge split (paper: 2; at most 10)")
+    r.add_argument("-k", type=bounded_int("k"), default=5,
+                   help="subsets sampled per vertex refinement (paper: 5; at most 100)")
     return parser
 
 
@@ -94,7 +97,10 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("specrefine: interrupted; evaluations so far are kept in the cache under --out", file=sys.stderr)
         return 130
-    print(result.summary())
+    try:
+        print(result.summary(), flush=True)
+    except BrokenPipeError:  # `specrefine refine ... | head`: the run is done and written; no traceback at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 

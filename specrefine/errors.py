@@ -54,3 +54,11 @@ class ProposalRejected(SpecrefineError, ValueError):
 
     A proposer logs it, re-asks once and drops the candidate: it never ends a run.
     """
+
+
+class RunFolderError(SpecrefineError):
+    """An output folder that cannot be used: not a directory, unwritable, in use, or holding another run."""
+
+
+class SweepError(SpecrefineError):
+    """A sweep that cannot go on as asked (its --out holds cells run with other parameters)."""

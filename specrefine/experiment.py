@@ -48,7 +48,11 @@ def load_goal_policy(agent: str, policy="shipped"):
         return PointController(), "scripted straight-line controller (no learning)"
     if policy in (None, "shipped"):
         return load_policy(agent), f"shipped data/policies/{agent}.pt"
-    return load_policy(Path(policy)), f"trained policy {Path(policy).name}"
+    loaded = load_policy(Path(policy))
+    if getattr(loaded, "agent", agent) != agent:
+        raise PolicyError(f"{policy}: holds a {loaded.agent} policy, not one for the {agent}: pick the {agent}'s "
+                          f"checkpoint (or leave --policy out for the shipped one)")
+    return loaded, f"trained policy {Path(policy).name}"
 
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = 32,

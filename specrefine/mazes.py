@@ -178,6 +178,7 @@ class Maze:
 def parse_maze(text: str, name: str = "<maze>", cell_size: float = 1.0) -> Maze:
     """Parse maze text; any problem raises MazeError('name:line:col: what')."""
     rows, width, first_line, spec_line = [], None, None, None
+    text = text.removeprefix("\ufeff")  # a UTF-8 byte order mark, as some editors write
     for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.rstrip("\r\n").rstrip()
         if not line.strip() or line.lstrip().startswith(";"):
@@ -261,7 +262,7 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise MazeError(f"{path}: cannot read maze file ({exc.strerror or exc})") from None
     except UnicodeDecodeError:

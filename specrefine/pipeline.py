@@ -61,14 +61,33 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
                 rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
                 spec: str | None = None) -> RunResult:
     """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
-    ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain)."""
+    ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain).
+
+    ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
+    rerun with other arguments into it is refused, and so is a folder another live run is using.
+    """
     from .experiment import setup
+    from .mazes import Maze, load_maze
+    from .runfolder import claim, write_record
+    from .spec import maze_task
 
     t0 = time.time()
-    out = Path(out)
-    exp = setup(maze_path, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
-                rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
-                record_path=out / "vlm_recording.jsonl", spec=spec)
+    maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
+    maze_task(maze.for_agent(agent), spec)  # a bad agent or spec fails before the folder is touched
+    args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": agent,
+            "method": method, "proposer": proposer if method in PROPOSER_METHODS else None, "seed": seed,
+            "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,
+            "k": k, "spec": spec}
+    with claim(out, args) as out:
+        exp = setup(maze, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
+                    rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
+                    record_path=out / "vlm_recording.jsonl", spec=spec)
+        write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
+        return _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0)
+
+
+def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0) -> RunResult:
+    agent = exp.agent
     maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
 

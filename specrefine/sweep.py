@@ -11,6 +11,15 @@ A cell's ``spec`` (``--specs``, or ``MAZE=SPEC`` in ``--mazes``) is the task as 
 given, so the ids of default-task cells (and the rows of older tables, which lack the ``spec``
 column) stay valid; rows are appended in the columns of the table they go into.
 
+A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
+``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
+ids and tables stay valid).  ``OUT/sweep.json`` records each cell's ``rollouts`` and ``episodes`` (not part
+of the id): a rerun into the same ``OUT`` with other values is refused (exit 2) rather than silently
+keeping rows measured with the old ones.  A row counts as done only when its status is ``ok`` and its
+numbers are all there (a row cut short by a kill is redone), and at the end the table holds one row per
+cell (the last ``ok`` one, else the last failure).  Ctrl-C ends the sweep with one line and exit 130,
+keeping every finished row; pool workers die with the sweep's process.  Exit 1 when every cell failed.
+
 Backends: ``local`` (a process pool sized to the machine) and ``ray`` (the same cells as
 Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).
 """
@@ -18,18 +27,25 @@ Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).
 from __future__ import annotations
 
 import csv
+import hashlib
+import json
 import os
+import signal
 import sys
+import threading
 import time
 import traceback
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from tqdm.auto import tqdm
 
 from .agents import AGENTS
+from .argtypes import OneLineParser, bounded_int
+from .errors import SpecrefineError, SweepError
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -42,7 +58,7 @@ COLUMNS = [
 
 @dataclass(frozen=True)
 class Cell:
-    maze: str
+    maze: str  # a shipped maze's name, or the absolute path of any other maze file (see maze_ref)
     agent: str
     method: str
     proposer: str  # "none" for methods that use no proposer
@@ -54,7 +70,10 @@ class Cell:
     @property
     def id(self) -> str:
         prop = self.proposer.replace(":", "-").replace("/", "-")
-        task = f"{self.maze}__{spec_slug(self.spec)}" if self.spec else self.maze
+        name = self.maze
+        if Path(name).is_absolute():  # a file outside data/mazes: unique by its path
+            name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
+        task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}"
 
 
@@ -64,6 +83,19 @@ def spec_slug(spec: str) -> str:
     for old, new in (("->", "-then-"), ("|", "-or-"), ("(", "P"), (")", "Q")):
         text = text.replace(old, new)
     return text
+
+
+def maze_ref(arg: str) -> str:
+    """What a cell runs: a shipped maze (a name, or a path to the file in data/mazes) by its name; any other
+    existing file by its absolute path; anything else as given (loading it reports the error)."""
+    from .mazes import MAZE_DIR
+
+    path = Path(arg)
+    if not path.exists():
+        return arg
+    resolved = path.resolve()
+    shipped = MAZE_DIR / f"{path.stem}.maze"
+    return path.stem if shipped.exists() and shipped.resolve() == resolved else str(resolved)
 
 
 def split_maze_arg(arg: str) -> tuple[str, str]:
@@ -90,7 +122,7 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                 props = list(proposers) if method in PROPOSER_METHODS else ["none"]
                 for proposer in props:
                     for seed in seeds:
-                        cells.append(Cell(Path(maze).stem, agent, method, proposer, int(seed), rollouts, episodes,
+                        cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
                                           spec))
     return cells
 
@@ -145,6 +177,22 @@ def _typed(row: dict) -> dict:
     return out
 
 
+#: a row is done only when these hold numbers (a row cut short by a kill has empty fields)
+_NUMBERS = ("success_rate", "success_ci_low", "success_ci_high", "episodes", "evaluations", "graph_vertices")
+
+
+def is_done(row: dict) -> bool:
+    """An ``ok`` row with all its numbers (typed as by ``read_table``)."""
+    return row.get("status") == "ok" and all(
+        isinstance(row.get(k), (int, float)) and not isinstance(row.get(k), bool) for k in _NUMBERS)
+
+
+def _ends_cleanly(path: Path) -> bool:
+    with path.open("rb") as fh:
+        fh.seek(-1, os.SEEK_END)
+        return fh.read(1) == b"\n"
+
+
 def _append(path: Path, row: dict) -> None:
     new = not path.exists() or path.stat().st_size == 0
     columns = COLUMNS
@@ -157,30 +205,88 @@ def _append(path: Path, row: dict) -> None:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
+        elif not _ends_cleanly(path):  # a row cut short by a kill: end it, or this row would join it
+            fh.write("\r\n")
         writer.writerow({k: row.get(k, "") for k in columns})
         fh.flush()
         os.fsync(fh.fileno())
 
 
 def pending(cells: list[Cell], table: Path) -> list[Cell]:
-    done = {r["cell"] for r in read_table(table) if r.get("status") == "ok"}
+    done = {r["cell"] for r in read_table(table) if is_done(r)}
     return [c for c in cells if c.id not in done]
+
+
+def compact(table: Path) -> None:
+    """One row per cell: its last done row, else its last row; first-appearance order, the table's own header."""
+    if not table.exists():
+        return
+    with table.open(newline="") as fh:
+        reader = csv.DictReader(fh)
+        columns, raw = reader.fieldnames, list(reader)
+    if not columns:
+        return
+    keep: dict[str, dict] = {}
+    for row in raw:
+        old = keep.get(row["cell"])
+        if old is None or is_done(_typed(row)) or not is_done(_typed(old)):
+            keep[row["cell"]] = row
+    if len(keep) == len(raw):
+        return
+    tmp = table.with_suffix(".csv.tmp")
+    with tmp.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows({k: v if v is not None else "" for k, v in r.items() if k is not None}
+                         for r in keep.values())
+    os.replace(tmp, table)
+
+
+PARAMS = ("rollouts", "episodes")  # what a cell's rows depend on beyond its id
+
+
+def check_params(cells: list[Cell], out_root: Path) -> None:
+    """Refuse cells whose id ``OUT`` already holds with other ``PARAMS`` (``OUT/sweep.json``, or for older
+    tables the rows' ``rollouts_per_evaluation``); record the new cells' parameters."""
+    record = out_root / "sweep.json"
+    known = json.loads(record.read_text())["cells"] if record.exists() else {}
+    for row in read_table(out_root / "results.csv"):
+        if row.get("cell") not in known and isinstance(row.get("rollouts_per_evaluation"), float):
+            known[row["cell"]] = {"rollouts": int(row["rollouts_per_evaluation"])}
+    for cell in cells:
+        old = known.get(cell.id, {})
+        diff = [f"--{k} {old[k]}" for k in PARAMS if k in old and old[k] != getattr(cell, k)]
+        if diff:
+            raise SweepError(f"{out_root} holds cell {cell.id} run with {' '.join(diff)}; rerun with those values "
+                             f"or use another --out")
+    known.update({c.id: {k: getattr(c, k) for k in PARAMS} for c in cells})
+    tmp = record.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps({"cells": known}, indent=1, sort_keys=True))
+    os.replace(tmp, record)
 
 
 def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
               address: str | None = None, retries: int = 1) -> Path:
-    """Run every pending cell, appending rows to OUT/results.csv; returns the table's path."""
-    out_root = Path(out_root)
-    out_root.mkdir(parents=True, exist_ok=True)
+    """Run every pending cell, appending rows to OUT/results.csv; returns the table's path.
+
+    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters.
+    """
+    from .runfolder import ensure_dir
+
+    out_root = ensure_dir(out_root)
     table = out_root / "results.csv"
-    for attempt in range(retries + 1):
-        todo = pending(cells, table)
-        if not todo:
-            break
-        runner = _run_ray if backend == "ray" else _run_local
-        for row in tqdm(runner(todo, str(out_root), workers, address), total=len(todo),
-                        desc=f"sweep ({backend}, try {attempt + 1})"):
-            _append(table, row)
+    check_params(cells, out_root)
+    try:
+        for attempt in range(retries + 1):
+            todo = pending(cells, table)
+            if not todo:
+                break
+            runner = _run_ray if backend == "ray" else _run_local
+            for row in tqdm(runner(todo, str(out_root), workers, address), total=len(todo),
+                            desc=f"sweep ({backend}, try {attempt + 1})"):
+                _append(table, row)
+    finally:
+        compact(table)
     return table
 
 
@@ -190,16 +296,57 @@ def _run_local(cells, out_root, workers, _address):
         for cell in cells:
             yield run_cell(cell, out_root)
         return
-    with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init) as pool:
-        futures = [pool.submit(run_cell, cell, out_root) for cell in cells]
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),),
+                               mp_context=_mp_context())
+    finished = False
+    try:
+        futures = {pool.submit(run_cell, cell, out_root): cell for cell in cells}
         for fut in as_completed(futures):
-            yield fut.result()
+            yield _row_of(fut, futures[fut])
+        finished = True
+    finally:
+        if not finished:  # interrupted: no waiting for running cells
+            _stop(pool)
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _worker_init():
+def _row_of(fut, cell: Cell) -> dict:
+    try:
+        return fut.result()
+    except BrokenProcessPool:  # a worker was killed (out of memory?) or crashed: the cell failed, the sweep goes on
+        return {**asdict(cell), "cell": cell.id, "status": "error",
+                "error": "the worker process running this cell died (killed or crashed)"}
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        proc.terminate()
+    for proc in procs:
+        proc.join(timeout=5)
+
+
+def _mp_context():
+    """fork where there is one (Linux's default before Python 3.14): a worker's parent is then the sweep itself."""
+    import multiprocessing
+
+    return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+
+
+def _worker_init(parent: int):
+    """A pool worker: Ctrl-C is the parent's to handle, and the worker ends when its parent (the sweep) is gone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True, name="sweep-parent").start()
     import torch
 
     torch.set_num_threads(1)
+
+
+def _exit_with_parent(parent: int, every: float = 0.5) -> None:
+    while os.getppid() == parent:
+        time.sleep(every)
+    os._exit(1)  # orphaned: the sweep that started this worker was killed
 
 
 def _run_ray(cells, out_root, _workers, address):
@@ -236,7 +383,6 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
 
 def _check_specs(cells: list[Cell]) -> str | None:
     """The first bad (maze, spec) pair's one-line message, before any cell runs (None: all fine)."""
-    from .errors import SpecrefineError
     from .mazes import load_maze
     from .spec import maze_task
 
@@ -249,11 +395,9 @@ def _check_specs(cells: list[Cell]) -> str | None:
 
 
 def main(argv=None) -> int:
-    import argparse
-
     from .mazes import benchmark_mazes
 
-    p = argparse.ArgumentParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
     p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
                    help="maze names or files; MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
@@ -261,27 +405,37 @@ def main(argv=None) -> int:
                         "'' = the maze's own task; default: the maze's own task)")
     p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
     p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
-    p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
+    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
-    p.add_argument("--rollouts", type=int, default=32)
-    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
+    p.add_argument("--episodes", type=bounded_int("episodes"), default=200)
     p.add_argument("--out", default="runs/sweep")
     p.add_argument("--backend", choices=["local", "ray"], default="local")
     p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
-    p.add_argument("--workers", type=int, default=None, help="local processes (default: CPU count)")
+    p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                  episodes=args.episodes, specs=args.specs)
     bad = _check_specs(cells)
     if bad:
-        print(f"python -m specrefine.sweep: error: {bad}", file=sys.stderr)
-        return 2
+        return _fail(bad, 2)
     t0 = time.time()
-    table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
-    rows = read_table(table)
-    failed = [r for r in rows if r.get("status") != "ok"]
-    print(f"{len(cells)} cells -> {table} ({len(failed)} failed rows) in {time.time() - t0:.0f} s")
-    return 0
+    try:
+        table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
+    except SpecrefineError as exc:
+        return _fail(str(exc), 2)
+    except KeyboardInterrupt:
+        return _fail(f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun the same "
+                     f"command to resume", 130)
+    done = {r["cell"] for r in read_table(table) if is_done(r)}
+    failed = sum(c.id not in done for c in cells)
+    print(f"{len(cells)} cells -> {table} ({failed} failed) in {time.time() - t0:.0f} s")
+    return 1 if cells and failed == len(cells) else 0
+
+
+def _fail(message: str, code: int) -> int:
+    print(f"python -m specrefine.sweep: error: {message}", file=sys.stderr)
+    return code
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ import logging
 import re
 import struct
 import threading
+import time
 import zlib
 from pathlib import Path
 
@@ -384,3 +385,16 @@ def test_one_shot_example_in_prompt_is_a_valid_answer():
     g, why = parse_graph(answer, example, maze_task(example))
     assert len(g.vertices()) == 6 and len(g.edges()) == 5 and "corridor" in why
     assert check_refines(g, maze_task(example)) == []
+
+
+def test_a_request_ends_at_its_deadline_with_one_line(srv, tmp_path, query, monkeypatch):
+    srv.script[:] = [500] * 20
+    client = LiteLLMClient(MODEL, api_base=srv.base, record_path=tmp_path / "rec.jsonl", retry_wait=1.0,
+                           num_retries=10, timeout=10, deadline=0.5)
+    t0 = time.monotonic()
+    with pytest.raises(VLMUnavailable, match=r"no answer within the 0.5 s deadline .* after 1 attempts") as e:
+        VLMProposer(client).propose_split(query, 1)
+    assert time.monotonic() - t0 < 5 and "\n" not in str(e.value)  # not 10 retries with back-off
+    monkeypatch.setenv("SPECREFINE_VLM_DEADLINE", "-1")
+    with pytest.raises(VLMConfigError, match="SPECREFINE_VLM_DEADLINE"):
+        LiteLLMClient(MODEL, api_base=srv.base, record_path=tmp_path / "rec.jsonl")

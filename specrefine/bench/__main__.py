@@ -2,36 +2,37 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import warnings
 
 from ..agents import AGENTS
+from ..argtypes import OneLineParser, bounded_int, positive_float
 from . import __doc__ as package_doc
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m specrefine.bench", description=package_doc.splitlines()[0])
+    ap = OneLineParser(prog="python -m specrefine.bench", description=package_doc.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
     e = sub.add_parser("evaluator", help="env steps/s of the subtask evaluator vs raw mujoco.rollout")
     e.add_argument("--agent", choices=list(AGENTS), default="point")
-    e.add_argument("--batch", type=int, default=32)
-    e.add_argument("--seconds", type=float, default=6.0, help="time spent in the evaluator measurement")
-    e.add_argument("--horizon", type=int, default=None)
-    e.add_argument("--torch-threads", type=int, default=1)
-    e.add_argument("--nthread", type=int, default=None, help="mujoco.rollout threads (default: up to 2)")
+    e.add_argument("--batch", type=bounded_int("batch"), default=32)
+    e.add_argument("--seconds", type=positive_float, default=6.0, help="time spent in the evaluator measurement")
+    e.add_argument("--horizon", type=bounded_int("horizon"), default=None)
+    e.add_argument("--torch-threads", type=bounded_int("torch_threads"), default=1)
+    e.add_argument("--nthread", type=bounded_int("nthread"), default=None,
+                   help="mujoco.rollout threads (default: up to 2)")
     e.add_argument("--scenario", default="open",
                    help="'open' (open room, full-length rollouts) or a maze name (S -> G, early exits)")
-    e.add_argument("--rounds", type=int, default=3)
+    e.add_argument("--rounds", type=bounded_int("rounds"), default=3)
     g = sub.add_parser("gymenv", help="the evaluator and TorchRL GymEnv around Gymnasium-Robotics, in one run")
     g.add_argument("--agent", choices=("point", "ant"), default="ant")
-    g.add_argument("--batch", type=int, default=32)
-    g.add_argument("--seconds", type=float, default=9.0)
-    g.add_argument("--gym-steps", type=int, default=2000)
+    g.add_argument("--batch", type=bounded_int("batch"), default=32)
+    g.add_argument("--seconds", type=positive_float, default=9.0)
+    g.add_argument("--gym-steps", type=bounded_int("gym_steps"), default=2000)
     t = sub.add_parser("train", help="PPO training frames/s: our config vs the reference TorchRL config")
     t.add_argument("--agent", choices=list(AGENTS), default="ant")
-    t.add_argument("--batches", type=int, default=4, help="measured batches per configuration")
+    t.add_argument("--batches", type=bounded_int("batches"), default=4, help="measured batches per configuration")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore")
     from . import bench_evaluator, bench_gymenv, bench_train

@@ -4,7 +4,9 @@
 ``gemini/gemini-2.0-flash``, ``anthropic/claude-sonnet-4-5``, ``ollama/llava``, ...): images go as
 base64 PNG data URLs, ``w`` samples per query (``n`` where the provider has it, else ``w`` calls),
 JSON response format where supported, timeouts, and logged retries with back-off on rate limits,
-server errors and dropped connections.  Tokens and cost are counted per call (cost 0 for models
+server errors and dropped connections (a provider's ``Retry-After`` honoured up to 60 s).  One request,
+retries included, ends within ``deadline`` seconds (default 600, or ``SPECREFINE_VLM_DEADLINE``): past it
+the run stops with one line saying what timed out.  Tokens and cost are counted per call (cost 0 for models
 LiteLLM has no price for).  Keys are read by LiteLLM from the environment only; nothing this
 module writes (recordings, logs, error messages) ever contains them.  Every real call is appended
 to a recording (:mod:`specrefine.vlm.recording`).
@@ -44,6 +46,18 @@ def _litellm():
     return litellm
 
 
+def _deadline(value: float | None) -> float:
+    """Seconds one request may take, retries included: ``value``, else $SPECREFINE_VLM_DEADLINE, else 600."""
+    text = os.environ.get("SPECREFINE_VLM_DEADLINE", "600") if value is None else value
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = float("nan")
+    if not 0 < seconds < float("inf"):
+        raise VLMConfigError(f"VLM deadline {text!r} (SPECREFINE_VLM_DEADLINE): use a number of seconds > 0")
+    return seconds
+
+
 def _priced(lt, model: str) -> bool:
     try:
         info = lt.get_model_info(model)
@@ -66,8 +80,10 @@ class LiteLLMClient(VLMClient):
     def __init__(self, model: str, *, record_path: str | Path | None = None, record: bool = True,
                  api_base: str | None = None, timeout: float = 120.0, num_retries: int = 3,
                  retry_wait: float = 2.0, json_mode: bool = True, temperature: float | None = None,
-                 max_tokens: int | None = None, check_env: bool = True):
+                 max_tokens: int | None = None, check_env: bool = True, deadline: float | None = None):
         super().__init__()
+        self.deadline = _deadline(deadline)
+        self._until = float("inf")
         self.model = model
         self.name = f"litellm:{model}"
         self.api_base = api_base
@@ -119,6 +135,7 @@ class LiteLLMClient(VLMClient):
 
     # -- one request -------------------------------------------------------------------------
     def complete(self, messages: list[dict], n: int = 1) -> list[str]:
+        self._until = time.monotonic() + self.deadline
         texts: list[str] = []
         for _ in range(n + 1):  # n calls at most when the provider has no `n`, plus one spare
             if len(texts) >= n:
@@ -128,7 +145,8 @@ class LiteLLMClient(VLMClient):
         return texts[:n]
 
     def _kwargs(self, messages, n) -> dict:
-        kw: dict[str, Any] = {"model": self.model, "messages": messages, "timeout": self.timeout,
+        timeout = max(0.001, min(self.timeout, self._until - time.monotonic()))
+        kw: dict[str, Any] = {"model": self.model, "messages": messages, "timeout": timeout,
                               "num_retries": 0, "max_retries": 0}  # retries are ours (logged), not nested
         if self.api_base:
             kw["api_base"] = self.api_base
@@ -182,6 +200,7 @@ class LiteLLMClient(VLMClient):
                                          f"(404); {_MODEL_HINT}") from None
                 if isinstance(exc, retryable) and attempt <= self.num_retries:
                     wait = self._wait(exc, attempt)
+                    self._check_deadline(wait, attempt, exc)
                     log.warning("VLM %s: %s (%s); retry %d/%d in %.1fs", self.model, type(exc).__name__,
                                 one_line(exc, 100), attempt, self.num_retries, wait)
                     time.sleep(wait)
@@ -220,6 +239,12 @@ class LiteLLMClient(VLMClient):
             log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(texts), pt, ct, cost,
                      latency)
             return texts
+
+    def _check_deadline(self, wait: float, attempt: int, exc) -> None:
+        if time.monotonic() + wait >= self._until:
+            raise VLMUnavailable(f"litellm:{self.model}: no answer within the {self.deadline:g} s deadline of one "
+                                 f"request (SPECREFINE_VLM_DEADLINE) after {attempt} attempts; the last: "
+                                 f"{type(exc).__name__} ({one_line(exc, 100)})") from None
 
     def _wait(self, exc, attempt: int) -> float:
         wait = self.retry_wait * (2 ** (attempt - 1))

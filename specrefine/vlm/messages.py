@@ -2,7 +2,11 @@
 transcript, the scrubbing of secrets, and :class:`VLMClient`, what a proposer needs from a model.
 
 Keys are read by LiteLLM from the environment only; :func:`scrub` keeps every key-like value out
-of anything this package writes (recordings, logs, error messages).
+of anything this package writes (recordings, logs, error messages): the value of every set environment
+variable whose name looks like a key, whatever its length.  A value of 8 characters or more is replaced
+wherever it occurs; a shorter one (a test key, a 1-2 character placeholder) only where it stands as a whole
+token, so that a key ``ab`` hides ``ab`` but leaves ``table`` alone; flag values (``true``, ``0``, ...) of
+variables such as ``TOKENIZERS_PARALLELISM`` are no secrets and are left alone.
 """
 
 from __future__ import annotations
@@ -19,9 +23,24 @@ _SECRET_FIELDS = {"api_key", "apikey", "authorization", "x-api-key", "x-goog-api
                   "proxy-authorization", "aws_secret_access_key", "aws_session_token"}
 
 
+LONG_SECRET = 8  # a secret this long is replaced anywhere; a shorter one only as a whole token
+_FLAGS = {"", "0", "1", "true", "false", "yes", "no", "on", "off", "none", "null"}
+
+
 def _secret_values() -> list[str]:
-    vals = {v for k, v in os.environ.items() if _SECRET_ENV.search(k) and isinstance(v, str) and len(v) >= 8}
+    vals = {v for k, v in os.environ.items()
+            if _SECRET_ENV.search(k) and isinstance(v, str) and v.strip().lower() not in _FLAGS}
     return sorted(vals, key=len, reverse=True)
+
+
+def scrub_text(text: str, secrets: list[str], long_only: bool = False) -> str:
+    """``text`` with each secret replaced by ``***`` (short ones only as whole tokens; none if ``long_only``)."""
+    for s in secrets:
+        if len(s) >= LONG_SECRET:
+            text = text.replace(s, "***")
+        elif not long_only and s in text:
+            text = re.sub(rf"(?<![\w-]){re.escape(s)}(?![\w-])", "***", text)
+    return text
 
 
 def scrub(obj: Any, secrets: list[str] | None = None) -> Any:
@@ -32,10 +51,7 @@ def scrub(obj: Any, secrets: list[str] | None = None) -> Any:
     if isinstance(obj, (list, tuple)):
         return [scrub(v, secrets) for v in obj]
     if isinstance(obj, str):
-        for s in secrets:
-            if s in obj:
-                obj = obj.replace(s, "***")
-        return obj
+        return scrub_text(obj, secrets)
     return obj
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ..errors import ReplayMiss, VLMConfigError
 from ..paths import data_dir
-from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub
+from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub, scrub_text
 
 log = logging.getLogger(__name__)
 
@@ -62,11 +62,40 @@ class Recorder:
         record["request"] = dict(record.get("request", {}), messages=self._store_messages(messages))
         secrets = _secret_values()
         line = json.dumps(scrub(record, secrets), ensure_ascii=False, sort_keys=False)
-        for s in secrets:  # belt and braces: no secret value survives, whatever field it hid in
-            line = line.replace(s, "***")
+        # belt and braces: no long secret survives, whatever field it hid in (short ones could match JSON syntax)
+        line = scrub_text(line, secrets, long_only=True)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with self.path.open("a", encoding="utf-8") as fh:
             fh.write(line + "\n")
+
+
+def _parse_record(line: bytes) -> dict | None:
+    """One recording line as a record dict, or None when it is not UTF-8 JSON of a recorded call's shape."""
+    try:
+        rec = json.loads(line.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError):
+        return None
+    if not isinstance(rec, dict):
+        return None
+    if rec.get("error") or not rec.get("response"):
+        return {**rec, "response": None}  # a failed call: nothing to replay
+    return rec if _answer_shape(rec) else None
+
+
+def _number(value) -> bool:
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
+
+
+def _answer_shape(rec: dict) -> bool:
+    response = rec["response"]
+    if not isinstance(response, dict) or not isinstance(response.get("usage", {}), dict):
+        return False
+    choices, usage = response.get("choices", []), response.get("usage", {})
+    return (isinstance(choices, list) and all(isinstance(c, dict) and isinstance(c.get("text", ""), str)
+                                              for c in choices)
+            and all(isinstance(rec.get(k), (str, type(None))) for k in ("key", "text_key"))
+            and all(_number(v) for v in (usage.get("prompt_tokens"), usage.get("completion_tokens"),
+                                         rec.get("cost_usd"))))
 
 
 class ReplayClient(VLMClient):
@@ -82,23 +111,25 @@ class ReplayClient(VLMClient):
         self.path = Path(path)
         self.strict = strict
         try:
-            lines = self.path.read_text(encoding="utf-8").splitlines()
+            lines = self.path.read_bytes().splitlines()
         except OSError as exc:
             raise VLMConfigError(f"replay:{path}: cannot read the recording ({exc.strerror or exc})") from None
         self.records: list[dict] = []
+        bad = []  # line numbers that are not UTF-8 JSON of a recorded call's shape
         for lineno, line in enumerate(lines, start=1):
             if not line.strip():
                 continue
-            try:
-                rec = json.loads(line)
-            except json.JSONDecodeError:
-                log.warning("replay %s:%d: not JSON, skipped", path, lineno)
-                continue
-            if rec.get("error") or not rec.get("response"):
-                continue
-            self.records.append(rec)
+            rec = _parse_record(line)
+            if rec is None:
+                bad.append(lineno)
+            elif not rec.get("error") and rec["response"]:
+                self.records.append(rec)
         if not self.records:
-            raise VLMConfigError(f"replay:{path}: the recording holds no answered calls")
+            unreadable = f" ({len(bad)} unreadable lines, the first line {bad[0]})" if bad else ""
+            raise VLMConfigError(f"replay:{path}: the recording holds no answered calls{unreadable}")
+        if bad:
+            log.warning("replay %s: %d unreadable lines skipped (not UTF-8 JSON of a recorded call; the first: "
+                        "line %d)", path, len(bad), bad[0])
         models = sorted({r.get("model", "?") for r in self.records})
         self.model = models[0] if len(models) == 1 else "+".join(models)
         self.name = f"replay:{path}"

@@ -1,0 +1,54 @@
+"""argparse ``type=`` functions for the command lines' numbers: a nonsense or absurd value is a one-line usage
+error (exit 2) before anything runs, never a hang, a traceback or a silently meaningless result.
+
+The caps are far above what the paper uses (w = 3, d = 2, k = 5, 32 rollouts, 200 episodes): they only stop
+values that would run for days (``-w 1000000``) or overflow a seed.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (no usage block), still exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+MAX_SEED = 2**31 - 1
+#: option -> (smallest, largest) accepted value
+LIMITS = {
+    "w": (1, 20), "d": (1, 10), "k": (1, 100), "rollouts": (1, 4096), "episodes": (1, 100_000),
+    "seed": (0, MAX_SEED), "workers": (1, 256), "batch": (1, 65_536), "rounds": (1, 1000), "horizon": (1, 100_000),
+    "torch_threads": (1, 256), "nthread": (1, 256), "gym_steps": (1, 10_000_000), "batches": (1, 10_000),
+}
+
+
+def bounded_int(name: str):
+    """An argparse type: an integer within ``LIMITS[name]``, else a one-line message naming the range."""
+    lo, hi = LIMITS[name]
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{value} is out of range: use {lo} to {hi}")
+        return value
+
+    parse.__name__ = name  # argparse names the type in its messages
+    return parse
+
+
+def positive_float(text: str) -> float:
+    """An argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"{text} must be a finite number > 0")
+    return value
