@@ -18,7 +18,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from specrefine import bench, sweep
+from specrefine import sweep
+from specrefine.bench.__main__ import main as bench_main
 from specrefine.cli import main as cli_main
 
 TINY = ["--rollouts", "2", "--episodes", "2"]
@@ -63,7 +64,7 @@ def test_sweep_rejects_nonsense_numbers(tmp_path, capsys, args):
 
 @pytest.mark.parametrize("args", [["--batch", "0"], ["--batch", "-4"], ["--rounds", "0"], ["--seconds", "0"]])
 def test_bench_rejects_nonsense_numbers(capsys, args):
-    assert_one_line_exit_2(bench.main, ["evaluator", *args], capsys, "error")
+    assert_one_line_exit_2(bench_main, ["evaluator", *args], capsys, "error")
 
 
 # --- the sweep: maze files, parameters, truncated rows, exit codes ------------------------------------
