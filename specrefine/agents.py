@@ -16,7 +16,7 @@ from .errors import SpecrefineError
 
 @dataclass(frozen=True)
 class ReachTask:
-    """The open-floor training task of the goal-conditioned policy (see ``sim.GoalReachEnv``)."""
+    """The open-floor training task of the goal-conditioned policy (see ``reach_env.GoalReachEnv``)."""
 
     goal_min: float
     goal_max: float

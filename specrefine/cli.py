@@ -80,6 +80,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="VLM query rounds per edge split (paper: 2; at most 10)")
     r.add_argument("-k", type=bounded_int("k"), default=5,
                    help="subsets sampled per vertex refinement (paper: 5; at most 100)")
+    r.add_argument("--evaluation", choices=["fixed", "adaptive"], default="fixed",
+                   help="fixed: every subtask estimate on --rollouts rollouts (the paper); adaptive: the vertex "
+                        "refinement's candidates in stages, stopping those that cannot be chosen (same full "
+                        "budget for what is chosen; far fewer simulator steps)")
     return parser
 
 
@@ -90,7 +94,8 @@ def main(argv=None) -> int:
 
         result = refine_maze(args.maze, agent=args.agent, method=args.method, proposer=args.proposer,
                              seed=args.seed, out=args.out, rollouts=args.rollouts, episodes=args.episodes,
-                             policy_path=args.policy, w=args.w, d=args.d, k=args.k, spec=args.spec)
+                             policy_path=args.policy, w=args.w, d=args.d, k=args.k, spec=args.spec,
+                             evaluation=args.evaluation)
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2

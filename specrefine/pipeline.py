@@ -19,6 +19,7 @@ import numpy as np
 from .calibrate import predict
 from .errors import SpecrefineError
 from .graph import check_refines
+from .refine.search import EVALUATIONS
 from .spec import maze_spec_text
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
@@ -59,9 +60,12 @@ class RunResult:
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
                 rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
-                spec: str | None = None) -> RunResult:
+                spec: str | None = None, evaluation: str = "fixed") -> RunResult:
     """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
     ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain).
+
+    ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts, the paper's protocol) or
+    "adaptive" (the chain DP by branch and bound with staged rollouts: :mod:`specrefine.refine.racing`).
 
     ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
@@ -78,15 +82,19 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
             "method": method, "proposer": proposer if method in PROPOSER_METHODS else None, "seed": seed,
             "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,
             "k": k, "spec": spec}
+    if evaluation != "fixed":  # run folders of the fixed protocol keep the records they always had
+        args["evaluation"] = evaluation
+    if evaluation not in EVALUATIONS:
+        raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {evaluation!r}")
     with claim(out, args) as out:
         exp = setup(maze, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
                     rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
                     record_path=out / "vlm_recording.jsonl", spec=spec)
         write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
-        return _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0)
+        return _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evaluation)
 
 
-def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0) -> RunResult:
+def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evaluation="fixed") -> RunResult:
     agent = exp.agent
     maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
     with (out / "steps.jsonl").open("w") as steps_log:
@@ -95,50 +103,52 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0) -> Ru
             steps_log.write(json.dumps(step, default=_jsonable) + "\n")
             steps_log.flush()
 
-        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step)
+        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step, evaluation)
     measured = _measure(evaluator, original, search, episodes, seed)
     prediction = predict(evaluator, search.graph, search.path, original.region(original.initial), seed, episodes)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out legs, Jeffreys posterior of the product
+    data["evaluation"] = evaluation
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
 
 
-def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step):
+def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step, evaluation="fixed"):
     from .refine import RefinementSearch, SearchConfig, shortest_path
 
     if method == "dirl":
         return shortest_path(original, evaluator, seed=seed)
     if method == "symbolic":
-        cfg = SearchConfig(k=k, edge_refinement=False, seed=seed)
+        cfg = SearchConfig(k=k, edge_refinement=False, seed=seed, evaluation=evaluation)
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
     if method.startswith("ours"):
         cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
-                           vertex_refinement=method != "ours-novertex")
+                           vertex_refinement=method != "ours-novertex", evaluation=evaluation)
         query_for = edge_query_builder(maze, agent, evaluator.facts())
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
                                 query_for=query_for, picture=candidate_picture(maze)).run()
     if method.startswith("vlm-oneshot"):
         from .refine.oneshot import oneshot
 
-        budget = budget_of_ours(original, evaluator, proposer.spec, maze, agent, seed, w, d, k) \
+        budget = budget_of_ours(original, evaluator, proposer.spec, maze, agent, seed, w, d, k, evaluation) \
             if method == "vlm-oneshot-matched" else None
         return oneshot(original, evaluator, proposer, maze=maze, agent=agent, w=w, rounds=d, seed=seed,
                        on_step=on_step, budget=budget)
     raise SpecrefineError(f"unknown method {method!r}")
 
 
-def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, k) -> tuple[int, int]:
+def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, k, evaluation="fixed"
+                   ) -> tuple[int, int]:
     """(proposer calls, subtask evaluations) that ``ours`` spends on this task and seed (run here, on its own cache)."""
     from .proposers import make_proposer
 
     cache = evaluator.cache_dir.parent / "budget_cache" if evaluator.cache_dir is not None else None
     twin = evaluator.fresh_copy(cache_dir=cache)
     proposer = make_proposer(proposer_spec, seed=seed)
-    _search("ours", original, twin, proposer, maze, agent, seed, w, d, k, on_step=None)
+    _search("ours", original, twin, proposer, maze, agent, seed, w, d, k, on_step=None, evaluation=evaluation)
     return proposer.proposer_calls, twin.evaluations + twin.disk_hits
 
 

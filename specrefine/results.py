@@ -109,3 +109,23 @@ def unreached(state_dim: int = 0) -> EdgeResult:
     return EdgeResult(0.0, wilson_ci(0, 0), 0, 0, np.zeros(0, bool), np.zeros((0, 1, 2), np.float32),
                       np.zeros(0, np.int64), StartStates(np.zeros((0, state_dim)), np.zeros((0, 2))), 0,
                       outcome=np.zeros(0, np.int8))
+
+
+def merge_edge_results(a: EdgeResult, b: EdgeResult) -> EdgeResult:
+    """One estimate from two independent batches of rollouts of the same subtask (a's rollouts first)."""
+    T = max(a.trajectories.shape[1], b.trajectories.shape[1])
+    success = np.concatenate([a.success, b.success])
+    k, n = int(success.sum()), a.n + b.n
+    ends = StartStates(np.concatenate([a.end_states.states, b.end_states.states]),
+                       np.concatenate([a.end_states.xy, b.end_states.xy]))
+    return EdgeResult(p=k / n if n else 0.0, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                      trajectories=np.concatenate([_pad_to(a.trajectories, T), _pad_to(b.trajectories, T)]),
+                      lengths=np.concatenate([a.lengths, b.lengths]), end_states=ends, steps=a.steps + b.steps,
+                      cached=a.cached and b.cached, outcome=np.concatenate([a.outcome, b.outcome]))
+
+
+def _pad_to(traj: np.ndarray, T: int) -> np.ndarray:
+    """Trajectories padded to T points with each row's last point (rows are already padded that way)."""
+    if traj.shape[1] >= T:
+        return traj
+    return np.concatenate([traj, np.repeat(traj[:, -1:], T - traj.shape[1], axis=1)], axis=1)

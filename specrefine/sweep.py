@@ -52,7 +52,7 @@ COLUMNS = [
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
-    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high",
+    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation",
 ]
 
 
@@ -66,6 +66,7 @@ class Cell:
     rollouts: int = 32
     episodes: int = 200
     spec: str = ""  # the task as a spec expression; "" = the maze's own task
+    evaluation: str = "fixed"  # "fixed" (the paper's protocol) or "adaptive" (specrefine.refine.racing)
 
     @property
     def id(self) -> str:
@@ -74,7 +75,8 @@ class Cell:
         if Path(name).is_absolute():  # a file outside data/mazes: unique by its path
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
         task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
-        return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}"
+        tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
+        return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
 
 
 def spec_slug(spec: str) -> str:
@@ -106,7 +108,7 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = 32, episodes: int = 200,
-         specs: Iterable[str | None] = (None,)) -> list[Cell]:
+         specs: Iterable[str | None] = (None,), evaluation: str = "fixed") -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
@@ -123,7 +125,7 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                 for proposer in props:
                     for seed in seeds:
                         cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
-                                          spec))
+                                          spec, evaluation))
     return cells
 
 
@@ -136,7 +138,7 @@ def run_cell(cell: Cell, out_root: str) -> dict:
         result = refine_maze(cell.maze, agent=cell.agent, method=cell.method,
                              proposer="geometric" if cell.proposer == "none" else cell.proposer, seed=cell.seed,
                              out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes,
-                             spec=cell.spec or None)
+                             spec=cell.spec or None, evaluation=cell.evaluation)
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
@@ -201,6 +203,8 @@ def _append(path: Path, row: dict) -> None:
             columns = next(csv.reader(fh), None) or COLUMNS
         if row.get("spec") and "spec" not in columns:
             raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
+        if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
+            raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
     with path.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
@@ -409,13 +413,16 @@ def main(argv=None) -> int:
     p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
     p.add_argument("--episodes", type=bounded_int("episodes"), default=200)
+    p.add_argument("--evaluation", choices=["fixed", "adaptive"], default="fixed",
+                   help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
+                        "when adaptive)")
     p.add_argument("--out", default="runs/sweep")
     p.add_argument("--backend", choices=["local", "ray"], default="local")
     p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
-                 episodes=args.episodes, specs=args.specs)
+                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation)
     bad = _check_specs(cells)
     if bad:
         return _fail(bad, 2)

@@ -7,7 +7,7 @@ explained variance) go into the curves.
     python -m specrefine.train --agent ant --evaluate data/policies/ant.pt --episodes 500
     python -m specrefine.train --agent ant --evaluate ant --chain 8 --goal-range 3 5   # goals in a row
 
-Task: reach a goal sampled on the open floor (``specrefine.sim.GoalReachEnv``); the policy never
+Task: reach a goal sampled on the open floor (``specrefine.reach_env.GoalReachEnv``); the policy never
 sees a maze.  ``OUT/`` receives ``checkpoint.pt`` (everything needed to resume), ``policy.pt``
 (the shippable policy), ``log.jsonl`` (one line per batch) and ``curve.png``.
 
@@ -36,7 +36,7 @@ from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_lo
 from .errors import SpecrefineError
 from .policy import GoalPolicy, load_policy, mlp, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
-from .sim import GoalReachEnv
+from .reach_env import GoalReachEnv
 
 __all__ = ["PPO_DIAGNOSTICS", "Config", "Trainer", "config_arguments", "explained_variance", "make_config", "main",
            "make_modules", "train",

@@ -24,10 +24,27 @@ def test_evaluator_benchmark_prints_one_json_line():
     assert out["env_steps_per_s"] > 0 and out["env_steps"] > 0 and out["horizon"] == 20
 
 
-@pytest.mark.parametrize("what", ["evaluator", "gymenv", "train"])
+@pytest.mark.parametrize("what", ["evaluator", "gymenv", "train", "refine"])
 def test_every_benchmark_is_a_subcommand(what, capsys):
     from specrefine.bench.__main__ import main
 
     with pytest.raises(SystemExit) as e:
         main([what, "--help"])
     assert e.value.code == 0 and "--agent" in capsys.readouterr().out
+
+
+def test_refine_benchmark_runs_both_evaluations_and_resumes(tmp_path, capsys):
+    from specrefine.bench.__main__ import main
+
+    table = tmp_path / "bench.csv"
+    args = ["refine", "--agent", "point", "--mazes", "u_chain_1", "--seeds", "1", "--episodes", "20", "--table",
+            str(table)]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    rows = table.read_text().splitlines()
+    assert len(rows) == 3 and rows[1].split(",")[5] == "adaptive"  # odd seed: adaptive first
+    assert out["pairs"] == 1 and out["overall"]["sim_steps"]["fixed"] > 0
+    assert set(out["per_maze"]) == {"u_chain_1"} and len(out["overall"]["success_adaptive"]) == 1
+    assert main(args) == 0  # resumed: nothing rerun, the same summary
+    assert len(table.read_text().splitlines()) == 3
+    assert json.loads(capsys.readouterr().out.strip().splitlines()[-1]) == out

@@ -6,7 +6,8 @@ import torch
 
 from specrefine.errors import SpecrefineError
 from specrefine.mazes import parse_maze
-from specrefine.sim import BatchedSim, GoalReachEnv
+from specrefine.reach_env import GoalReachEnv
+from specrefine.sim import BatchedSim
 
 CORRIDOR = parse_maze("#####\n#S.G#\n#####", "corridor")
 

@@ -1,4 +1,4 @@
-"""``python -m specrefine.bench {evaluator,gymenv,train} ...``: one benchmark, one JSON line on stdout."""
+"""``python -m specrefine.bench {evaluator,gymenv,train,refine} ...``: one benchmark, one JSON line on stdout."""
 
 from __future__ import annotations
 
@@ -33,9 +33,17 @@ def main(argv=None) -> int:
     t = sub.add_parser("train", help="PPO training frames/s: our config vs the reference TorchRL config")
     t.add_argument("--agent", choices=list(AGENTS), default="ant")
     t.add_argument("--batches", type=bounded_int("batches"), default=4, help="measured batches per configuration")
+    r = sub.add_parser("refine", help="a refinement run's cost: fixed vs adaptive evaluation, side by side")
+    r.add_argument("--agent", choices=list(AGENTS), default="ant")
+    r.add_argument("--mazes", nargs="+", default=["split_doorway", "u_maze", "u_chain_2"])
+    r.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2])
+    r.add_argument("--method", default="ours")
+    r.add_argument("--proposer", default="geometric")
+    r.add_argument("--episodes", type=bounded_int("episodes"), default=200)
+    r.add_argument("--table", default=None, help="CSV the rows are appended to (and resumed from)")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore")
-    from . import bench_evaluator, bench_gymenv, bench_train
+    from . import bench_evaluator, bench_gymenv, bench_refinement, bench_train
 
     if args.what == "evaluator":
         out = bench_evaluator(args.agent, args.batch, args.seconds, args.horizon, args.torch_threads, args.nthread,
@@ -47,6 +55,9 @@ def main(argv=None) -> int:
         if "env_steps_per_s" in gym:
             out["evaluator_over_gymenv"] = round(ev["env_steps_per_s"] / gym["env_steps_per_s"], 2)
         out["evaluator_over_raw_rollout"] = ev["ratio_vs_raw_rollout"]
+    elif args.what == "refine":
+        out = bench_refinement(args.mazes, args.seeds, args.agent, args.method, args.proposer, args.table,
+                               args.episodes)
     else:
         out = bench_train(args.agent, args.batches)
     print(json.dumps(out), flush=True)

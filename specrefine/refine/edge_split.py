@@ -48,7 +48,7 @@ class SplitOutcome:
 
 
 def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = 3, d: int = 2,
-               k: int = 5, rng: np.random.Generator, picture: Callable | None = None) -> SplitOutcome:
+               k: int = 5, rng: np.random.Generator, picture: Callable | None = None, racing=None) -> SplitOutcome:
     """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
     from ..proposers import CandidateFeedback
 
@@ -70,7 +70,7 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
                 candidate = SplitCandidate(list(waypoints), path.results, round_)
             else:
                 choice = refine_chain(evaluator, start, list(waypoints), goal, [avoid] * (len(waypoints) + 1),
-                                      k, rng, goal_point)
+                                      k, rng, goal_point, racing=racing)
                 outcome.evaluations += choice.evaluations
                 candidate = SplitCandidate(choice.regions, choice.results, round_, tuned=True)
             outcome.candidates.append(candidate)

@@ -31,7 +31,10 @@ import numpy as np
 from ..graph import TaskGraph, assert_refines
 from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
+from .racing import Racing
 from .vertex import refine_chain
+
+EVALUATIONS = ("fixed", "adaptive")
 
 
 @dataclass
@@ -46,6 +49,11 @@ class SearchConfig:
     tau_max: float = 0.1
     max_edge_splits: int = 30  # budget of Algorithm 1 calls (proposer queries) per search
     seed: int = 0
+    evaluation: str = "fixed"  # "fixed": every estimate on n rollouts (the paper); "adaptive": racing.py
+
+    def __post_init__(self):
+        if self.evaluation not in EVALUATIONS:
+            raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
 
 
 @dataclass
@@ -94,6 +102,7 @@ class RefinementSearch:
         self.picture = picture  # SplitCandidate -> PNG bytes for proposer feedback
         self.on_step = on_step
         self.rng = np.random.default_rng(self.cfg.seed)
+        self.racing = Racing.for_budget(evaluator.n) if self.cfg.evaluation == "adaptive" else None
         self.tau = self.cfg.tau0
         self.f = _Frontier()
         self.results: dict[tuple[str, str], object] = {}
@@ -204,7 +213,8 @@ class RefinementSearch:
         f, g = self.f, self.graph
         query = self.query_for(g, u, v, self.results[(u, v)])
         outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
-                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture)
+                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
+                             racing=self.racing)
         self._log("split-generated", edge=[u, v], candidates=[
             {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
              "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
@@ -219,7 +229,7 @@ class RefinementSearch:
         f, g = self.f, self.graph
         avoids = [g.avoid(u, v), g.avoid(v, w)]
         choice = refine_chain(self.evaluator, f.arrivals[u], [g.region(v)], g.region(w), avoids, self.cfg.k,
-                              self.rng, g.goal_point(w))
+                              self.rng, g.goal_point(w), racing=self.racing)
         current = estimate_legs(self.evaluator, f.arrivals[u],
                                 [Leg(g.region(v), avoids[0], g.goal_point(v)), Leg(g.region(w), avoids[1],
                                                                                    g.goal_point(w))])

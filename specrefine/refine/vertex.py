@@ -12,11 +12,13 @@ probability bounds the DP (a partial path that is already less likely is not ext
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from ..regions import Box, Disc, Region
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, evaluate_all, start_of
+from .racing import Racing
 
 
 def sample_subsets(region: Region, k: int, rng: np.random.Generator, shrink=(0.3, 0.7)) -> list[Region]:
@@ -53,10 +55,12 @@ class ChainChoice:
 
 
 def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: Region, avoids: list[Region],
-                 k: int, rng: np.random.Generator, goal_point=None) -> ChainChoice:
+                 k: int, rng: np.random.Generator, goal_point=None, racing: Racing | None = None) -> ChainChoice:
     """Best subsets for the inner vertices of u -> x_1 .. x_t -> v (Algorithm 2, chain DP).
 
     ``avoids`` has one avoid set per subtask (t + 1 of them); option 0 of each layer is I(x_j) itself.
+    ``racing``: evaluate the DP adaptively (:mod:`specrefine.refine.racing`); None = every extension on
+    the evaluator's full n rollouts, as in the paper.
     """
     if len(avoids) != len(inner) + 1:
         raise ValueError("refine_chain needs one avoid set per subtask")
@@ -69,13 +73,19 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
 
     # one Path per option of the current layer: the best way found to reach it
     bound = unrefined.p
-    first = evaluate_all(evaluator, [(start, opt, avoids[0], None) for opt in options[0]])
+    extend = _next_layer if racing is None else partial(_next_layer_racing, racing=racing)
+    first_tasks = [(start, opt, avoids[0], None) for opt in options[0]]
+    if racing is None:
+        first = evaluate_all(evaluator, first_tasks)
+    else:
+        ones = [1.0] * len(first_tasks)
+        first = racing.evaluate(evaluator, first_tasks, floors=[bound] * len(first_tasks), scale=ones)
     calls += len(first)
-    layer = [_Path(r.p, [r], [i]) for i, r in enumerate(first)]
+    layer = [_Path(r.p, [r], [i]) if r is not None else _Path(0.0, [UNREACHED], [i]) for i, r in enumerate(first)]
     for j in range(1, len(inner)):
-        layer, asked = _next_layer(evaluator, layer, [(opt, avoids[j], None) for opt in options[j]], bound)
+        layer, asked = extend(evaluator, layer, [(opt, avoids[j], None) for opt in options[j]], bound)
         calls += asked
-    (best,), asked = _next_layer(evaluator, layer, [(goal, avoids[-1], goal_point)], bound, last=True)
+    (best,), asked = extend(evaluator, layer, [(goal, avoids[-1], goal_point)], bound, last=True)
     calls += asked
     if best.p <= bound:  # nothing beat the chain as proposed
         return ChainChoice(regions=list(inner), results=unrefined.results, p=unrefined.p, evaluations=calls)
@@ -105,6 +115,35 @@ def _next_layer(evaluator, layer: list[_Path], targets: list[tuple], bound: floa
     for (prev, i, _), step in zip(asked, results, strict=True):
         if best[i] is None or prev.p * step.p > best[i].p:
             best[i] = _Path(prev.p * step.p, prev.results + [step], prev.choices + ([] if last else [i]))
+    return _fill(layer, best, last), len(asked)
+
+
+def _fill(layer: list[_Path], best: list[_Path | None], last: bool) -> list[_Path]:
+    """Targets nobody reached keep p = 0."""
     base = layer[0]
     return [b if b is not None else _Path(0.0, base.results + [UNREACHED], base.choices + ([] if last else [i]))
-            for i, b in enumerate(best)], len(asked)
+            for i, b in enumerate(best)]
+
+
+def _next_layer_racing(evaluator, layer: list[_Path], targets: list[tuple], bound: float, last: bool = False, *,
+                       racing: Racing) -> tuple[list[_Path], int]:
+    """``_next_layer`` by branch and bound with staged estimates, in two rounds of batches.
+
+    Round 1 extends the most likely prefix to every target; round 2 extends every other prefix to the
+    targets where it is still more likely than the best value found (and than ``bound``: p(step) <= 1
+    cannot lift it above), dropping an extension whose first stage shows it cannot beat that value.
+    """
+    alive = sorted((prev for prev in layer if prev.p > bound and start_of(prev.results[-1]) is not None),
+                   key=lambda prev: -prev.p)
+    best: list[_Path | None] = [None] * len(targets)
+    asked = 0
+    for round_ in (alive[:1], alive[1:]):
+        floor = [max(bound, b.p if b is not None else 0.0) for b in best]
+        pairs = [(prev, i) for prev in round_ for i in range(len(targets)) if prev.p > floor[i]]
+        steps = racing.evaluate(evaluator, [(start_of(prev.results[-1]), *targets[i]) for prev, i in pairs],
+                                floors=[floor[i] for _, i in pairs], scale=[prev.p for prev, _ in pairs])
+        asked += len(pairs)
+        for (prev, i), step in zip(pairs, steps, strict=True):
+            if step is not None and prev.p * step.p > max(floor[i], best[i].p if best[i] is not None else 0.0):
+                best[i] = _Path(prev.p * step.p, prev.results + [step], prev.choices + ([] if last else [i]))
+    return _fill(layer, best, last), asked
