@@ -46,10 +46,11 @@ def _select(summary, maze, method, proposer):
     return next((s for s in summary if s["maze"] == maze and s["method"] == method and s["proposer"] == prop), None)
 
 
-def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=None):
+def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=None, legend_outside=False):
     """Success (or graph size, metric='vertices') per task per method, one panel per proposer.
 
-    ``proposers``: the panels (default: every proposer in ``rows``).
+    ``proposers``: the panels (default: every proposer in ``rows``). ``legend_outside``: the legend right of
+    the panels (for many methods or long panel titles, which the legend above the first panel would cover).
     """
     summary = summarise(rows)
     tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
@@ -70,9 +71,11 @@ def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=
             ax.set_ylim(0, 1.05)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
         ax.grid(axis="y", alpha=0.3)
-    # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
-    axes[0, 0].legend(ncol=len(methods), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
-                      frameon=False, borderaxespad=0.2)
+    if legend_outside:
+        axes[0, 0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    else:  # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
+        axes[0, 0].legend(ncol=len(methods), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
+                          frameon=False, borderaxespad=0.2)
     fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
                  if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
                  fontsize=11)
@@ -80,12 +83,16 @@ def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=
     return fig
 
 
-def figure6(rows, tasks=None, methods=METHOD_ORDER, proposers=None):
-    return figure4(rows, tasks, metric="vertices", methods=methods, proposers=proposers)
+def figure6(rows, tasks=None, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    return figure4(rows, tasks, metric="vertices", methods=methods, proposers=proposers,
+                   legend_outside=legend_outside)
 
 
-def figure5(rows, methods=METHOD_ORDER, proposers=None):
-    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer."""
+def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer.
+
+    ``legend_outside``: one legend right of the last panel instead of one in each (for many methods).
+    """
     summary = summarise(rows)
     proposers = proposers or _proposers(rows) or ["none"]
     fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
@@ -109,7 +116,10 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None):
         ax.set_xticks(range(1, 6))
         ax.grid(alpha=0.3)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
-        ax.legend(fontsize=7)
+        if not legend_outside:
+            ax.legend(fontsize=7)
+    if legend_outside:
+        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle("Figure 5: U-chain of 1-5 rooms (mean ± std over seeds)")
     fig.tight_layout()
     return fig
