@@ -118,8 +118,11 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
         if not legend_outside:
             ax.legend(fontsize=7)
-    if legend_outside:
-        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    if legend_outside:  # gathered from every panel: a proposer's panel may have no runs yet
+        handles = {label: h for ax in axes[0] for h, label in zip(*ax.get_legend_handles_labels())}
+        if handles:
+            axes[0, -1].legend(handles.values(), handles.keys(), fontsize=7, loc="upper left",
+                               bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle("Figure 5: U-chain of 1-5 rooms (mean ± std over seeds)")
     fig.tight_layout()
     return fig

@@ -186,3 +186,12 @@ def test_cli_refuses_a_missing_table(tmp_path, capsys):
 
 def test_table_note_tolerates_a_missing_file(tmp_path):
     assert "no comparison table" in cmp.table_note(tmp_path / "nope.csv", [])
+
+
+@pytest.mark.filterwarnings("error")
+def test_figure5_legend_when_the_last_preset_has_no_u_chain_runs_yet():
+    rows = rooms_rows("ours", lambda n, seed: 0.5, proposer="imperfect:mild")
+    rows.append(row("split_doorway", "ours", 0.5, 0, proposer=MODERATE))
+    fig = cmp.comparison_figures(rows)["figure5"]
+    legend = fig.axes[-1].get_legend()
+    assert legend is not None and [t.get_text() for t in legend.get_texts()][0] == "ours (no subgoals)"
