@@ -78,8 +78,7 @@ def _entry(claim, proposer, method, estimate, ci, verdict, n_expected, seeds, mi
     kind = "ratio" if claim == RATIO_CLAIM_TEXT else "rooms"
     paper = "ours >= 2x" if kind == "ratio" else PAPER_ROOM_CLAIMS.get(method, "")
     return {"claim": claim, "kind": kind, "proposer": proposer, "method": method, "paper": paper,
-            "estimate": float(estimate),
-            "ci_low": float(ci[0]), "ci_high": float(ci[1]), "verdict": verdict,
+            "estimate": float(estimate), "ci_low": float(ci[0]), "ci_high": float(ci[1]), "verdict": verdict,
             "n_cells": n_expected - len(missing), "n_expected": n_expected, "seeds": sorted(seeds),
             "missing": missing, "complete": not missing, "note": note}
 
