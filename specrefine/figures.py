@@ -15,11 +15,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .pipeline import PROPOSER_METHODS  # noqa: E402
 from .render import PngFigure  # noqa: E402
 from .sweep import summarise  # noqa: E402
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
-METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6c00", "ours": "#1565c0"}
+METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6c00", "ours": "#1565c0",
+                  # controls of the offline comparison: a shade near the method each one varies
+                  "ours-novertex": "#64b5f6", "ours-d1": "#00897b", "vlm-oneshot-matched": "#ffb74d"}
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
 EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
 _UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")
@@ -29,6 +32,8 @@ def proposer_label(proposer: str, rows=()) -> str:
     vlm = any(r.get("proposer") == proposer and r.get("proposer_is_vlm") for r in rows)
     if proposer in ("geometric", "random"):
         return f"proposer: {proposer} (offline, not a VLM)"
+    if proposer == "imperfect" or proposer.startswith("imperfect:"):
+        return f"proposer: {proposer} (offline error model, not a VLM)"
     return f"proposer: {proposer}" + (" (VLM)" if vlm else "")
 
 
@@ -37,24 +42,28 @@ def _proposers(rows) -> list[str]:
 
 
 def _select(summary, maze, method, proposer):
-    prop = proposer if method in ("ours", "vlm-oneshot") else "none"
+    prop = proposer if method in PROPOSER_METHODS else "none"
     return next((s for s in summary if s["maze"] == maze and s["method"] == method and s["proposer"] == prop), None)
 
 
-def figure4(rows, tasks=None, metric="success"):
-    """Success (or graph size, metric='vertices') per task per method, one panel per proposer."""
+def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    """Success (or graph size, metric='vertices') per task per method, one panel per proposer.
+
+    ``proposers``: the panels (default: every proposer in ``rows``). ``legend_outside``: the legend right of
+    the panels (for many methods or long panel titles, which the legend above the first panel would cover).
+    """
     summary = summarise(rows)
     tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
-    proposers = _proposers(rows) or ["none"]
+    proposers = proposers or _proposers(rows) or ["none"]
     fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
                              squeeze=False, FigureClass=PngFigure)
-    width = 0.8 / len(METHOD_ORDER)
+    width = 0.8 / len(methods)
     for ax, proposer in zip(axes[:, 0], proposers):
-        for i, method in enumerate(METHOD_ORDER):
+        for i, method in enumerate(methods):
             stats = [_select(summary, t, method, proposer) for t in tasks]
             mean = [s[f"{metric}_mean"] if s else np.nan for s in stats]
             std = [s[f"{metric}_std"] if s else 0 for s in stats]
-            x = np.arange(len(tasks)) + (i - (len(METHOD_ORDER) - 1) / 2) * width
+            x = np.arange(len(tasks)) + (i - (len(methods) - 1) / 2) * width
             ax.bar(x, mean, width, yerr=std, capsize=2, label=method, color=METHOD_COLOURS[method])
         ax.set_xticks(np.arange(len(tasks)), tasks, rotation=15)
         ax.set_ylabel("success rate" if metric == "success" else "task-graph vertices")
@@ -62,9 +71,11 @@ def figure4(rows, tasks=None, metric="success"):
             ax.set_ylim(0, 1.05)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
         ax.grid(axis="y", alpha=0.3)
-    # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
-    axes[0, 0].legend(ncol=len(METHOD_ORDER), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
-                      frameon=False, borderaxespad=0.2)
+    if legend_outside:
+        axes[0, 0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    else:  # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
+        axes[0, 0].legend(ncol=len(methods), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
+                          frameon=False, borderaxespad=0.2)
     fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
                  if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
                  fontsize=11)
@@ -72,20 +83,24 @@ def figure4(rows, tasks=None, metric="success"):
     return fig
 
 
-def figure6(rows, tasks=None):
-    return figure4(rows, tasks, metric="vertices")
+def figure6(rows, tasks=None, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    return figure4(rows, tasks, metric="vertices", methods=methods, proposers=proposers,
+                   legend_outside=legend_outside)
 
 
-def figure5(rows):
-    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer."""
+def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer.
+
+    ``legend_outside``: one legend right of the last panel instead of one in each (for many methods).
+    """
     summary = summarise(rows)
-    proposers = _proposers(rows) or ["none"]
+    proposers = proposers or _proposers(rows) or ["none"]
     fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
                              FigureClass=PngFigure)
     for ax, proposer in zip(axes[0], proposers):
-        for method in METHOD_ORDER:
+        for method in methods:
             for subgoals, style in ((False, "-"), (True, "--")):
-                prop = proposer if method in ("ours", "vlm-oneshot") else "none"
+                prop = proposer if method in PROPOSER_METHODS else "none"
                 pts = _rooms(summary, method, prop, subgoals)
                 if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
                     pts += [p for p in _rooms(summary, method, prop, False) if p[0] == 1]
@@ -101,7 +116,13 @@ def figure5(rows):
         ax.set_xticks(range(1, 6))
         ax.grid(alpha=0.3)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
-        ax.legend(fontsize=7)
+        if not legend_outside:
+            ax.legend(fontsize=7)
+    if legend_outside:  # gathered from every panel: a proposer's panel may have no runs yet
+        handles = {label: h for ax in axes[0] for h, label in zip(*ax.get_legend_handles_labels())}
+        if handles:
+            axes[0, -1].legend(handles.values(), handles.keys(), fontsize=7, loc="upper left",
+                               bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle("Figure 5: U-chain of 1-5 rooms (mean ± std over seeds)")
     fig.tight_layout()
     return fig

@@ -1,0 +1,358 @@
+"""The offline comparison of docs/proposers.md ("The comparison"): its figures and the paper's two claims.
+
+The proposer of every run here is ``imperfect:*``, an error model standing in for a VLM: it is NOT a VLM,
+and every figure and table says so. Claims, per preset, with 95 % bootstrap intervals (percentile,
+``BOOTSTRAP_RESAMPLES`` resamples, numpy seed ``BOOTSTRAP_SEED``):
+
+* "ours >= 2x one-shot on multi-room tasks": mean success of ``ours`` over that of ``vlm-oneshot`` on
+  ``MULTI_ROOM_MAZES``, resampling (maze, seed) cells;
+* "flat over 1-5 rooms": for each method, the least-squares change of success from 1 to 5 rooms
+  (slope x 4) on u_chain_1..5, resampling seeds within each room; flat when its interval lies within
+  +-``FLAT_TOLERANCE`` (the paper says ``ours`` is flat and ``vlm-oneshot`` falls).
+
+A cell of the fixed grid without an ``ok`` row is reported as missing: every entry states the cells
+it used (``n_cells`` of ``n_expected``), the seeds, and which are missing. An entry with a missing cell
+is ``complete = False`` and is not the comparison the grid fixed.
+
+``python -m specrefine.comparison TABLE --out DIR`` writes the figures, ``claims.md`` and ``claims.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .figures import METHOD_COLOURS, figure4, figure5, plt, proposer_label  # plt: with the figures' backend
+from .render import PngFigure
+from .sweep import is_done
+
+COMPARISON_METHODS = ["ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"]
+ERROR_LEVELS = ["imperfect:mild", "imperfect:moderate", "imperfect:severe"]  # alpha = 0: the x axis, in order
+ALPHA_PRESET = "imperfect:moderate,alpha=0.1"  # builds the paper's hypothesis into the model: shown apart
+PRESETS = ERROR_LEVELS + [ALPHA_PRESET]
+SEEDS = (0, 1, 2, 3)
+U_CHAIN_ROOMS = {n: f"u_chain_{n}" for n in range(1, 6)}  # rooms -> the maze without subgoals
+
+#: The multi-room tasks of claim (i): the U-chains of 2-5 rooms, with and without subgoals at the doorways.
+#: docs/proposers.md fixed the claim on "U-chain 2-5" before any result, and the paper's multi-room study
+#: (its Figure 5) is the U-chain with and without subgoals. or_maze (one room, a block in the middle),
+#: x_maze / xx_maze_* (rooms around a cross of walls) are left out: counting them would change the claim
+#: after the grid was fixed. ``ratio_claim(..., mazes=...)`` computes it on any other set.
+MULTI_ROOM_MAZES = tuple(f"u_chain_{n}{suffix}" for n in range(2, 6) for suffix in ("", "_subgoals"))
+RATIO_CLAIM = 2.0
+#: Largest change of success from 1 to 5 rooms (either way) that still counts as flat: about the half-width
+#: of one run's 95 % Wilson interval at 200 episodes and p = 0.9 (0.042), i.e. what one run can resolve.
+FLAT_TOLERANCE = 0.05
+PAPER_ROOM_CLAIMS = {"ours": "flat", "vlm-oneshot": "falls"}
+BOOTSTRAP_RESAMPLES = 10_000
+BOOTSTRAP_SEED = 0
+
+RATIO_CLAIM_TEXT = "ours >= 2x one-shot on multi-room tasks"
+ROOMS_CLAIM_TEXT = "success over 1-5 rooms"  # the paper: flat for ours, falling for vlm-oneshot
+OFFLINE_NOTE = "proposer imperfect:* is an offline error model, NOT a VLM"
+
+
+def table_cells(rows, agent: str = "point") -> tuple[dict, set]:
+    """(maze, method, proposer, seed) -> success of the last ``ok`` row of the maze's own task; and the cells
+    whose rows all failed (a failed run has no success to report)."""
+    ok, tried = {}, set()
+    for r in rows:
+        if r.get("spec") or r.get("agent", agent) != agent or not isinstance(r.get("seed"), int):
+            continue  # another task or agent, or a row cut short before its seed
+        key = (r["maze"], r["method"], r["proposer"], r["seed"])
+        tried.add(key)
+        if is_done(r):
+            ok[key] = float(r["success_rate"])
+    return ok, tried - set(ok)
+
+
+def _missing_text(maze, seed, methods, failed, proposer) -> str:
+    why = ["failed" if (maze, m, proposer, seed) in failed else "no row" for m in methods]
+    return f"{maze} s{seed}: " + ", ".join(f"{m} ({w})" for m, w in zip(methods, why))
+
+
+def _entry(claim, proposer, method, estimate, ci, verdict, n_expected, seeds, missing, note="") -> dict:
+    kind = "ratio" if claim == RATIO_CLAIM_TEXT else "rooms"
+    paper = "ours >= 2x" if kind == "ratio" else PAPER_ROOM_CLAIMS.get(method, "")
+    return {"claim": claim, "kind": kind, "proposer": proposer, "method": method, "paper": paper,
+            "estimate": float(estimate), "ci_low": float(ci[0]), "ci_high": float(ci[1]), "verdict": verdict,
+            "n_cells": n_expected - len(missing), "n_expected": n_expected, "seeds": sorted(seeds),
+            "missing": missing, "complete": not missing, "note": note}
+
+
+def _percentile_ci(boot) -> tuple[float, float]:
+    if np.isnan(boot).any():  # an undefined resample (0/0) makes the interval undefined, not narrower
+        return (math.nan, math.nan)
+    lo, hi = np.quantile(boot, [0.025, 0.975], method="inverted_cdf")  # no interpolation: inf stays inf
+    return float(lo), float(hi)
+
+
+def _ratio(num, den):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(den > 0, num / np.where(den > 0, den, 1), np.where(num > 0, np.inf, np.nan))
+
+
+def ratio_claim(cells, failed, proposer, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) -> dict:
+    """Claim (i): mean success of ours / vlm-oneshot over the (maze, seed) cells where both ran."""
+    pairs, missing, used_seeds = [], [], set()
+    for maze in mazes:
+        for seed in seeds:
+            values = [cells.get((maze, m, proposer, seed)) for m in ("ours", "vlm-oneshot")]
+            lacking = [m for m, v in zip(("ours", "vlm-oneshot"), values) if v is None]
+            if lacking:
+                missing.append(_missing_text(maze, seed, lacking, failed, proposer))
+            else:
+                pairs.append(values)
+                used_seeds.add(seed)
+    n_expected = len(mazes) * len(seeds)
+    if not pairs:
+        return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", math.nan, (math.nan, math.nan),
+                      "undecided", n_expected, used_seeds, missing, "no cell with both methods")
+    ours, oneshot = np.array(pairs).T
+    idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(pairs), (BOOTSTRAP_RESAMPLES, len(pairs)))
+    boot = _ratio(ours[idx].mean(axis=1), oneshot[idx].mean(axis=1))
+    ci = _percentile_ci(boot)
+    note = "ratio undefined (0/0) in some resamples" if np.isnan(ci[0]) else ""
+    return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", _ratio(ours.mean(), oneshot.mean()), ci,
+                  threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note)
+
+
+def threshold_verdict(ci, threshold) -> str:
+    lo, hi = ci
+    if lo >= threshold:
+        return "holds"
+    if hi < threshold:
+        return "does not hold"
+    return "undecided"  # the interval straddles the threshold (or is undefined)
+
+
+def _change_1_to_5(rooms, means):
+    """Least-squares slope of success on rooms, times 4: the fitted change from 1 to 5 rooms (per row of means)."""
+    x = np.asarray(rooms, float) - np.mean(rooms)
+    means = np.asarray(means, float)
+    centred = means - means.mean(axis=-1, keepdims=True)
+    return 4 * (centred @ x) / (x @ x)
+
+
+def rooms_verdict(ci, tolerance=FLAT_TOLERANCE) -> str:
+    lo, hi = ci
+    if -tolerance <= lo and hi <= tolerance:
+        return "flat"
+    if hi < -tolerance:
+        return "falls"
+    if lo > tolerance:
+        return "rises"
+    return "undecided"
+
+
+def rooms_claim(cells, failed, proposer, method, seeds=SEEDS) -> dict:
+    """Claim (ii) for one method: the change of success from 1 to 5 rooms on u_chain_1..5, CI over seeds."""
+    by_room, missing, used_seeds = {}, [], set()
+    for rooms, maze in U_CHAIN_ROOMS.items():
+        values = []
+        for seed in seeds:
+            value = cells.get((maze, method, proposer, seed))
+            if value is None:
+                missing.append(_missing_text(maze, seed, [method], failed, proposer))
+            else:
+                values.append(value)
+                used_seeds.add(seed)
+        if values:
+            by_room[rooms] = np.array(values)
+    n_expected = len(U_CHAIN_ROOMS) * len(seeds)
+    claim = f"{method} {ROOMS_CLAIM_TEXT}"
+    absent = [r for r in U_CHAIN_ROOMS if r not in by_room]
+    note = f"rooms with no run: {absent}" if absent else ""
+    if len(by_room) < 2:
+        return _entry(claim, proposer, method, math.nan, (math.nan, math.nan), "undecided", n_expected,
+                      used_seeds, missing, note or "fewer than two room counts")
+    rooms = sorted(by_room)
+    rng = np.random.default_rng(BOOTSTRAP_SEED)
+    boot_means = np.stack([by_room[r][rng.integers(0, len(by_room[r]), (BOOTSTRAP_RESAMPLES, len(by_room[r])))]
+                           .mean(axis=1) for r in rooms], axis=1)  # seeds resampled within each room
+    ci = _percentile_ci(_change_1_to_5(rooms, boot_means))
+    estimate = _change_1_to_5(rooms, [by_room[r].mean() for r in rooms])
+    return _entry(claim, proposer, method, estimate, ci, rooms_verdict(ci), n_expected, used_seeds, missing, note)
+
+
+def claims(rows, proposers=PRESETS, methods=COMPARISON_METHODS, seeds=SEEDS, agent: str = "point") -> list[dict]:
+    """Both claims for every preset: per proposer, the ratio entry, then the rooms entry of each method."""
+    cells, failed = table_cells(rows, agent)
+    out = []
+    for proposer in proposers:
+        out.append(ratio_claim(cells, failed, proposer, seeds))
+        out += [rooms_claim(cells, failed, proposer, method, seeds) for method in methods]
+    return out
+
+
+def _interval_text(entry) -> str:
+    e, lo, hi = entry["estimate"], entry["ci_low"], entry["ci_high"]
+    if math.isnan(e):
+        return "—"
+    prefix = "ratio" if entry["kind"] == "ratio" else "change 1→5 rooms"
+    sign = "" if entry["kind"] == "ratio" else "+"
+    return f"{prefix} {e:{sign}.3f} [{lo:{sign}.3f}, {hi:{sign}.3f}]"
+
+
+def _missing_summary(missing, shown: int = 3) -> str:
+    if not missing:
+        return "none"
+    more = f"; … {len(missing) - shown} more" if len(missing) > shown else ""
+    return f"{len(missing)}: " + "; ".join(missing[:shown]) + more
+
+
+def markdown(entries) -> str:
+    """A README table of ``claims(...)``: estimate with its 95 % interval, verdict, cells used and missing."""
+    lines = [f"{OFFLINE_NOTE}. 95 % bootstrap percentile intervals ({BOOTSTRAP_RESAMPLES} resamples, numpy seed "
+             f"{BOOTSTRAP_SEED}): the ratio over (maze, seed) cells of {', '.join(MULTI_ROOM_MAZES)}; the change "
+             f"from 1 to 5 rooms (least-squares slope x 4 on u_chain_1..5) resampling seeds within each room, "
+             f"flat when its interval lies within ±{FLAT_TOLERANCE}. An entry marked *partial* lacks cells of "
+             "the fixed grid and is not the comparison the grid fixed.", "",
+             "| proposer | claim | paper | estimate [95 % CI] | verdict | cells (seeds) | missing |",
+             "|---|---|---|---|---|---|---|"]
+    for e in entries:
+        verdict = e["verdict"] + ("" if e["complete"] else " (*partial*)")
+        note = f" ({e['note']})" if e["note"] else ""
+        seeds = ",".join(map(str, e["seeds"])) or "none"
+        lines.append(f"| {e['proposer']} | {e['claim']} | {e['paper'] or '—'} | {_interval_text(e)}{note} | "
+                     f"{verdict} | {e['n_cells']}/{e['n_expected']} ({seeds}) | {_missing_summary(e['missing'])} |")
+    return "\n".join(lines)
+
+
+T_975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
+         2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042]
+
+
+def mean_ci(values) -> tuple[float, float, float]:
+    """Mean with a 95 % Student-t interval over seeds, clipped to [0, 1]; no interval from one seed."""
+    v = np.asarray(values, float)
+    if len(v) == 0:
+        return (math.nan, math.nan, math.nan)
+    mean = float(v.mean())
+    if len(v) < 2:
+        return (mean, mean, mean)
+    df = len(v) - 1
+    t = T_975[df - 1] if df <= len(T_975) else 1.96 + (1.96**3 + 1.96) / (4 * df)  # Cornish-Fisher beyond the table
+    half = t * v.std(ddof=1) / math.sqrt(len(v))
+    return (mean, max(0.0, mean - half), min(1.0, mean + half))
+
+
+def _level_label(proposer: str) -> str:
+    return proposer.split(":", 1)[1].replace(",", "\n")
+
+
+def error_level_figure(rows, methods=COMPARISON_METHODS, levels=ERROR_LEVELS, extra=ALPHA_PRESET,
+                       rooms=tuple(U_CHAIN_ROOMS), agent: str = "point"):
+    """End-to-end success against proposer error level, one panel per U-chain length (no subgoals): per method,
+    the mean over seeds with a 95 % t-interval band over ``levels``, and ``extra`` as a separate marker."""
+    cells, _ = table_cells(rows, agent)
+    fig, axes = plt.subplots(1, len(rooms), figsize=(3.4 * len(rooms), 4.2), sharey=True, squeeze=False,
+                             FigureClass=PngFigure)
+    x_extra = len(levels) - 0.4
+    counts = []
+    for ax, n in zip(axes[0], rooms):
+        maze = U_CHAIN_ROOMS[n]
+        for i, method in enumerate(methods):
+            colour, shift = METHOD_COLOURS.get(method), (i - (len(methods) - 1) / 2) * 0.04
+            stats = []
+            for proposer in [*levels, extra]:
+                values = [v for (m, me, prop, _), v in cells.items() if (m, me, prop) == (maze, method, proposer)]
+                counts.append(len(values))
+                stats.append(mean_ci(values))
+            mean, lo, hi = map(np.array, zip(*stats))
+            x = np.arange(len(levels)) + shift
+            ax.plot(x, mean[:-1], marker="o", color=colour, label=method)
+            ax.fill_between(x, lo[:-1], hi[:-1], color=colour, alpha=0.12, linewidth=0)
+            ax.errorbar([x_extra + shift], mean[-1:], yerr=[mean[-1:] - lo[-1:], hi[-1:] - mean[-1:]], fmt="D",
+                        mfc="none", color=colour, capsize=2)
+        ax.axvline(len(levels) - 0.7, color="k", lw=0.6, ls=":")
+        ax.set_xticks([*range(len(levels)), x_extra], [_level_label(p) for p in [*levels, extra]], fontsize=8)
+        ax.set_ylim(0, 1.05)
+        ax.grid(alpha=0.3)
+        ax.set_title(f"{maze} ({n} room{'s' * (n > 1)})\n{proposer_label('imperfect')}", fontsize=8)
+    axes[0, 0].set_ylabel("end-to-end success")
+    axes[0, 0].legend(fontsize=7, loc="lower left")
+    seeds = f"{min(counts)}" if min(counts) == max(counts) else f"{min(counts)}-{max(counts)}"
+    fig.suptitle("Success against the offline proposer's error level, U-chain of 1-5 rooms "
+                 f"(mean over seeds, 95 % t-interval; seeds per point: {seeds})", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def comparison_figures(rows) -> dict:
+    """name -> figure: Figures 4 and 5 for the five methods, one panel per preset, and the error-level figure."""
+    present = [p for p in PRESETS if any(r.get("proposer") == p for r in rows)]
+    if not present:
+        return {}
+    return {"figure4": figure4(rows, methods=COMPARISON_METHODS, proposers=present, legend_outside=True),
+            "figure5": figure5(rows, methods=COMPARISON_METHODS, proposers=present, legend_outside=True),
+            "error_levels": error_level_figure(rows)}
+
+
+def expected_cells() -> int:
+    """Runs in the fixed grid: every maze in data/mazes x the five methods x the four presets x the seeds."""
+    from .mazes import benchmark_mazes
+
+    return len(benchmark_mazes()) * len(COMPARISON_METHODS) * len(PRESETS) * len(SEEDS)
+
+
+def table_note(path, rows) -> str:
+    """One line on how much of the fixed grid a table holds (a missing or partial table is no error)."""
+    if not Path(path).exists():
+        return f"no comparison table at {path}: nothing to draw (the sweep of docs/proposers.md has not run here)"
+    cells, _ = table_cells(rows)
+    done = sum(1 for (_, method, proposer, _) in cells if method in COMPARISON_METHODS and proposer in PRESETS)
+    if done < expected_cells():
+        return (f"{path}: PARTIAL, {done} of {expected_cells()} runs of the fixed grid have an ok row; "
+                "what follows is not the comparison the grid fixed")
+    return f"{path}: all {done} runs of the fixed grid have an ok row"
+
+
+def _jsonable(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def write_claims(entries, out: Path, table) -> None:
+    about = {"table": str(table), "note": OFFLINE_NOTE, "multi_room_mazes": list(MULTI_ROOM_MAZES),
+             "ratio_threshold": RATIO_CLAIM, "flat_tolerance": FLAT_TOLERANCE, "seeds": list(SEEDS),
+             "bootstrap_resamples": BOOTSTRAP_RESAMPLES, "bootstrap_seed": BOOTSTRAP_SEED}
+    (out / "claims.json").write_text(json.dumps(_jsonable({"about": about, "claims": entries}), indent=1) + "\n")
+    (out / "claims.md").write_text(markdown(entries) + "\n")
+
+
+def main(argv=None) -> int:
+    from .argtypes import OneLineParser
+    from .sweep import read_table
+
+    p = OneLineParser(prog="python -m specrefine.comparison", description=__doc__.split("\n")[0])
+    p.add_argument("table", help="results.csv of the comparison sweep (specrefine.sweep)")
+    p.add_argument("--out", required=True,
+                   help="folder for figure4.png, figure5.png, error_levels.png, claims.md and claims.json")
+    args = p.parse_args(argv)
+    if not Path(args.table).is_file():
+        p.exit(2, f"{p.prog}: error: no table at {args.table}\n")
+    rows = read_table(args.table)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    print(table_note(args.table, rows))
+    for name, fig in comparison_figures(rows).items():
+        fig.savefig(out / f"{name}.png", dpi=110)
+        plt.close(fig)
+    entries = claims(rows)
+    write_claims(entries, out, args.table)
+    partial = sum(not e["complete"] for e in entries)
+    print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,197 @@
+"""specrefine.comparison on small synthetic tables: the claims' verdicts, missing cells, figures and the CLI."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from specrefine import comparison as cmp
+from specrefine.sweep import COLUMNS, read_table
+
+MODERATE = "imperfect:moderate"
+
+
+def row(maze, method, success, seed, proposer=MODERATE, status="ok"):
+    return {"cell": f"{maze}__point__{method}__{proposer}__s{seed}", "maze": maze, "agent": "point",
+            "method": method, "proposer": proposer, "proposer_is_vlm": False, "seed": seed, "status": status,
+            "error": "" if status == "ok" else "boom", "success_rate": success, "success_ci_low": 0.0,
+            "success_ci_high": 1.0, "episodes": 200, "evaluations": 10, "graph_vertices": 3, "spec": ""}
+
+
+def ratio_rows(oneshot_of, ratio, seeds=cmp.SEEDS, proposer=MODERATE):
+    """ours = ratio x vlm-oneshot in every multi-room cell; vlm-oneshot's success from oneshot_of(maze, seed)."""
+    rows = []
+    for i, maze in enumerate(cmp.MULTI_ROOM_MAZES):
+        for seed in seeds:
+            base = oneshot_of(i, seed)
+            rows += [row(maze, "vlm-oneshot", base, seed, proposer), row(maze, "ours", ratio * base, seed, proposer)]
+    return rows
+
+
+def rooms_rows(method, success_of, seeds=cmp.SEEDS, proposer=MODERATE):
+    return [row(maze, method, success_of(n, seed), seed, proposer)
+            for n, maze in cmp.U_CHAIN_ROOMS.items() for seed in seeds]
+
+
+def entry(entries, method, proposer=MODERATE):
+    """The rooms entry of ``method``, or the ratio entry for method 'ratio'."""
+    kind = "ratio" if method == "ratio" else "rooms"
+    return next(e for e in entries if (e["proposer"], e["kind"]) == (proposer, kind)
+                and (kind == "ratio" or e["method"] == method))
+
+
+def test_exact_two_and_a_half_times_holds():
+    rows = ratio_rows(lambda i, seed: 0.1 + 0.03 * i + 0.01 * seed, 2.5)
+    e = entry(cmp.claims(rows), "ratio")
+    assert e["estimate"] == pytest.approx(2.5)
+    assert e["ci_low"] == pytest.approx(2.5) and e["ci_high"] == pytest.approx(2.5)
+    assert e["verdict"] == "holds"
+    assert e["complete"] and e["n_cells"] == e["n_expected"] == 8 * 4 and e["seeds"] == [0, 1, 2, 3]
+
+
+def test_ratio_below_two_does_not_hold():
+    rows = ratio_rows(lambda i, seed: 0.2 + 0.02 * seed, 1.2)
+    assert entry(cmp.claims(rows), "ratio")["verdict"] == "does not hold"
+
+
+def test_ratio_interval_straddling_two_is_undecided():
+    # half the cells at 1.2x, half at 3x: the mean ratio is near 2 and the resampled cells move it both ways
+    rows = []
+    for i, maze in enumerate(cmp.MULTI_ROOM_MAZES):
+        for seed in cmp.SEEDS:
+            factor = 3.0 if (i + seed) % 2 else 1.2
+            rows += [row(maze, "vlm-oneshot", 0.3, seed), row(maze, "ours", factor * 0.3, seed)]
+    e = entry(cmp.claims(rows), "ratio")
+    assert e["ci_low"] < 2 < e["ci_high"]
+    assert e["verdict"] == "undecided"
+
+
+def test_bootstrap_is_reproducible():
+    rng = np.random.default_rng(5)
+    rows = ratio_rows(lambda i, seed: rng.uniform(0.1, 0.4), 2.0)
+    for r in rows:
+        r["success_rate"] = min(1.0, r["success_rate"] + rng.normal(0, 0.05))
+    first, second = (entry(cmp.claims(rows), "ratio") for _ in range(2))
+    assert (first["ci_low"], first["ci_high"]) == (second["ci_low"], second["ci_high"])
+
+
+def test_one_shot_never_succeeding_gives_an_infinite_ratio():
+    rows = ratio_rows(lambda i, seed: 0.0, 1.0) + [row("u_chain_2", "ours", 0.5, 0)]  # the later row counts
+    e = entry(cmp.claims(rows), "ratio")
+    # ours is 0.5 in one cell only, one-shot 0 everywhere: resamples without that cell are 0/0
+    assert e["estimate"] == np.inf
+    assert np.isnan(e["ci_low"]) and e["verdict"] == "undecided" and "0/0" in e["note"]
+
+
+def test_missing_and_failed_cells_are_reported():
+    rows = ratio_rows(lambda i, seed: 0.3, 2.5)
+    rows = [r for r in rows if not (r["maze"] == "u_chain_3" and r["seed"] == 2 and r["method"] == "vlm-oneshot")]
+    rows = [r if not (r["maze"] == "u_chain_4" and r["seed"] == 1 and r["method"] == "ours")
+            else {**r, "status": "error", "success_rate": ""} for r in rows]
+    e = entry(cmp.claims(rows), "ratio")
+    assert e["missing"] == ["u_chain_3 s2: vlm-oneshot (no row)", "u_chain_4 s1: ours (failed)"]
+    assert (e["n_cells"], e["n_expected"], e["complete"]) == (30, 32, False)
+    assert e["verdict"] == "holds"  # on the cells present, and said to be partial
+    assert "(*partial*)" in cmp.markdown([e]) and "30/32" in cmp.markdown([e])
+
+
+def test_a_preset_without_rows_is_all_missing():
+    e = entry(cmp.claims(ratio_rows(lambda i, seed: 0.3, 2.5)), "ratio", "imperfect:severe")
+    assert e["n_cells"] == 0 and len(e["missing"]) == 32 and e["verdict"] == "undecided" and e["seeds"] == []
+
+
+def test_flat_series_is_flat():
+    rows = rooms_rows("ours", lambda n, seed: 0.9 + 0.01 * (seed - 1.5))
+    e = entry(cmp.claims(rows), "ours")
+    assert e["estimate"] == pytest.approx(0.0, abs=1e-12)
+    assert e["verdict"] == "flat" and e["paper"] == "flat" and e["n_cells"] == 20
+
+
+def test_falling_series_falls_and_small_drift_is_not_flat_by_decree():
+    rows = rooms_rows("vlm-oneshot", lambda n, seed: 0.9 - 0.1 * (n - 1) + 0.01 * seed)
+    rows += rooms_rows("ours", lambda n, seed: 0.9 - 0.012 * (n - 1) + 0.05 * (seed % 2))
+    entries = cmp.claims(rows)
+    falls = entry(entries, "vlm-oneshot")
+    assert falls["estimate"] == pytest.approx(-0.4) and falls["verdict"] == "falls" and falls["paper"] == "falls"
+    drift = entry(entries, "ours")  # a drop of 0.048 with seed noise: its interval leaves +-0.05
+    assert drift["estimate"] == pytest.approx(-0.048)
+    assert drift["verdict"] == "undecided"
+
+
+def test_rooms_missing_a_whole_room_says_so():
+    rows = [r for r in rooms_rows("ours", lambda n, seed: 0.8) if r["maze"] != "u_chain_4"]
+    e = entry(cmp.claims(rows), "ours")
+    assert e["n_cells"] == 16 and "[4]" in e["note"] and not e["complete"]
+
+
+def test_verdict_boundaries():
+    assert cmp.threshold_verdict((2.0, 2.3), 2.0) == "holds"
+    assert cmp.threshold_verdict((1.5, 1.99), 2.0) == "does not hold"
+    assert cmp.rooms_verdict((-0.05, 0.05)) == "flat"
+    assert cmp.rooms_verdict((0.06, 0.2)) == "rises"
+    assert cmp.rooms_verdict((-0.2, 0.0)) == "undecided"
+
+
+def test_mean_ci_uses_student_t():
+    mean, lo, hi = cmp.mean_ci([0.5, 0.6, 0.7, 0.8])
+    assert mean == pytest.approx(0.65)
+    assert hi - mean == pytest.approx(3.182 * np.std([0.5, 0.6, 0.7, 0.8], ddof=1) / 2)
+    assert cmp.mean_ci([0.4]) == (0.4, 0.4, 0.4)
+
+
+def test_every_figure_panel_says_offline(tmp_path):
+    rows = []
+    for proposer in cmp.PRESETS[:2]:
+        for method in cmp.COMPARISON_METHODS:
+            rows += rooms_rows(method, lambda n, seed: 0.5, seeds=(0, 1), proposer=proposer)
+    figures = cmp.comparison_figures(rows)
+    assert set(figures) == {"figure4", "figure5", "error_levels"}
+    for name in ("figure5", "error_levels"):
+        titles = [ax.get_title() for ax in figures[name].axes]
+        assert titles and all("offline error model, not a VLM" in t for t in titles), (name, titles)
+    assert len(figures["error_levels"].axes) == 5
+
+
+def write_csv(path, rows):
+    with path.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def test_cli_writes_figures_and_claims(tmp_path, capsys):
+    rows = ratio_rows(lambda i, seed: 0.3, 2.5) + rooms_rows("ours", lambda n, seed: 0.9)
+    table = tmp_path / "results.csv"
+    write_csv(table, rows)
+    assert len(read_table(table)) == len(rows)
+    out = tmp_path / "out"
+    assert cmp.main([str(table), "--out", str(out)]) == 0
+    for name in ("figure4.png", "figure5.png", "error_levels.png", "claims.md", "claims.json"):
+        assert (out / name).stat().st_size > 0, name
+    data = json.loads((out / "claims.json").read_text())
+    assert len(data["claims"]) == len(cmp.PRESETS) * (1 + len(cmp.COMPARISON_METHODS))
+    assert data["about"]["flat_tolerance"] == cmp.FLAT_TOLERANCE
+    assert "PARTIAL" in capsys.readouterr().out
+
+
+def test_cli_refuses_a_missing_table(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        cmp.main([str(tmp_path / "nope.csv"), "--out", str(tmp_path / "out")])
+    assert exc.value.code == 2 and "no table" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_table_note_tolerates_a_missing_file(tmp_path):
+    assert "no comparison table" in cmp.table_note(tmp_path / "nope.csv", [])
+
+
+@pytest.mark.filterwarnings("error")
+def test_figure5_legend_when_the_last_preset_has_no_u_chain_runs_yet():
+    rows = rooms_rows("ours", lambda n, seed: 0.5, proposer="imperfect:mild")
+    rows.append(row("split_doorway", "ours", 0.5, 0, proposer=MODERATE))
+    fig = cmp.comparison_figures(rows)["figure5"]
+    legend = fig.axes[-1].get_legend()
+    assert legend is not None and [t.get_text() for t in legend.get_texts()][0] == "ours (no subgoals)"
