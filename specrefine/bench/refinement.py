@@ -1,11 +1,12 @@
 """The cost of a refinement run, fixed vs adaptive evaluation, side by side in one process.
 
 For each (maze, seed), ``refine_maze`` runs with ``evaluation="fixed"`` (the paper's 32 rollouts per
-subtask estimate) and then ``evaluation="adaptive"`` (:mod:`specrefine.refine.racing`), each from an
-empty run folder (no cache shared), after one untimed warm-up run, the order alternating with the seed.  Each row records the run's simulator steps (search, calibration
-and the 200-episode measurement), wall and process CPU seconds, evaluations and the measured success
-with its CI.  Rows are appended to ``--table`` as each run finishes; a rerun skips the (maze, seed,
-evaluation) rows already there, so a long Ant benchmark can be interrupted and resumed.
+subtask estimate) and ``evaluation="adaptive"`` (:mod:`specrefine.refine.racing`), each from an empty
+run folder (no cache shared), after one untimed warm-up run, the order alternating with the seed.
+Each row records the run's simulator steps (search, calibration and the 200-episode measurement),
+wall and process CPU seconds, evaluations and the measured success with its CI.  Rows are appended
+to ``--table`` as each run finishes; a rerun skips the (maze, seed, evaluation) rows already there,
+so a long Ant benchmark can be interrupted and resumed.
 """
 
 from __future__ import annotations
