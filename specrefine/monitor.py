@@ -1,6 +1,12 @@
-"""The specification monitor: which trajectories satisfy a task graph (success on the ORIGINAL task)."""
+"""The specification monitor: which trajectories satisfy a task graph (success on the ORIGINAL task).
+
+``measure`` runs a path's compositional policy and judges every episode by this monitor, as a run's
+final measurement (and its held-out prediction) does.
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -56,3 +62,27 @@ def satisfies(graph, trajectories, lengths=None, clearance: float = 0.0) -> np.n
         if not any(a.any() for a in active.values()):
             break
     return accepted
+
+
+@dataclass
+class Measurement:
+    success: np.ndarray  # per episode: satisfied the original task
+    path_result: object | None  # the CompositionalResult (None: no path)
+
+    @property
+    def rate(self) -> float:
+        return float(self.success.mean()) if len(self.success) else 0.0
+
+
+def measure(evaluator, original, graph, path, episodes: int, seed) -> Measurement:
+    """``episodes`` episodes of the compositional policy along ``path`` of ``graph``, judged on ``original``.
+
+    Always from the ORIGINAL initial distribution, even if a baseline changed the initial vertex.
+    """
+    from .evaluate import path_legs
+
+    if not path or len(path) < 2:
+        return Measurement(np.zeros(0, dtype=bool), None)
+    run = evaluator.run_compositional(original.region(original.initial), path_legs(graph, path), n=episodes,
+                                      seed=seed)
+    return Measurement(satisfies(original, run.trajectories, run.lengths, clearance=evaluator.clearance), run)

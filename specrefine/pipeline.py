@@ -19,6 +19,7 @@ import numpy as np
 from .calibrate import predict
 from .errors import SpecrefineError
 from .graph import check_refines
+from .monitor import measure
 from .refine.search import EVALUATIONS
 from .spec import maze_spec_text
 
@@ -104,11 +105,11 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
             steps_log.flush()
 
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step, evaluation)
-    measured = _measure(evaluator, original, search, episodes, seed)
-    prediction = predict(evaluator, search.graph, search.path, original.region(original.initial), seed, episodes)
+    measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
+    prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
-    data.update(prediction.to_dict())  # calibrated: held-out legs, Jeffreys posterior of the product
+    data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"] = evaluation
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
@@ -192,44 +193,15 @@ def candidate_picture(maze):
         if not legs:
             return None
         width = max(r.trajectories.shape[1] for r in legs)
-        traj = np.concatenate([_pad(r.trajectories, width) for r in legs])
+        from .results import pad_trajectories
+
+        traj = np.concatenate([pad_trajectories(r.trajectories, width) for r in legs])
         fig = render_task(maze, trajectories=traj, success=np.concatenate([r.success for r in legs]),
                           lengths=np.concatenate([r.lengths for r in legs]), waypoints=candidate.waypoints,
                           title="subtask success: " + ", ".join(f"{p:.2f}" for p in candidate.probabilities))
         return to_png(fig)
 
     return picture
-
-
-def _pad(traj, width):
-    if traj.shape[1] == width:
-        return traj
-    return np.concatenate([traj, np.repeat(traj[:, -1:], width - traj.shape[1], axis=1)], axis=1)
-
-
-@dataclass
-class Measurement:
-    success: np.ndarray
-    path_result: object | None
-
-    @property
-    def rate(self) -> float:
-        return float(self.success.mean()) if len(self.success) else 0.0
-
-
-def _measure(evaluator, original, search, episodes, seed) -> Measurement:
-    from .evaluate import path_legs
-    from .monitor import satisfies
-
-    if not search.path or len(search.path) < 2:
-        return Measurement(np.zeros(0, dtype=bool), None)
-
-    # always from the ORIGINAL initial distribution, even if a baseline changed the initial vertex
-    legs = path_legs(search.graph, search.path)
-    pr = evaluator.run_compositional(original.region(original.initial), legs, n=episodes,
-                                     seed=seed + MEASURE_SEED_OFFSET)
-    ok = satisfies(original, pr.trajectories, pr.lengths, clearance=evaluator.clearance)
-    return Measurement(ok, pr)
 
 
 def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, search, measured, evaluator, t0):

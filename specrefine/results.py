@@ -118,13 +118,13 @@ def merge_edge_results(a: EdgeResult, b: EdgeResult) -> EdgeResult:
     k, n = int(success.sum()), a.n + b.n
     ends = StartStates(np.concatenate([a.end_states.states, b.end_states.states]),
                        np.concatenate([a.end_states.xy, b.end_states.xy]))
-    return EdgeResult(p=k / n if n else 0.0, ci=wilson_ci(k, n), n=n, successes=k, success=success,
-                      trajectories=np.concatenate([_pad_to(a.trajectories, T), _pad_to(b.trajectories, T)]),
+    traj = np.concatenate([pad_trajectories(a.trajectories, T), pad_trajectories(b.trajectories, T)])
+    return EdgeResult(p=k / n if n else 0.0, ci=wilson_ci(k, n), n=n, successes=k, success=success, trajectories=traj,
                       lengths=np.concatenate([a.lengths, b.lengths]), end_states=ends, steps=a.steps + b.steps,
                       cached=a.cached and b.cached, outcome=np.concatenate([a.outcome, b.outcome]))
 
 
-def _pad_to(traj: np.ndarray, T: int) -> np.ndarray:
+def pad_trajectories(traj: np.ndarray, T: int) -> np.ndarray:
     """Trajectories padded to T points with each row's last point (rows are already padded that way)."""
     if traj.shape[1] >= T:
         return traj
