@@ -146,6 +146,41 @@ def markdown_table(rows, by=("maze", "method", "proposer")) -> str:
     return "\n".join(lines)
 
 
+def calibration_figure(tables: dict):
+    """Measured success against the calibrated prediction, one marker per run, with both intervals.
+
+    ``tables``: label -> rows with ``success_rate``, ``success_ci_low/high`` (optional) and
+    ``predicted_success``, ``predicted_ci_low/high`` (e.g. ``python -m specrefine.calibrate``'s table).
+    A run is covered when its measured rate lies inside ``predicted_ci``; the legend gives the count per table.
+    """
+    from .calibrate import coverage
+
+    fig, ax = plt.subplots(figsize=(6.4, 6.0), FigureClass=PngFigure)
+    for (label, rows), marker in zip(tables.items(), "osD^v<>"):
+        rows = [r for r in rows if r.get("predicted_ci_low") not in (None, "")]
+        if not rows:
+            continue
+        pred = np.array([float(r["predicted_success"]) for r in rows])
+        meas = np.array([float(r["success_rate"]) for r in rows])
+        lo, hi = (np.array([float(r[k]) for r in rows]) for k in ("predicted_ci_low", "predicted_ci_high"))
+        inside, total = coverage(rows)
+        ax.vlines(pred, lo, hi, color="0.75", lw=0.8, zorder=1)
+        covered = (lo <= meas) & (meas <= hi)
+        ax.scatter(pred[covered], meas[covered], marker=marker, s=14, label=f"{label}: {inside}/{total} covered",
+                   zorder=2)
+        ax.scatter(pred[~covered], meas[~covered], marker=marker, s=22, facecolors="none", edgecolors="#c62828",
+                   zorder=3)
+    ax.plot([0, 1], [0, 1], color="0.4", lw=0.8, ls="--")
+    ax.set_xlim(-0.02, 1.02)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("predicted success (held-out posterior mean); grey: 95 % predictive interval")
+    ax.set_ylabel("measured success (fresh episodes)")
+    ax.set_title("Calibration: measured success vs the prediction (red rings: outside predicted_ci)", fontsize=10)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
 def main(argv=None) -> int:
     import argparse
     from pathlib import Path

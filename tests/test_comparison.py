@@ -195,3 +195,14 @@ def test_figure5_legend_when_the_last_preset_has_no_u_chain_runs_yet():
     fig = cmp.comparison_figures(rows)["figure5"]
     legend = fig.axes[-1].get_legend()
     assert legend is not None and [t.get_text() for t in legend.get_texts()][0] == "ours (no subgoals)"
+
+
+def test_calibration_figure_counts_runs_inside_the_predicted_interval():
+    from specrefine.figures import calibration_figure
+
+    rows = [{"success_rate": 0.9, "predicted_success": 0.88, "predicted_ci_low": 0.8, "predicted_ci_high": 0.95},
+            {"success_rate": 0.5, "predicted_success": 0.9, "predicted_ci_low": 0.8, "predicted_ci_high": 0.97},
+            {"success_rate": 0.7, "predicted_success": "", "predicted_ci_low": "", "predicted_ci_high": ""}]
+    fig = calibration_figure({"runs": rows})
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels == ["runs: 1/2 covered"]
