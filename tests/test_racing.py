@@ -135,3 +135,13 @@ def test_cli_adaptive_run_records_its_evaluation(tmp_path, capsys):
     rc = cli_main(["refine", "u_chain_1", "--evaluation", "fixed", "--rollouts", "16", "--episodes", "40",
                    "--out", str(out)])
     assert rc == 2 and "evaluation" in capsys.readouterr().err  # another run's folder is refused
+
+
+@pytest.mark.parametrize("method", ["dirl", "vlm-oneshot"])
+def test_methods_without_the_vertex_dp_do_not_depend_on_the_evaluation(method, tmp_path):
+    from specrefine.pipeline import refine_maze
+
+    runs = [refine_maze("u_chain_1", method=method, seed=2, rollouts=8, episodes=20, out=tmp_path / ev,
+                        evaluation=ev).data for ev in ("fixed", "adaptive")]
+    for key in ("success_rate", "evaluations", "sim_steps", "path", "predicted_ci"):
+        assert runs[0][key] == runs[1][key], key
