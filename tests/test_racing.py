@@ -58,6 +58,10 @@ def test_stages_and_seeds():
     assert len({stage_seed(0, 0), stage_seed(0, 1), 0, 1_000_003, 2_000_029}) == 5
     with pytest.raises(ValueError):
         Racing((8, 0))
+    with pytest.raises(ValueError):
+        Racing((8, 24), indifference=1.0)
+    assert Racing((8, 24)).may_beat(1.0, 31 / 32) and not Racing((8, 24)).may_beat(1.0, 1.0)
+    assert not Racing((8, 24), indifference=1 / 32).may_beat(1.0, 31 / 32)  # one rollout's worth: indifferent
 
 
 def test_hopeless_candidate_gets_only_its_first_stage():
@@ -78,14 +82,15 @@ def _bumps(seed, plateau: float):
     return p_of_x
 
 
-def _fixed_and_adaptive(p_of_x, seed):
+def _fixed_and_adaptive(p_of_x, seed, racing=None):
+    racing = racing or Racing((8, 24))
     inner = [Box(0, 0, 2.5, 1), Box(2.5, 0, 5, 1), Box(5, 0, 7.5, 1)]
     goal = Box(7.5, 0, 9, 1)
     runs = {}
-    for name, racing in (("fixed", None), ("adaptive", Racing((8, 24)))):
+    for name, how in (("fixed", None), ("adaptive", racing)):
         ev = ExactEvaluator(p_of_x)
         choice = refine_chain(ev, Box(-1, 0, 0, 1), inner, goal, [WALLS] * 4, 5, np.random.default_rng(seed),
-                              racing=racing)
+                              racing=how)
         runs[name] = (choice, ev.rollouts)
     return runs["fixed"], runs["adaptive"]
 
@@ -94,9 +99,12 @@ def _fixed_and_adaptive(p_of_x, seed):
 @pytest.mark.parametrize("plateau", [0.15, 0.6])
 def test_adaptive_chain_dp_chooses_what_the_fixed_dp_chooses(seed, plateau):
     """With exact estimates the adaptive DP finds the fixed DP's optimum (a tie may pick another option), never
-    on more rollouts."""
-    (fixed, fixed_rollouts), (adaptive, adaptive_rollouts) = _fixed_and_adaptive(_eighths(_bumps(seed, plateau)), seed)
+    on more rollouts; with a margin of 1/32 it ends within (1 - 1/32) per layer of it."""
+    p_of_x = _eighths(_bumps(seed, plateau))
+    (fixed, fixed_rollouts), (adaptive, adaptive_rollouts) = _fixed_and_adaptive(p_of_x, seed)
+    (_, _), (margin, _) = _fixed_and_adaptive(p_of_x, seed, Racing((8, 24), indifference=1 / 32))
     assert adaptive.p == pytest.approx(fixed.p, rel=1e-12)
+    assert fixed.p * (1 - 1 / 32) ** 4 - 1e-12 <= margin.p <= fixed.p + 1e-12
     assert all(r.n == 32 for r in adaptive.results)  # what is chosen rests on the full budget
     assert adaptive_rollouts <= fixed_rollouts
 

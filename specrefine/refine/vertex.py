@@ -127,23 +127,23 @@ def _fill(layer: list[_Path], best: list[_Path | None], last: bool) -> list[_Pat
 
 def _next_layer_racing(evaluator, layer: list[_Path], targets: list[tuple], bound: float, last: bool = False, *,
                        racing: Racing) -> tuple[list[_Path], int]:
-    """``_next_layer`` by branch and bound with staged estimates, in two rounds of batches.
+    """``_next_layer`` by branch and bound over the prefixes, most likely first, with staged estimates.
 
-    Round 1 extends the most likely prefix to every target; round 2 extends every other prefix to the
-    targets where it is still more likely than the best value found (and than ``bound``: p(step) <= 1
-    cannot lift it above), dropping an extension whose first stage shows it cannot beat that value.
+    A prefix is extended to a target only while it could beat the best value found for that target
+    (and ``bound``) by more than ``racing.indifference`` (p(step) <= 1 bounds what it can reach); an
+    extension whose first stage shows it cannot is dropped.
     """
     alive = sorted((prev for prev in layer if prev.p > bound and start_of(prev.results[-1]) is not None),
                    key=lambda prev: -prev.p)
     best: list[_Path | None] = [None] * len(targets)
     asked = 0
-    for round_ in (alive[:1], alive[1:]):
+    for prev in alive:
         floor = [max(bound, b.p if b is not None else 0.0) for b in best]
-        pairs = [(prev, i) for prev in round_ for i in range(len(targets)) if prev.p > floor[i]]
-        steps = racing.evaluate(evaluator, [(start_of(prev.results[-1]), *targets[i]) for prev, i in pairs],
-                                floors=[floor[i] for _, i in pairs], scale=[prev.p for prev, _ in pairs])
-        asked += len(pairs)
-        for (prev, i), step in zip(pairs, steps, strict=True):
-            if step is not None and prev.p * step.p > max(floor[i], best[i].p if best[i] is not None else 0.0):
+        open_targets = [i for i in range(len(targets)) if racing.may_beat(prev.p, floor[i])]
+        steps = racing.evaluate(evaluator, [(start_of(prev.results[-1]), *targets[i]) for i in open_targets],
+                                floors=[floor[i] for i in open_targets], scale=[prev.p] * len(open_targets))
+        asked += len(open_targets)
+        for i, step in zip(open_targets, steps, strict=True):
+            if step is not None and prev.p * step.p > floor[i]:
                 best[i] = _Path(prev.p * step.p, prev.results + [step], prev.choices + ([] if last else [i]))
     return _fill(layer, best, last), asked
