@@ -352,12 +352,16 @@ class CompiledRegion:
             g = self._grids[thr] = (lo, size, shape, table, c, h)
         return g
 
-    def below(self, pts: np.ndarray, thr: float) -> np.ndarray:
-        """``signed_distance(pts) < thr``, exactly, looking only at nearby boxes."""
+    def below(self, pts: np.ndarray, thr: float, grid_thr: float = 0.0) -> np.ndarray:
+        """``signed_distance(pts) < thr``, exactly, looking only at nearby boxes.
+
+        The bucket grid is the one for ``max(thr, grid_thr)`` (a grid for a larger threshold answers a
+        smaller one too): callers asking about many different thresholds pass their largest, and share one grid.
+        """
         pts = np.asarray(pts, dtype=float).reshape(-1, 2)
         if len(self.bc) < self.BUCKET_MIN_PARTS:
             return self.signed_distance(pts) < thr
-        lo, size, shape, table, c, h = self._grid(float(thr))
+        lo, size, shape, table, c, h = self._grid(float(max(thr, grid_thr)))
         ij = np.floor((pts - lo) / size).astype(np.int64)
         inside = np.all((ij >= 0) & (ij < shape), axis=1)
         cand = table[np.where(inside, ij[:, 0] * shape[1] + ij[:, 1], 0)]  # (n, k)
