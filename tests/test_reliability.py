@@ -310,3 +310,19 @@ def test_a_closed_stdout_is_no_traceback(tmp_path):
     proc.stdout.close()  # as `| head` does once it has its lines
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 0 and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf")])
+def test_a_policy_with_nan_or_inf_weights_is_refused_at_load(tmp_path, capsys, value):
+    import torch
+
+    from specrefine.policy import GoalPolicy, save_policy
+
+    policy = GoalPolicy("point")
+    with torch.no_grad():
+        policy.net[2].weight[3, 5] = value
+    path = tmp_path / "broken.pt"
+    save_policy(policy, path)
+    assert_one_line_exit_2(cli_main, refine(tmp_path / "o", "--policy", str(path)), capsys,
+                           f"{path}: weights hold NaN or infinite values (net.2.weight)")
+    assert not (tmp_path / "o" / "run.json").exists()
