@@ -66,7 +66,9 @@ class Server:
     """Scripted OpenAI-compatible chat-completions endpoint."""
 
     def __init__(self):
-        self.script: list = []  # items: int (HTTP error status) or list[str] (choice contents)
+        # items: int (HTTP error status), (status, {header: value}), list[str] (choice contents) or bytes (a raw
+        # HTTP 200 body)
+        self.script: list = []
         self.requests: list[dict] = []
         outer = self
 
@@ -75,9 +77,13 @@ class Server:
                 body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
                 outer.requests.append({"path": self.path, "headers": dict(self.headers), "body": body})
                 item = outer.script.pop(0) if outer.script else [GOOD]
-                if isinstance(item, int):
-                    data = json.dumps({"error": {"message": f"scripted {item}", "type": "test"}}).encode()
-                    self.send_response(item)
+                status, headers = item if isinstance(item, tuple) else (item, {})
+                if isinstance(status, int):
+                    data = json.dumps({"error": {"message": f"scripted {status}", "type": "test"}}).encode()
+                    self.send_response(status)
+                elif isinstance(item, bytes):
+                    data = item
+                    self.send_response(200)
                 else:
                     n = int(body.get("n") or 1)
                     contents = (item * n)[:n] if len(item) < n else item[:n]
@@ -89,7 +95,8 @@ class Server:
                         "usage": {"prompt_tokens": 1000, "completion_tokens": 100, "total_tokens": 1100},
                     }).encode()
                     self.send_response(200)
-                self.send_header("Content-Type", "application/json")
+                for name, value in {"Content-Type": "application/json", **headers}.items():
+                    self.send_header(name, value)
                 self.send_header("Content-Length", str(len(data)))
                 self.end_headers()
                 self.wfile.write(data)
@@ -398,3 +405,14 @@ def test_a_request_ends_at_its_deadline_with_one_line(srv, tmp_path, query, monk
     monkeypatch.setenv("SPECREFINE_VLM_DEADLINE", "-1")
     with pytest.raises(VLMConfigError, match="SPECREFINE_VLM_DEADLINE"):
         LiteLLMClient(MODEL, api_base=srv.base, record_path=tmp_path / "rec.jsonl")
+
+
+@pytest.mark.parametrize("retry_after,slept", [("2", 2.0), ("100000", 60.0)])
+def test_retry_after_is_honoured_up_to_its_cap(srv, tmp_path, query, monkeypatch, retry_after, slept):
+    from specrefine.vlm.client import MAX_RETRY_AFTER
+
+    waits = []
+    monkeypatch.setattr("specrefine.vlm.client.time.sleep", waits.append)
+    srv.script[:] = [(429, {"Retry-After": retry_after}), [GOOD]]
+    assert len(proposer(srv, tmp_path).propose_split(query, 1)) == 1
+    assert waits == [slept] and MAX_RETRY_AFTER == 60.0  # not the 0.01 s back-off, and never 100000 s

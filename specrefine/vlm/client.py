@@ -3,13 +3,13 @@
 :class:`LiteLLMClient` calls ``litellm.completion`` for any model string (``gpt-4o``,
 ``gemini/gemini-2.0-flash``, ``anthropic/claude-sonnet-4-5``, ``ollama/llava``, ...): images go as
 base64 PNG data URLs, ``w`` samples per query (``n`` where the provider has it, else ``w`` calls),
-JSON response format where supported, timeouts, and logged retries with back-off on rate limits,
-server errors and dropped connections (a provider's ``Retry-After`` honoured up to 60 s).  One request,
-retries included, ends within ``deadline`` seconds (default 600, or ``SPECREFINE_VLM_DEADLINE``): past it
-the run stops with one line saying what timed out.  Tokens and cost are counted per call (cost 0 for models
-LiteLLM has no price for).  Keys are read by LiteLLM from the environment only; nothing this
-module writes (recordings, logs, error messages) ever contains them.  Every real call is appended
-to a recording (:mod:`specrefine.vlm.recording`).
+JSON response format where supported, timeouts, and logged retries with back-off on rate limits, server
+errors and dropped connections (a provider's ``Retry-After`` honoured up to ``MAX_RETRY_AFTER`` = 60 s).
+One request, retries included, ends within ``deadline`` seconds (default 600, or
+``SPECREFINE_VLM_DEADLINE``): past it the run stops with one line saying what timed out.  Tokens and
+cost are counted per call (cost 0 for models LiteLLM has no price for).  Keys are read by LiteLLM from
+the environment only; nothing this module writes (recordings, logs, error messages) ever contains them.
+Every real call is appended to a recording (:mod:`specrefine.vlm.recording`).
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ _KEY_VARS = {"openai": "OPENAI_API_KEY", "gemini": "GEMINI_API_KEY", "anthropic"
              "ollama": "OLLAMA_API_BASE", "ollama_chat": "OLLAMA_API_BASE", "mistral": "MISTRAL_API_KEY",
              "groq": "GROQ_API_KEY", "openrouter": "OPENROUTER_API_KEY", "azure": "AZURE_API_KEY",
              "together_ai": "TOGETHERAI_API_KEY", "deepseek": "DEEPSEEK_API_KEY", "xai": "XAI_API_KEY"}
+MAX_RETRY_AFTER = 60.0  # s: the longest wait a provider's Retry-After header gets (a longer one is cut to this)
 _MODEL_HINT = "use a LiteLLM model string such as gpt-4o, gemini/gemini-2.0-flash, anthropic/claude-sonnet-4-5 " \
               "or ollama/llava"
 
@@ -56,6 +57,20 @@ def _deadline(value: float | None) -> float:
     if not 0 < seconds < float("inf"):
         raise VLMConfigError(f"VLM deadline {text!r} (SPECREFINE_VLM_DEADLINE): use a number of seconds > 0")
     return seconds
+
+
+def _retry_after(exc) -> float | None:
+    """The seconds of a Retry-After header, if the failed call had one (LiteLLM keeps the provider's headers in
+    ``litellm_response_headers``; its ``response`` is a stand-in without them)."""
+    for headers in (getattr(exc, "litellm_response_headers", None), getattr(getattr(exc, "response", None), "headers",
+                                                                            None)):
+        try:
+            seconds = float(headers.get("retry-after"))
+        except (TypeError, ValueError, AttributeError):
+            continue
+        if seconds >= 0:
+            return seconds
+    return None
 
 
 def _priced(lt, model: str) -> bool:
@@ -248,13 +263,8 @@ class LiteLLMClient(VLMClient):
 
     def _wait(self, exc, attempt: int) -> float:
         wait = self.retry_wait * (2 ** (attempt - 1))
-        headers = getattr(getattr(exc, "response", None), "headers", None) or {}
-        try:
-            after = float(headers.get("retry-after"))
-            wait = max(wait, min(after, 60.0))
-        except (TypeError, ValueError, AttributeError):
-            pass
-        return wait
+        after = _retry_after(exc)
+        return wait if after is None else max(wait, min(after, MAX_RETRY_AFTER))
 
     def _cost(self, lt, resp) -> float:
         try:
