@@ -416,3 +416,26 @@ def test_retry_after_is_honoured_up_to_its_cap(srv, tmp_path, query, monkeypatch
     srv.script[:] = [(429, {"Retry-After": retry_after}), [GOOD]]
     assert len(proposer(srv, tmp_path).propose_split(query, 1)) == 1
     assert waits == [slept] and MAX_RETRY_AFTER == 60.0  # not the 0.01 s back-off, and never 100000 s
+
+
+ADDRESSES = [("ollama/llava", "OLLAMA_API_BASE"), ("ollama_chat/llava", "OLLAMA_API_BASE"),
+             (MODEL, "OPENAI_BASE_URL"), (MODEL, "OPENAI_API_BASE")]
+
+
+@pytest.mark.parametrize("model,variable", ADDRESSES)
+def test_an_unreachable_provider_is_named_by_the_address_tried(srv, tmp_path, query, monkeypatch, model, variable):
+    for name in ("OLLAMA_API_BASE", "OPENAI_BASE_URL", "OPENAI_API_BASE"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(variable, "http://user:secret@127.0.0.1:9/v1?token=x")
+    client = LiteLLMClient(model, record_path=tmp_path / "rec.jsonl", num_retries=0, timeout=5)
+    with pytest.raises(VLMUnavailable, match=r"unreachable or failing at http://127\.0\.0\.1:9/v1[ )]") as e:
+        VLMProposer(client).propose_split(query, 1)
+    assert "secret" not in str(e.value) and "token" not in str(e.value)
+    if model.startswith("ollama"):
+        assert "ollama serve" in str(e.value)
+        monkeypatch.delenv(variable)
+        assert LiteLLMClient(model, record_path=tmp_path / "rec.jsonl").endpoint == "http://localhost:11434"
+    else:  # the address named is the one LiteLLM calls: pointed at the fake server, it answers
+        monkeypatch.setenv(variable, srv.base)
+        client = LiteLLMClient(model, record_path=tmp_path / "rec.jsonl", timeout=10)
+        assert len(VLMProposer(client).propose_split(query, 1)) == 1 and len(srv.requests) == 1

@@ -81,6 +81,20 @@ def _priced(lt, model: str) -> bool:
     return bool(info.get("input_cost_per_token") or info.get("output_cost_per_token"))
 
 
+_DEFAULT_BASES = {"ollama": "http://localhost:11434", "ollama_chat": "http://localhost:11434"}
+_BASE_VARS = {"openai": ("OPENAI_BASE_URL", "OPENAI_API_BASE"), "ollama_chat": ("OLLAMA_API_BASE",)}
+
+
+def _endpoint(provider: str, api_base: str | None, resolved: str | None) -> str | None:
+    """The address calls go to, where it is known here: ``api_base``, LiteLLM's resolution, the provider's
+    ``*_API_BASE`` variable, or a local provider's default (None: the provider's own cloud address)."""
+    names = (f"{provider.upper()}_API_BASE", *_BASE_VARS.get(provider, ()))
+    for url in (api_base, resolved, *(os.environ.get(name) for name in names), _DEFAULT_BASES.get(provider)):
+        if url:
+            return _safe_url(url)
+    return None
+
+
 def _safe_url(url: str | None) -> str | None:
     """``url`` without any ``user:password@`` part or query string."""
     if not url:
@@ -109,10 +123,11 @@ class LiteLLMClient(VLMClient):
         self.recorder = Recorder(record_path or default_record_path(model)) if record else None
         lt = _litellm()
         try:
-            _, self.provider, _, _ = lt.get_llm_provider(model, api_base=api_base)
+            _, self.provider, _, resolved = lt.get_llm_provider(model, api_base=api_base)
         except Exception:
             raise VLMConfigError(f"unknown model litellm:{model}: LiteLLM cannot tell its provider; "
                                  f"{_MODEL_HINT}") from None
+        self.endpoint = _endpoint(self.provider, api_base, resolved if isinstance(resolved, str) else None)
         self.key_var = _KEY_VARS.get(self.provider, f"{self.provider.upper()}_API_KEY")
         if check_env:
             self._check_env(lt)
@@ -224,11 +239,11 @@ class LiteLLMClient(VLMClient):
                     raise VLMUnavailable(f"litellm:{self.model}: rate-limited by the provider after {attempt} "
                                          f"attempts; wait and rerun, or lower -w / the number of edges") from None
                 if isinstance(exc, retryable):
-                    where = f" at {_safe_url(self.api_base)}" if self.api_base else ""
-                    if self.provider.startswith("ollama") and not self.api_base:
-                        where = " (is `ollama serve` running? set OLLAMA_API_BASE if it is not at localhost:11434)"
-                    raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where} after "
-                                         f"{attempt} attempts ({one_line(exc, 120)})") from None
+                    where = f" at {self.endpoint}" if self.endpoint else ""
+                    hint = " (is `ollama serve` running there? OLLAMA_API_BASE sets its address)" \
+                        if self.provider.startswith("ollama") else ""
+                    raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where}{hint} "
+                                         f"after {attempt} attempts ({one_line(exc, 120)})") from None
                 raise VLMError(f"litellm:{self.model}: call failed: {one_line(exc, 160)}") from None
             latency = time.time() - t0
             texts, finish = [], []
@@ -257,8 +272,9 @@ class LiteLLMClient(VLMClient):
 
     def _check_deadline(self, wait: float, attempt: int, exc) -> None:
         if time.monotonic() + wait >= self._until:
+            source = f" from {self.endpoint}" if self.endpoint else ""
             raise VLMUnavailable(f"litellm:{self.model}: no answer within the {self.deadline:g} s deadline of one "
-                                 f"request (SPECREFINE_VLM_DEADLINE) after {attempt} attempts; the last: "
+                                 f"request (SPECREFINE_VLM_DEADLINE){source} after {attempt} attempts; the last: "
                                  f"{type(exc).__name__} ({one_line(exc, 100)})") from None
 
     def _wait(self, exc, attempt: int) -> float:
