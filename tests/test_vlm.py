@@ -439,3 +439,40 @@ def test_an_unreachable_provider_is_named_by_the_address_tried(srv, tmp_path, qu
         monkeypatch.setenv(variable, srv.base)
         client = LiteLLMClient(model, record_path=tmp_path / "rec.jsonl", timeout=10)
         assert len(VLMProposer(client).propose_split(query, 1)) == 1 and len(srv.requests) == 1
+
+
+NOT_JSON = b"<html><body>502 Bad Gateway, sent by a proxy as 200</body></html>"
+NO_CHOICES = json.dumps({"id": "c", "object": "chat.completion", "created": 0, "model": "test-model", "choices": [],
+                         "usage": {"prompt_tokens": 1, "completion_tokens": 0, "total_tokens": 1}}).encode()
+
+
+@pytest.mark.parametrize("body,why", [(NOT_JSON, "no chat completion"), (b"{}", "no chat completion"),
+                                      (b"null", "no chat completion"), (NO_CHOICES, "empty choices list")])
+def test_a_reply_that_cannot_be_read_is_a_bad_answer_asked_again(srv, tmp_path, query, caplog, body, why):
+    srv.script[:] = [body, [GOOD], body, [GOOD2]]
+    p = proposer(srv, tmp_path)
+    with caplog.at_level(logging.WARNING):
+        first, second = p.propose_split(query, 2), p.propose_split(query, 2)
+    assert first == [[Disc(-1.0, -2.5, 0.4), Disc(1.0, -2.5, 0.4)]] * 2 and len(second) == 2  # the run goes on
+    assert len(srv.requests) == 4 and srv.requests[1]["body"]["n"] == 2  # re-asked for both answers
+    assert len([r for r in caplog.records if why in r.getMessage()]) == 1  # warned once
+    assert p.bad_replies == 4 and p.client.stats()["bad_replies"] == 4 and p.calls == 4
+    assert p.history[0]["reasked"] and len(p.history[0]["rejected"]) == 2 and why in p.history[0]["rejected"][0]
+    replay = make_proposer(f"replay:{tmp_path / 'rec.jsonl'}")  # recorded as the same bad answers
+    assert replay.propose_split(query, 2) == first and replay.history == p.history[:1] and replay.bad_replies == 2
+
+
+def test_a_reply_longer_than_the_cap_is_a_bad_answer_recorded_capped(srv, tmp_path, query):
+    from specrefine.vlm import MAX_REPLY_CHARS
+
+    srv.script[:] = [[GOOD + " " * MAX_REPLY_CHARS], [GOOD]]  # valid JSON, a megabyte of it
+    p = proposer(srv, tmp_path)
+    out = p.propose_split(query, 1)
+    assert out == [[Disc(-1.0, -2.5, 0.4), Disc(1.0, -2.5, 0.4)]]  # from the re-ask
+    assert p.bad_replies == 1 and "longer than the cap of 1,000,000 characters" in p.history[0]["rejected"][0]
+    record = tmp_path / "rec.jsonl"
+    (choice,) = json.loads(record.read_text().splitlines()[0])["response"]["choices"]
+    assert len(choice["text"]) == MAX_REPLY_CHARS and "MAX_REPLY_CHARS" in choice["bad"]
+    assert record.stat().st_size < MAX_REPLY_CHARS + 100_000
+    replay = make_proposer(f"replay:{record}")
+    assert replay.propose_split(query, 1) == out and replay.bad_replies == 1

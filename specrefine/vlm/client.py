@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import VLMConfigError, VLMError, VLMUnavailable
-from .messages import VLMClient, one_line, request_hash
+from .messages import MAX_REPLY_CHARS, TOO_LONG, VLMClient, one_line, request_hash
 from .recording import RECORD_VERSION, Recorder, default_record_path
 
 log = logging.getLogger(__name__)
@@ -57,6 +57,49 @@ def _deadline(value: float | None) -> float:
     if not 0 < seconds < float("inf"):
         raise VLMConfigError(f"VLM deadline {text!r} (SPECREFINE_VLM_DEADLINE): use a number of seconds > 0")
     return seconds
+
+
+NOT_A_COMPLETION = "an HTTP 200 reply that is no chat completion (not JSON, or without choices)"
+NO_ANSWERS = "a reply without answers (an empty choices list)"
+
+
+def _not_a_completion(exc, lt) -> bool:
+    """An HTTP 200 whose body is no chat completion.  LiteLLM reports an InternalServerError, as it does for a
+    real 5xx or a refused connection; those carry an HTTP or transport error in the exception's cause chain
+    (httpx, httpcore, an OSError, openai's APIConnectionError), a body that is no completion does not."""
+    server_error = getattr(lt, "InternalServerError", None)
+    if not (isinstance(server_error, type) and isinstance(exc, server_error)):
+        return False
+    cause, depth = exc, 0
+    while cause is not None and depth < 16:
+        kind = type(cause)
+        if kind.__module__.split(".")[0] in ("httpx", "httpcore") or isinstance(cause, OSError) \
+                or kind.__name__ in ("APIConnectionError", "APITimeoutError"):
+            return False
+        cause, depth = cause.__cause__ or cause.__context__, depth + 1
+    return True
+
+
+def _choices(resp) -> list[tuple[str, Any]]:
+    """(text, finish_reason) of each choice of a completion."""
+    out = []
+    for choice in getattr(resp, "choices", None) or []:
+        content = getattr(getattr(choice, "message", None), "content", None)
+        if isinstance(content, list):  # some providers return content parts
+            content = "".join(p.get("text", "") if isinstance(p, dict) else str(p) for p in content)
+        out.append((content if isinstance(content, str) else "", getattr(choice, "finish_reason", None)))
+    return out
+
+
+def _answers(resp, n: int) -> list[tuple[str, Any, str | None]]:
+    """(text as recorded, finish_reason, why it cannot be used) per answer; a reply with none is n bad ones."""
+    if resp is None:
+        return [("", None, NOT_A_COMPLETION)] * n
+    choices = _choices(resp)
+    if not choices:
+        return [("", None, NO_ANSWERS)] * n
+    return [(text[:MAX_REPLY_CHARS], finish, TOO_LONG if len(text) > MAX_REPLY_CHARS else None)
+            for text, finish in choices]
 
 
 def _retry_after(exc) -> float | None:
@@ -211,6 +254,8 @@ class LiteLLMClient(VLMClient):
                 resp = lt.completion(**kw)
             except Exception as exc:  # noqa: BLE001 - every provider failure becomes one line or a retry
                 latency = time.time() - t0
+                if _not_a_completion(exc, lt):  # a bad answer, not a failure: the proposer asks again
+                    return self._answered(lt, kw, messages, (key, text_key), None, latency, attempt, n)
                 self._record(kw, messages, key, text_key, None, 0.0, latency, attempt, error=one_line(exc))
                 if isinstance(exc, bad_request) and not isinstance(exc, (not_found, *auth)) and (
                         "n" in kw or "response_format" in kw):
@@ -245,30 +290,26 @@ class LiteLLMClient(VLMClient):
                     raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where}{hint} "
                                          f"after {attempt} attempts ({one_line(exc, 120)})") from None
                 raise VLMError(f"litellm:{self.model}: call failed: {one_line(exc, 160)}") from None
-            latency = time.time() - t0
-            texts, finish = [], []
-            for choice in getattr(resp, "choices", None) or []:
-                msg = getattr(choice, "message", None)
-                content = getattr(msg, "content", None)
-                if isinstance(content, list):  # some providers return content parts
-                    content = "".join(p.get("text", "") if isinstance(p, dict) else str(p) for p in content)
-                texts.append(content if isinstance(content, str) else "")
-                finish.append(getattr(choice, "finish_reason", None))
-            usage = getattr(resp, "usage", None)
-            pt = int(getattr(usage, "prompt_tokens", 0) or 0)
-            ct = int(getattr(usage, "completion_tokens", 0) or 0)
-            cost = self._cost(lt, resp)
-            self.calls += 1
-            self.prompt_tokens += pt
-            self.completion_tokens += ct
-            self.cost_usd += cost
-            response = {"id": getattr(resp, "id", None), "model": getattr(resp, "model", None),
-                        "choices": [{"text": t, "finish_reason": f} for t, f in zip(texts, finish)],
-                        "usage": {"prompt_tokens": pt, "completion_tokens": ct}}
-            self._record(kw, messages, key, text_key, response, cost, latency, attempt)
-            log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(texts), pt, ct, cost,
-                     latency)
-            return texts
+            return self._answered(lt, kw, messages, (key, text_key), resp, time.time() - t0, attempt, n)
+
+    def _answered(self, lt, kw, messages, keys, resp, latency, attempt, n) -> list[str]:
+        """Count and record a call the server answered; its answers, a BadReply for each that cannot be read."""
+        answers = _answers(resp, n)
+        usage = getattr(resp, "usage", None)
+        pt = int(getattr(usage, "prompt_tokens", 0) or 0)
+        ct = int(getattr(usage, "completion_tokens", 0) or 0)
+        cost = self._cost(lt, resp) if resp is not None else 0.0
+        self.calls += 1
+        self.prompt_tokens += pt
+        self.completion_tokens += ct
+        self.cost_usd += cost
+        response = {"id": getattr(resp, "id", None), "model": getattr(resp, "model", None),
+                    "choices": [{"text": text, "finish_reason": finish, **({"bad": why} if why else {})}
+                                for text, finish, why in answers],
+                    "usage": {"prompt_tokens": pt, "completion_tokens": ct}}
+        self._record(kw, messages, *keys, response, cost, latency, attempt)
+        log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(answers), pt, ct, cost, latency)
+        return [self.bad(why) if why else text for text, _, why in answers]
 
     def _check_deadline(self, wait: float, attempt: int, exc) -> None:
         if time.monotonic() + wait >= self._until:
