@@ -2,7 +2,7 @@
 
 ``data/planner_routes.json`` holds, per shipped maze (data/mazes and data/mazes/unseen) and agent, the
 SHA-256 of every proposal the geometric and imperfect planners made before their line-of-sight test
-was vectorised; the planner must still make exactly those.
+was vectorised (recorded with the code of commit 2fd381f); the planner must still make exactly those.
 Regenerate it only for a deliberate change of the planner: ``python tests/test_planner_scale.py``.
 """
 
