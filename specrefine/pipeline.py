@@ -222,6 +222,7 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "sim_steps": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
         "proposer_calls": int(getattr(proposer, "proposer_calls", 0) or 0),
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
+        "vlm_bad_replies": int(getattr(proposer, "bad_replies", 0) or 0),
         "rollouts_per_evaluation": evaluator.n, "refinements": search.refinements,
         "refines_input": not check_refines(graph, original), "path": search.path,
         "graph_vertices": graph.n_vertices, "graph_edges": graph.n_edges,

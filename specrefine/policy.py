@@ -1,8 +1,8 @@
 """The goal-conditioned subtask policy: observation normaliser + 2x256 tanh-Gaussian actor.
 
 A checkpoint is a small ``torch.save`` dict (float32 ``state_dict`` plus a few header
-fields), loaded with ``weights_only=True``; ``load_policy`` checks the header and shapes and
-turns any problem into a one-line :class:`PolicyError`.
+fields), loaded with ``weights_only=True``; ``load_policy`` checks the header, the shapes and that every
+weight is finite, and turns any problem into a one-line :class:`PolicyError`.
 """
 
 from __future__ import annotations
@@ -127,6 +127,10 @@ def load_policy(path_or_agent) -> GoalPolicy:
     except (RuntimeError, KeyError, TypeError) as e:
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
+    broken = [name for name, t in policy.state_dict().items() if not torch.isfinite(t).all()]
+    if broken:  # it would run, driving the simulator with NaN actions (tens of thousands of MuJoCo warnings)
+        raise PolicyError(f"{path}: weights hold NaN or infinite values ({', '.join(broken[:3])}"
+                          f"{', ...' if len(broken) > 3 else ''}); retrain or restore the checkpoint")
     policy.meta = blob.get("meta", {})
     return policy.eval()
 

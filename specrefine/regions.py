@@ -267,8 +267,9 @@ def is_subset(inner: Region, outer: Region, tol: float = 1e-9) -> bool:
     """True if every point of ``inner`` lies in ``outer``."""
     outer_parts = outer.parts()
     outer_boxes = [o for o in outer_parts if isinstance(o, Box)]  # inside these boxes => inside outer
+    members = set(outer_parts)  # an avoid set of hundreds of wall boxes against itself: no pairwise test
     for part in inner.parts():
-        if any(_part_in_part(part, o, tol) for o in outer_parts):
+        if part in members or any(_part_in_part(part, o, tol) for o in outer_parts):
             continue
         if outer_boxes and _part_in_boxes(_shrunk(part, tol), outer_boxes):
             continue
@@ -352,12 +353,16 @@ class CompiledRegion:
             g = self._grids[thr] = (lo, size, shape, table, c, h)
         return g
 
-    def below(self, pts: np.ndarray, thr: float) -> np.ndarray:
-        """``signed_distance(pts) < thr``, exactly, looking only at nearby boxes."""
+    def below(self, pts: np.ndarray, thr: float, grid_thr: float = 0.0) -> np.ndarray:
+        """``signed_distance(pts) < thr``, exactly, looking only at nearby boxes.
+
+        The bucket grid is the one for ``max(thr, grid_thr)`` (a grid for a larger threshold answers a
+        smaller one too): callers asking about many different thresholds pass their largest, and share one grid.
+        """
         pts = np.asarray(pts, dtype=float).reshape(-1, 2)
         if len(self.bc) < self.BUCKET_MIN_PARTS:
             return self.signed_distance(pts) < thr
-        lo, size, shape, table, c, h = self._grid(float(thr))
+        lo, size, shape, table, c, h = self._grid(float(max(thr, grid_thr)))
         ij = np.floor((pts - lo) / size).astype(np.int64)
         inside = np.all((ij >= 0) & (ij < shape), axis=1)
         cand = table[np.where(inside, ij[:, 0] * shape[1] + ij[:, 1], 0)]  # (n, k)

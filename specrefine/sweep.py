@@ -21,11 +21,14 @@ cell (the last ``ok`` one, else the last failure).  Ctrl-C ends the sweep with o
 keeping every finished row; pool workers die with the sweep's process.  Exit 1 when every cell failed.
 
 Backends: ``local`` (a process pool sized to the machine) and ``ray`` (the same cells as
-Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).
+Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).  With Ray, Ctrl-C cancels the cells
+still queued or running (``ray.cancel(force=True)``); a sweep killed outright cannot, and leaves its tasks
+to Ray's own clean-up of a job whose driver died (not tested here).
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import json
@@ -360,9 +363,14 @@ def _run_ray(cells, out_root, _workers, address):
         ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
     remote = ray.remote(num_cpus=1)(run_cell)
     refs = [remote.remote(cell, out_root) for cell in cells]
-    while refs:
-        ready, refs = ray.wait(refs, num_returns=1)
-        yield ray.get(ready[0])
+    try:
+        while refs:
+            ready, refs = ray.wait(refs, num_returns=1)
+            yield ray.get(ready[0])
+    finally:
+        for ref in refs:  # Ctrl-C or an error: the cells still queued or running must not go on without the sweep
+            with contextlib.suppress(Exception):
+                ray.cancel(ref, force=True)
 
 
 def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]:
@@ -417,7 +425,9 @@ def main(argv=None) -> int:
                    help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
                         "when adaptive)")
     p.add_argument("--out", default="runs/sweep")
-    p.add_argument("--backend", choices=["local", "ray"], default="local")
+    p.add_argument("--backend", choices=["local", "ray"], default="local",
+                   help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
+                        "Ray) (default: local)")
     p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)

@@ -310,3 +310,37 @@ def test_a_closed_stdout_is_no_traceback(tmp_path):
     proc.stdout.close()  # as `| head` does once it has its lines
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 0 and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf")])
+def test_a_policy_with_nan_or_inf_weights_is_refused_at_load(tmp_path, capsys, value):
+    import torch
+
+    from specrefine.policy import GoalPolicy, save_policy
+
+    policy = GoalPolicy("point")
+    with torch.no_grad():
+        policy.net[2].weight[3, 5] = value
+    path = tmp_path / "broken.pt"
+    save_policy(policy, path)
+    assert_one_line_exit_2(cli_main, refine(tmp_path / "o", "--policy", str(path)), capsys,
+                           f"{path}: weights hold NaN or infinite values (net.2.weight)")
+    assert not (tmp_path / "o" / "run.json").exists()
+
+
+def test_ctrl_c_cancels_a_ray_sweeps_tasks(tmp_path, monkeypatch):
+    """The Ray backend left its queued and running cells to go on after Ctrl-C (the local pool stops its workers)."""
+    from types import SimpleNamespace
+
+    def wait(refs, num_returns):
+        raise KeyboardInterrupt
+
+    cancelled = []
+    fake = SimpleNamespace(is_initialized=lambda: True, wait=wait,
+                           remote=lambda **_: lambda fn: SimpleNamespace(remote=lambda cell, out: f"ref:{cell.id}"),
+                           cancel=lambda ref, force=False: cancelled.append((ref, force)))
+    monkeypatch.setitem(sys.modules, "ray", fake)
+    cells = sweep.grid(["u_maze"], ["dirl"], ["none"], [0, 1, 2], rollouts=2, episodes=2)
+    with pytest.raises(KeyboardInterrupt):
+        sweep.run_sweep(cells, tmp_path / "s", backend="ray")
+    assert cancelled == [(f"ref:{c.id}", True) for c in cells]

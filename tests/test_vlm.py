@@ -66,7 +66,9 @@ class Server:
     """Scripted OpenAI-compatible chat-completions endpoint."""
 
     def __init__(self):
-        self.script: list = []  # items: int (HTTP error status) or list[str] (choice contents)
+        # items: int (HTTP error status), (status, {header: value}), list[str] (choice contents) or bytes (a raw
+        # HTTP 200 body)
+        self.script: list = []
         self.requests: list[dict] = []
         outer = self
 
@@ -75,9 +77,13 @@ class Server:
                 body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
                 outer.requests.append({"path": self.path, "headers": dict(self.headers), "body": body})
                 item = outer.script.pop(0) if outer.script else [GOOD]
-                if isinstance(item, int):
-                    data = json.dumps({"error": {"message": f"scripted {item}", "type": "test"}}).encode()
-                    self.send_response(item)
+                status, headers = item if isinstance(item, tuple) else (item, {})
+                if isinstance(status, int):
+                    data = json.dumps({"error": {"message": f"scripted {status}", "type": "test"}}).encode()
+                    self.send_response(status)
+                elif isinstance(item, bytes):
+                    data = item
+                    self.send_response(200)
                 else:
                     n = int(body.get("n") or 1)
                     contents = (item * n)[:n] if len(item) < n else item[:n]
@@ -89,7 +95,8 @@ class Server:
                         "usage": {"prompt_tokens": 1000, "completion_tokens": 100, "total_tokens": 1100},
                     }).encode()
                     self.send_response(200)
-                self.send_header("Content-Type", "application/json")
+                for name, value in {"Content-Type": "application/json", **headers}.items():
+                    self.send_header(name, value)
                 self.send_header("Content-Length", str(len(data)))
                 self.end_headers()
                 self.wfile.write(data)
@@ -398,3 +405,74 @@ def test_a_request_ends_at_its_deadline_with_one_line(srv, tmp_path, query, monk
     monkeypatch.setenv("SPECREFINE_VLM_DEADLINE", "-1")
     with pytest.raises(VLMConfigError, match="SPECREFINE_VLM_DEADLINE"):
         LiteLLMClient(MODEL, api_base=srv.base, record_path=tmp_path / "rec.jsonl")
+
+
+@pytest.mark.parametrize("retry_after,slept", [("2", 2.0), ("100000", 60.0)])
+def test_retry_after_is_honoured_up_to_its_cap(srv, tmp_path, query, monkeypatch, retry_after, slept):
+    from specrefine.vlm.client import MAX_RETRY_AFTER
+
+    waits = []
+    monkeypatch.setattr("specrefine.vlm.client.time.sleep", waits.append)
+    srv.script[:] = [(429, {"Retry-After": retry_after}), [GOOD]]
+    assert len(proposer(srv, tmp_path).propose_split(query, 1)) == 1
+    assert waits == [slept] and MAX_RETRY_AFTER == 60.0  # not the 0.01 s back-off, and never 100000 s
+
+
+ADDRESSES = [("ollama/llava", "OLLAMA_API_BASE"), ("ollama_chat/llava", "OLLAMA_API_BASE"),
+             (MODEL, "OPENAI_BASE_URL"), (MODEL, "OPENAI_API_BASE")]
+
+
+@pytest.mark.parametrize("model,variable", ADDRESSES)
+def test_an_unreachable_provider_is_named_by_the_address_tried(srv, tmp_path, query, monkeypatch, model, variable):
+    for name in ("OLLAMA_API_BASE", "OPENAI_BASE_URL", "OPENAI_API_BASE"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(variable, "http://user:secret@127.0.0.1:9/v1?token=x")
+    client = LiteLLMClient(model, record_path=tmp_path / "rec.jsonl", num_retries=0, timeout=5)
+    with pytest.raises(VLMUnavailable, match=r"unreachable or failing at http://127\.0\.0\.1:9/v1[ )]") as e:
+        VLMProposer(client).propose_split(query, 1)
+    assert "secret" not in str(e.value) and "token" not in str(e.value)
+    if model.startswith("ollama"):
+        assert "ollama serve" in str(e.value)
+        monkeypatch.delenv(variable)
+        assert LiteLLMClient(model, record_path=tmp_path / "rec.jsonl").endpoint == "http://localhost:11434"
+    else:  # the address named is the one LiteLLM calls: pointed at the fake server, it answers
+        monkeypatch.setenv(variable, srv.base)
+        client = LiteLLMClient(model, record_path=tmp_path / "rec.jsonl", timeout=10)
+        assert len(VLMProposer(client).propose_split(query, 1)) == 1 and len(srv.requests) == 1
+
+
+NOT_JSON = b"<html><body>502 Bad Gateway, sent by a proxy as 200</body></html>"
+NO_CHOICES = json.dumps({"id": "c", "object": "chat.completion", "created": 0, "model": "test-model", "choices": [],
+                         "usage": {"prompt_tokens": 1, "completion_tokens": 0, "total_tokens": 1}}).encode()
+
+
+@pytest.mark.parametrize("body,why", [(NOT_JSON, "no chat completion"), (b"{}", "no chat completion"),
+                                      (b"null", "no chat completion"), (NO_CHOICES, "empty choices list")])
+def test_a_reply_that_cannot_be_read_is_a_bad_answer_asked_again(srv, tmp_path, query, caplog, body, why):
+    srv.script[:] = [body, [GOOD], body, [GOOD2]]
+    p = proposer(srv, tmp_path)
+    with caplog.at_level(logging.WARNING):
+        first, second = p.propose_split(query, 2), p.propose_split(query, 2)
+    assert first == [[Disc(-1.0, -2.5, 0.4), Disc(1.0, -2.5, 0.4)]] * 2 and len(second) == 2  # the run goes on
+    assert len(srv.requests) == 4 and srv.requests[1]["body"]["n"] == 2  # re-asked for both answers
+    assert len([r for r in caplog.records if why in r.getMessage()]) == 1  # warned once
+    assert p.bad_replies == 4 and p.client.stats()["bad_replies"] == 4 and p.calls == 4
+    assert p.history[0]["reasked"] and len(p.history[0]["rejected"]) == 2 and why in p.history[0]["rejected"][0]
+    replay = make_proposer(f"replay:{tmp_path / 'rec.jsonl'}")  # recorded as the same bad answers
+    assert replay.propose_split(query, 2) == first and replay.history == p.history[:1] and replay.bad_replies == 2
+
+
+def test_a_reply_longer_than_the_cap_is_a_bad_answer_recorded_capped(srv, tmp_path, query):
+    from specrefine.vlm import MAX_REPLY_CHARS
+
+    srv.script[:] = [[GOOD + " " * MAX_REPLY_CHARS], [GOOD]]  # valid JSON, a megabyte of it
+    p = proposer(srv, tmp_path)
+    out = p.propose_split(query, 1)
+    assert out == [[Disc(-1.0, -2.5, 0.4), Disc(1.0, -2.5, 0.4)]]  # from the re-ask
+    assert p.bad_replies == 1 and "longer than the cap of 1,000,000 characters" in p.history[0]["rejected"][0]
+    record = tmp_path / "rec.jsonl"
+    (choice,) = json.loads(record.read_text().splitlines()[0])["response"]["choices"]
+    assert len(choice["text"]) == MAX_REPLY_CHARS and "MAX_REPLY_CHARS" in choice["bad"]
+    assert record.stat().st_size < MAX_REPLY_CHARS + 100_000
+    replay = make_proposer(f"replay:{record}")
+    assert replay.propose_split(query, 1) == out and replay.bad_replies == 1

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import functools
 import heapq
 import json
 import math
@@ -17,7 +18,7 @@ import numpy as np
 
 from ..agents import get_agent
 from ..graph import TaskGraph
-from ..regions import Disc, Region
+from ..regions import CompiledRegion, Disc, Region
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, Proposer, _jsonable, graph_score
 from .schema import region_json
 
@@ -27,7 +28,22 @@ def reach_cells(maze, agent: str) -> int:
     return max(1, int(get_agent(agent).policy_reach // maze.cell_size))
 
 
-_STEPS = [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)]
+_STEPS = [(dr, dc, math.sqrt(2.0) if dr and dc else 1.0)
+          for dr, dc in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)]]
+
+
+@functools.lru_cache(maxsize=8)
+def _passable_flags(maze) -> bytes:
+    """Cell (r, c) as the number ``(r + 1) * (cols + 2) + c + 1``; ``flags[number]`` is 1 where a route may enter
+    it.  A frame of 0 surrounds the grid, and numbers order as (r, c) tuples do (ties break as they always did)."""
+    frame = bytes(maze.cols + 2)
+    return frame + b"".join(bytes([0, *(maze.passable(r, c) for c in range(maze.cols)), 0])
+                            for r in range(maze.rows)) + frame
+
+
+@functools.lru_cache(maxsize=8)
+def _obstacles(maze) -> CompiledRegion:
+    return CompiledRegion(maze.obstacles)
 
 
 def _nearest_free_cell(maze, xy) -> tuple[int, int]:
@@ -45,46 +61,50 @@ def grid_path(maze, src: tuple[int, int], dst: tuple[int, int], rng: np.random.G
 
     ``cell_cost(cell)`` (optional) multiplies the cost of every step into ``cell``.
     """
-    dist = {src: 0.0}
-    prev: dict = {}
-    heap = [(0.0, src)]
+    width = maze.cols + 2
+    ok = _passable_flags(maze)
+    steps = [(dr * width + dc, dr * width, dc, step) for dr, dc, step in _STEPS]
+    start, end = (src[0] + 1) * width + src[1] + 1, (dst[0] + 1) * width + dst[1] + 1
+    dist, prev = [math.inf] * len(ok), [-1] * len(ok)
+    dist[start] = 0.0
+    heap = [(0.0, start)]
     costs: dict = {}
     while heap:
         d, cell = heapq.heappop(heap)
-        if cell == dst:
+        if cell == end:
             break
-        if d > dist.get(cell, math.inf):
+        if d > dist[cell]:
             continue
-        r, c = cell
-        for dr, dc in _STEPS:
-            nb = (r + dr, c + dc)
-            if not maze.passable(*nb):
+        for move, down, side, step in steps:
+            nb = cell + move
+            if not ok[nb] or (down and side and not (ok[cell + down] and ok[cell + side])):
                 continue
-            if dr and dc and not (maze.passable(r + dr, c) and maze.passable(r, c + dc)):
-                continue
-            step = math.sqrt(2.0) if dr and dc else 1.0
             if noise > 0 and rng is not None:
                 key = (cell, nb) if cell < nb else (nb, cell)
                 if key not in costs:
                     costs[key] = 1.0 + noise * rng.random()
                 step *= costs[key]
             if cell_cost is not None:
-                step *= cell_cost(nb)
+                step *= cell_cost((nb // width - 1, nb % width - 1))
             nd = d + step
-            if nd < dist.get(nb, math.inf):
+            if nd < dist[nb]:
                 dist[nb], prev[nb] = nd, cell
                 heapq.heappush(heap, (nd, nb))
-    if dst not in dist:
+    if dist[end] == math.inf:
         return []
-    path = [dst]
-    while path[-1] != src:
+    path = [end]
+    while path[-1] != start:
         path.append(prev[path[-1]])
-    return path[::-1]
+    return [(n // width - 1, n % width - 1) for n in reversed(path)]
 
 
-def clearance(maze, pts) -> np.ndarray:
-    """Distance of each point from the nearest wall (negative inside a wall)."""
-    return maze.obstacles.signed_distance(np.asarray(pts, dtype=float))
+def clear_of_obstacles(maze, pts, margin: float) -> np.ndarray:
+    """Whether each point lies at least ``margin`` metres from every wall and hazard.
+
+    Exact (the signed distance of ``maze.obstacles``), but only the boxes near each point are looked at,
+    on one bucket grid per maze: a big maze has hundreds of wall boxes.
+    """
+    return ~_obstacles(maze).below(pts, margin, grid_thr=0.5 * maze.cell_size)
 
 
 def segment_clear(maze, a, b, margin: float) -> bool:
@@ -92,7 +112,7 @@ def segment_clear(maze, a, b, margin: float) -> bool:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     k = max(2, int(np.ceil(np.linalg.norm(b - a) / (0.1 * maze.cell_size))) + 1)
     t = np.linspace(0.0, 1.0, k)[:, None]
-    return bool(np.all(clearance(maze, a + t * (b - a)) >= margin))
+    return bool(np.all(clear_of_obstacles(maze, a + t * (b - a), margin)))
 
 
 def pull_string(maze, pts: np.ndarray, margin: float) -> list[int]:
@@ -128,7 +148,8 @@ class _GridProposer(Proposer):
 
     def _usable(self, maze, xy, margin_cells: float = 0.05) -> bool:
         x0, y0, x1, y1 = maze.bounds()
-        return bool(x0 < xy[0] < x1 and y0 < xy[1] < y1 and clearance(maze, xy) >= margin_cells * maze.cell_size)
+        return bool(x0 < xy[0] < x1 and y0 < xy[1] < y1
+                    and clear_of_obstacles(maze, xy, margin_cells * maze.cell_size).all())
 
     def _dedupe(self, candidates: list[list[Region]]) -> list[list[Region]]:
         seen, out = set(), []
@@ -212,15 +233,26 @@ class GeometricProposer(_GridProposer):
     name = "geometric (offline stand-in, not a VLM)"
 
     def _route_points(self, maze, a_xy, b_xy, j, rng, margin_cells, max_leg, cell_cost=None) -> list[np.ndarray]:
+        return self._turns(self._route(maze, a_xy, b_xy, j, rng, margin_cells, cell_cost), max_leg)
+
+    @staticmethod
+    def _route(maze, a_xy, b_xy, j, rng, margin_cells, cell_cost=None) -> tuple[np.ndarray, list[int]] | None:
+        """The shortest path's points (a, cell centres, b) and the turns string pulling keeps; None if no path."""
         src, dst = _nearest_free_cell(maze, a_xy), _nearest_free_cell(maze, b_xy)
         path = grid_path(maze, src, dst, rng, noise=0.0 if j == 0 else 0.6, cell_cost=cell_cost)
         if not path:
-            return []
+            return None
         cells = np.array(path)
         pts = np.concatenate([np.asarray(a_xy, float)[None], maze.cell_to_xy(cells[:, 0], cells[:, 1]),
                               np.asarray(b_xy, float)[None]])
-        keep = pull_string(maze, pts, margin_cells * maze.cell_size)
-        # halve legs that are long along the path
+        return pts, pull_string(maze, pts, margin_cells * maze.cell_size)
+
+    @staticmethod
+    def _turns(route, max_leg) -> list[np.ndarray]:
+        """A route's waypoints: its turns, with legs longer than ``max_leg`` path cells cut into pieces."""
+        if route is None:
+            return []
+        pts, keep = route
         idx = [0, *keep, len(pts) - 1]
         full = []
         for a, b in zip(idx, idx[1:]):
@@ -239,10 +271,13 @@ class GeometricProposer(_GridProposer):
             margin, max_leg, jitter, fixed_r = 0.35, reach, 0.0, 0.4
         else:
             margin, max_leg, jitter, fixed_r = rng.uniform(0.2, 0.45), int(rng.integers(1, 2 * reach + 2)), 0.12, None
-        pts = self._route_points(maze, a, b, j, rng, margin, max_leg)
+        route = self._route(maze, a, b, j, rng, margin)
+        pts = self._turns(route, max_leg)
         while len(pts) > self.max_waypoints and max_leg < 4 * reach + 8:  # too many: longer legs, turns kept
             max_leg += 1
-            pts = self._route_points(maze, a, b, j, rng, margin, max_leg)
+            if j:  # a noisy route is drawn afresh each time, as it always was (seeded runs stay reproducible)
+                route = self._route(maze, a, b, j, rng, margin)
+            pts = self._turns(route, max_leg)
         pts = [p for p in pts if not (bool(start.contains(p)) or bool(goal.contains(p)))]
         if j and len(pts) > 1:  # drop redundant waypoints (neighbours still see each other) now and then
             kept = []

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from ..errors import ProposalRejected
 from ..graph import TaskGraph
 from ..regions import Region
-from ..vlm import ReplayClient, VLMClient
+from ..vlm import BadReply, ReplayClient, VLMClient
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, Proposer, _jsonable
 from .prompts import graph_messages, render_prompt, split_messages
 from .schema import parse_graph, parse_split
@@ -45,6 +45,11 @@ class VLMProposer(Proposer):
     def proposer_calls(self) -> int:
         return self.client.calls
 
+    @property
+    def bad_replies(self) -> int:
+        """Answers the client could not read (no chat completion, no choices, too long)."""
+        return self.client.bad_replies
+
     def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         messages = split_messages(q, feedback)
         parse = lambda text: parse_split(text, q.maze, max_waypoints=self.max_waypoints)  # noqa: E731
@@ -77,6 +82,10 @@ class VLMProposer(Proposer):
     def _parse_all(self, texts, parse, entry, kind):
         good, bad = [], []
         for text in texts:
+            if isinstance(text, BadReply):  # the client could not read it (and has warned)
+                entry["rejected"].append(text.reason)
+                bad.append((text, text.reason))
+                continue
             try:
                 value, reasoning = parse(text)
             except ProposalRejected as exc:

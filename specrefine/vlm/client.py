@@ -3,13 +3,13 @@
 :class:`LiteLLMClient` calls ``litellm.completion`` for any model string (``gpt-4o``,
 ``gemini/gemini-2.0-flash``, ``anthropic/claude-sonnet-4-5``, ``ollama/llava``, ...): images go as
 base64 PNG data URLs, ``w`` samples per query (``n`` where the provider has it, else ``w`` calls),
-JSON response format where supported, timeouts, and logged retries with back-off on rate limits,
-server errors and dropped connections (a provider's ``Retry-After`` honoured up to 60 s).  One request,
-retries included, ends within ``deadline`` seconds (default 600, or ``SPECREFINE_VLM_DEADLINE``): past it
-the run stops with one line saying what timed out.  Tokens and cost are counted per call (cost 0 for models
-LiteLLM has no price for).  Keys are read by LiteLLM from the environment only; nothing this
-module writes (recordings, logs, error messages) ever contains them.  Every real call is appended
-to a recording (:mod:`specrefine.vlm.recording`).
+JSON response format where supported, timeouts, and logged retries with back-off on rate limits, server
+errors and dropped connections (a provider's ``Retry-After`` honoured up to ``MAX_RETRY_AFTER`` = 60 s).
+One request, retries included, ends within ``deadline`` seconds (default 600, or
+``SPECREFINE_VLM_DEADLINE``): past it the run stops with one line saying what timed out.  Tokens and
+cost are counted per call (cost 0 for models LiteLLM has no price for).  Keys are read by LiteLLM from
+the environment only; nothing this module writes (recordings, logs, error messages) ever contains them.
+Every real call is appended to a recording (:mod:`specrefine.vlm.recording`).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import VLMConfigError, VLMError, VLMUnavailable
-from .messages import VLMClient, one_line, request_hash
+from .messages import MAX_REPLY_CHARS, TOO_LONG, VLMClient, one_line, request_hash
 from .recording import RECORD_VERSION, Recorder, default_record_path
 
 log = logging.getLogger(__name__)
@@ -34,6 +34,7 @@ _KEY_VARS = {"openai": "OPENAI_API_KEY", "gemini": "GEMINI_API_KEY", "anthropic"
              "ollama": "OLLAMA_API_BASE", "ollama_chat": "OLLAMA_API_BASE", "mistral": "MISTRAL_API_KEY",
              "groq": "GROQ_API_KEY", "openrouter": "OPENROUTER_API_KEY", "azure": "AZURE_API_KEY",
              "together_ai": "TOGETHERAI_API_KEY", "deepseek": "DEEPSEEK_API_KEY", "xai": "XAI_API_KEY"}
+MAX_RETRY_AFTER = 60.0  # s: the longest wait a provider's Retry-After header gets (a longer one is cut to this)
 _MODEL_HINT = "use a LiteLLM model string such as gpt-4o, gemini/gemini-2.0-flash, anthropic/claude-sonnet-4-5 " \
               "or ollama/llava"
 
@@ -58,12 +59,83 @@ def _deadline(value: float | None) -> float:
     return seconds
 
 
+NOT_A_COMPLETION = "an HTTP 200 reply that is no chat completion (not JSON, or without choices)"
+NO_ANSWERS = "a reply without answers (an empty choices list)"
+
+
+def _not_a_completion(exc, lt) -> bool:
+    """An HTTP 200 whose body is no chat completion.  LiteLLM reports an InternalServerError, as it does for a
+    real 5xx or a refused connection; those carry an HTTP or transport error in the exception's cause chain
+    (httpx, httpcore, an OSError, openai's APIConnectionError), a body that is no completion does not."""
+    server_error = getattr(lt, "InternalServerError", None)
+    if not (isinstance(server_error, type) and isinstance(exc, server_error)):
+        return False
+    cause, depth = exc, 0
+    while cause is not None and depth < 16:
+        kind = type(cause)
+        if kind.__module__.split(".")[0] in ("httpx", "httpcore") or isinstance(cause, OSError) \
+                or kind.__name__ in ("APIConnectionError", "APITimeoutError"):
+            return False
+        cause, depth = cause.__cause__ or cause.__context__, depth + 1
+    return True
+
+
+def _choices(resp) -> list[tuple[str, Any]]:
+    """(text, finish_reason) of each choice of a completion."""
+    out = []
+    for choice in getattr(resp, "choices", None) or []:
+        content = getattr(getattr(choice, "message", None), "content", None)
+        if isinstance(content, list):  # some providers return content parts
+            content = "".join(p.get("text", "") if isinstance(p, dict) else str(p) for p in content)
+        out.append((content if isinstance(content, str) else "", getattr(choice, "finish_reason", None)))
+    return out
+
+
+def _answers(resp, n: int) -> list[tuple[str, Any, str | None]]:
+    """(text as recorded, finish_reason, why it cannot be used) per answer; a reply with none is n bad ones."""
+    if resp is None:
+        return [("", None, NOT_A_COMPLETION)] * n
+    choices = _choices(resp)
+    if not choices:
+        return [("", None, NO_ANSWERS)] * n
+    return [(text[:MAX_REPLY_CHARS], finish, TOO_LONG if len(text) > MAX_REPLY_CHARS else None)
+            for text, finish in choices]
+
+
+def _retry_after(exc) -> float | None:
+    """The seconds of a Retry-After header, if the failed call had one (LiteLLM keeps the provider's headers in
+    ``litellm_response_headers``; its ``response`` is a stand-in without them)."""
+    for headers in (getattr(exc, "litellm_response_headers", None), getattr(getattr(exc, "response", None), "headers",
+                                                                            None)):
+        try:
+            seconds = float(headers.get("retry-after"))
+        except (TypeError, ValueError, AttributeError):
+            continue
+        if seconds >= 0:
+            return seconds
+    return None
+
+
 def _priced(lt, model: str) -> bool:
     try:
         info = lt.get_model_info(model)
     except Exception:  # noqa: BLE001 - unknown to LiteLLM
         return False
     return bool(info.get("input_cost_per_token") or info.get("output_cost_per_token"))
+
+
+_DEFAULT_BASES = {"ollama": "http://localhost:11434", "ollama_chat": "http://localhost:11434"}
+_BASE_VARS = {"openai": ("OPENAI_BASE_URL", "OPENAI_API_BASE"), "ollama_chat": ("OLLAMA_API_BASE",)}
+
+
+def _endpoint(provider: str, api_base: str | None, resolved: str | None) -> str | None:
+    """The address calls go to, where it is known here: ``api_base``, LiteLLM's resolution, the provider's
+    ``*_API_BASE`` variable, or a local provider's default (None: the provider's own cloud address)."""
+    names = (f"{provider.upper()}_API_BASE", *_BASE_VARS.get(provider, ()))
+    for url in (api_base, resolved, *(os.environ.get(name) for name in names), _DEFAULT_BASES.get(provider)):
+        if url:
+            return _safe_url(url)
+    return None
 
 
 def _safe_url(url: str | None) -> str | None:
@@ -94,10 +166,11 @@ class LiteLLMClient(VLMClient):
         self.recorder = Recorder(record_path or default_record_path(model)) if record else None
         lt = _litellm()
         try:
-            _, self.provider, _, _ = lt.get_llm_provider(model, api_base=api_base)
+            _, self.provider, _, resolved = lt.get_llm_provider(model, api_base=api_base)
         except Exception:
             raise VLMConfigError(f"unknown model litellm:{model}: LiteLLM cannot tell its provider; "
                                  f"{_MODEL_HINT}") from None
+        self.endpoint = _endpoint(self.provider, api_base, resolved if isinstance(resolved, str) else None)
         self.key_var = _KEY_VARS.get(self.provider, f"{self.provider.upper()}_API_KEY")
         if check_env:
             self._check_env(lt)
@@ -181,6 +254,8 @@ class LiteLLMClient(VLMClient):
                 resp = lt.completion(**kw)
             except Exception as exc:  # noqa: BLE001 - every provider failure becomes one line or a retry
                 latency = time.time() - t0
+                if _not_a_completion(exc, lt):  # a bad answer, not a failure: the proposer asks again
+                    return self._answered(lt, kw, messages, (key, text_key), None, latency, attempt, n)
                 self._record(kw, messages, key, text_key, None, 0.0, latency, attempt, error=one_line(exc))
                 if isinstance(exc, bad_request) and not isinstance(exc, (not_found, *auth)) and (
                         "n" in kw or "response_format" in kw):
@@ -209,52 +284,44 @@ class LiteLLMClient(VLMClient):
                     raise VLMUnavailable(f"litellm:{self.model}: rate-limited by the provider after {attempt} "
                                          f"attempts; wait and rerun, or lower -w / the number of edges") from None
                 if isinstance(exc, retryable):
-                    where = f" at {_safe_url(self.api_base)}" if self.api_base else ""
-                    if self.provider.startswith("ollama") and not self.api_base:
-                        where = " (is `ollama serve` running? set OLLAMA_API_BASE if it is not at localhost:11434)"
-                    raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where} after "
-                                         f"{attempt} attempts ({one_line(exc, 120)})") from None
+                    where = f" at {self.endpoint}" if self.endpoint else ""
+                    hint = " (is `ollama serve` running there? OLLAMA_API_BASE sets its address)" \
+                        if self.provider.startswith("ollama") else ""
+                    raise VLMUnavailable(f"litellm:{self.model}: provider unreachable or failing{where}{hint} "
+                                         f"after {attempt} attempts ({one_line(exc, 120)})") from None
                 raise VLMError(f"litellm:{self.model}: call failed: {one_line(exc, 160)}") from None
-            latency = time.time() - t0
-            texts, finish = [], []
-            for choice in getattr(resp, "choices", None) or []:
-                msg = getattr(choice, "message", None)
-                content = getattr(msg, "content", None)
-                if isinstance(content, list):  # some providers return content parts
-                    content = "".join(p.get("text", "") if isinstance(p, dict) else str(p) for p in content)
-                texts.append(content if isinstance(content, str) else "")
-                finish.append(getattr(choice, "finish_reason", None))
-            usage = getattr(resp, "usage", None)
-            pt = int(getattr(usage, "prompt_tokens", 0) or 0)
-            ct = int(getattr(usage, "completion_tokens", 0) or 0)
-            cost = self._cost(lt, resp)
-            self.calls += 1
-            self.prompt_tokens += pt
-            self.completion_tokens += ct
-            self.cost_usd += cost
-            response = {"id": getattr(resp, "id", None), "model": getattr(resp, "model", None),
-                        "choices": [{"text": t, "finish_reason": f} for t, f in zip(texts, finish)],
-                        "usage": {"prompt_tokens": pt, "completion_tokens": ct}}
-            self._record(kw, messages, key, text_key, response, cost, latency, attempt)
-            log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(texts), pt, ct, cost,
-                     latency)
-            return texts
+            return self._answered(lt, kw, messages, (key, text_key), resp, time.time() - t0, attempt, n)
+
+    def _answered(self, lt, kw, messages, keys, resp, latency, attempt, n) -> list[str]:
+        """Count and record a call the server answered; its answers, a BadReply for each that cannot be read."""
+        answers = _answers(resp, n)
+        usage = getattr(resp, "usage", None)
+        pt = int(getattr(usage, "prompt_tokens", 0) or 0)
+        ct = int(getattr(usage, "completion_tokens", 0) or 0)
+        cost = self._cost(lt, resp) if resp is not None else 0.0
+        self.calls += 1
+        self.prompt_tokens += pt
+        self.completion_tokens += ct
+        self.cost_usd += cost
+        response = {"id": getattr(resp, "id", None), "model": getattr(resp, "model", None),
+                    "choices": [{"text": text, "finish_reason": finish, **({"bad": why} if why else {})}
+                                for text, finish, why in answers],
+                    "usage": {"prompt_tokens": pt, "completion_tokens": ct}}
+        self._record(kw, messages, *keys, response, cost, latency, attempt)
+        log.info("VLM %s: %d answer(s), %d+%d tokens, $%.4f, %.1fs", self.model, len(answers), pt, ct, cost, latency)
+        return [self.bad(why) if why else text for text, _, why in answers]
 
     def _check_deadline(self, wait: float, attempt: int, exc) -> None:
         if time.monotonic() + wait >= self._until:
+            source = f" from {self.endpoint}" if self.endpoint else ""
             raise VLMUnavailable(f"litellm:{self.model}: no answer within the {self.deadline:g} s deadline of one "
-                                 f"request (SPECREFINE_VLM_DEADLINE) after {attempt} attempts; the last: "
+                                 f"request (SPECREFINE_VLM_DEADLINE){source} after {attempt} attempts; the last: "
                                  f"{type(exc).__name__} ({one_line(exc, 100)})") from None
 
     def _wait(self, exc, attempt: int) -> float:
         wait = self.retry_wait * (2 ** (attempt - 1))
-        headers = getattr(getattr(exc, "response", None), "headers", None) or {}
-        try:
-            after = float(headers.get("retry-after"))
-            wait = max(wait, min(after, 60.0))
-        except (TypeError, ValueError, AttributeError):
-            pass
-        return wait
+        after = _retry_after(exc)
+        return wait if after is None else max(wait, min(after, MAX_RETRY_AFTER))
 
     def _cost(self, lt, resp) -> float:
         try:

@@ -1,6 +1,10 @@
 """Chat messages as the VLM clients see them: text and PNG parts, a stable request hash, a readable
 transcript, the scrubbing of secrets, and :class:`VLMClient`, what a proposer needs from a model.
 
+A reply a client cannot read (an HTTP 200 that is no chat completion, an empty ``choices`` list, a text
+longer than :data:`MAX_REPLY_CHARS`) comes back as a :class:`BadReply`: counted, warned about once, and
+dropped by the proposer like any bad answer, which then asks again.
+
 Keys are read by LiteLLM from the environment only; :func:`scrub` keeps every key-like value out
 of anything this package writes (recordings, logs, error messages): the value of every set environment
 variable whose name looks like a key, whatever its length.  A value of 8 characters or more is replaced
@@ -14,14 +18,21 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import logging
 import os
 import re
 from typing import Any
+
+log = logging.getLogger(__name__)
 
 _SECRET_ENV = re.compile(r"(API_?KEY|_KEY$|TOKEN|SECRET|PASSWORD|CREDENTIAL)", re.IGNORECASE)
 _SECRET_FIELDS = {"api_key", "apikey", "authorization", "x-api-key", "x-goog-api-key", "api-key", "access_token",
                   "proxy-authorization", "aws_secret_access_key", "aws_session_token"}
 
+
+#: The longest reply text a proposer reads and a recording keeps (characters).  A longer reply is a bad
+#: answer (dropped and asked again, like malformed JSON); its recording holds its first MAX_REPLY_CHARS.
+MAX_REPLY_CHARS = 1_000_000
 
 LONG_SECRET = 8  # a secret this long is replaced anywhere; a shorter one only as a whole token
 _FLAGS = {"", "0", "1", "true", "false", "yes", "no", "on", "off", "none", "null"}
@@ -139,6 +150,21 @@ def messages_to_text(messages: list[dict]) -> str:
     return "\n".join(lines)
 
 
+class BadReply(str):
+    """An answer a client could not read (no chat completion, no choices, too long): empty text with the reason.
+
+    A proposer drops it like any bad answer and asks again; the client has logged a warning for it.
+    """
+
+    def __new__(cls, reason: str):
+        reply = super().__new__(cls, "")
+        reply.reason = reason
+        return reply
+
+
+TOO_LONG = f"a reply longer than the cap of {MAX_REPLY_CHARS:,} characters (MAX_REPLY_CHARS)"
+
+
 class VLMClient:
     """What a proposer needs from a model: ``complete(messages, n) -> n reply texts``."""
 
@@ -151,11 +177,22 @@ class VLMClient:
         self.prompt_tokens = 0
         self.completion_tokens = 0
         self.cost_usd = 0.0
+        self.bad_replies = 0  # answers that could not be read (see BadReply)
+        self._warned: set[str] = set()
 
     def complete(self, messages: list[dict], n: int = 1) -> list[str]:  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def bad(self, reason: str) -> BadReply:
+        """An answer that cannot be read: counted, and warned about once per reason."""
+        self.bad_replies += 1
+        if reason not in self._warned:
+            self._warned.add(reason)
+            log.warning("%s: %s; dropped as a bad answer and asked again (counted from now on, not logged)",
+                        self.name, reason)
+        return BadReply(reason)
+
     def stats(self) -> dict:
         return {"model": self.model, "calls": self.calls, "attempts": self.attempts,
                 "prompt_tokens": self.prompt_tokens, "completion_tokens": self.completion_tokens,
-                "cost_usd": round(self.cost_usd, 6)}
+                "cost_usd": round(self.cost_usd, 6), "bad_replies": self.bad_replies}

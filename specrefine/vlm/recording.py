@@ -15,7 +15,17 @@ from pathlib import Path
 
 from ..errors import ReplayMiss, VLMConfigError
 from ..paths import data_dir
-from .messages import VLMClient, _image_digest, _map_parts, _secret_values, request_hash, scrub, scrub_text
+from .messages import (
+    MAX_REPLY_CHARS,
+    TOO_LONG,
+    VLMClient,
+    _image_digest,
+    _map_parts,
+    _secret_values,
+    request_hash,
+    scrub,
+    scrub_text,
+)
 
 log = logging.getLogger(__name__)
 
@@ -92,7 +102,7 @@ def _answer_shape(rec: dict) -> bool:
         return False
     choices, usage = response.get("choices", []), response.get("usage", {})
     return (isinstance(choices, list) and all(isinstance(c, dict) and isinstance(c.get("text", ""), str)
-                                              for c in choices)
+                                              and isinstance(c.get("bad") or "", str) for c in choices)
             and all(isinstance(rec.get(k), (str, type(None))) for k in ("key", "text_key"))
             and all(_number(v) for v in (usage.get("prompt_tokens"), usage.get("completion_tokens"),
                                          rec.get("cost_usd"))))
@@ -133,13 +143,15 @@ class ReplayClient(VLMClient):
         models = sorted({r.get("model", "?") for r in self.records})
         self.model = models[0] if len(models) == 1 else "+".join(models)
         self.name = f"replay:{path}"
-        self._entries: list[tuple[int, str]] = []  # (record index, text)
+        self._entries: list[tuple[int, str, str | None]] = []  # (record index, text, why it cannot be used)
         self._by_key: dict[str, list[int]] = {}
         self._by_text: dict[str, list[int]] = {}
         for i, rec in enumerate(self.records):
             for choice in rec["response"].get("choices", []):
                 e = len(self._entries)
-                self._entries.append((i, choice.get("text", "")))
+                text = choice.get("text", "")
+                why = choice.get("bad") or (TOO_LONG if len(text) > MAX_REPLY_CHARS else None)
+                self._entries.append((i, text, why))
                 self._by_key.setdefault(rec.get("key"), []).append(e)
                 self._by_text.setdefault(rec.get("text_key"), []).append(e)
         self._used: set[int] = set()
@@ -173,4 +185,4 @@ class ReplayClient(VLMClient):
             self.prompt_tokens += int(usage.get("prompt_tokens", 0) or 0)
             self.completion_tokens += int(usage.get("completion_tokens", 0) or 0)
             self.cost_usd += float(rec.get("cost_usd", 0.0) or 0.0)  # what the recorded run spent
-        return [self._entries[e][1] for e in picked]
+        return [self.bad(why) if why else text for _, text, why in (self._entries[e] for e in picked)]

@@ -1,0 +1,206 @@
+"""Issue 13: random bytes as maze files, replay lines and VLM replies give a result or one line, never a
+traceback or a hang.
+
+Every example runs ``specrefine refine`` in-process with tiny budgets under a time limit (an alarm that
+fails the example instead of letting it hang) and ends in one of two ways: exit 0 with a valid
+result.json, or exit 2 with exactly one line from the CLI on stderr.  Log records (warnings before an
+error, e.g. skipped replay lines) go to their own stream; they too must hold no traceback.  Twelve examples
+per test by default (derandomized, about 45 s in all); ``FUZZ_N=200`` searches longer, at random.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import logging
+import os
+import shutil
+import signal
+import tempfile
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
+from test_vlm import GOOD, KEY, Server
+
+from specrefine.cli import main as cli_main
+from specrefine.errors import MazeError
+from specrefine.mazes import Maze, load_maze
+
+TINY = ["-w", "1", "-d", "1", "--rollouts", "2", "--episodes", "2"]
+LIMIT_S = 60  # per example: far above a tiny run, far below a hang
+
+
+@contextlib.contextmanager
+def time_limit(seconds: int):
+    def expire(*_):
+        raise TimeoutError(f"no result within {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def refine(*args: str) -> tuple[int, str, str, Path]:
+    """Exit code, the CLI's stderr, the log records and the run folder of ``specrefine refine ARGS``."""
+    out = Path(tempfile.mkdtemp(prefix="fuzz_"))
+    err, logs = io.StringIO(), io.StringIO()
+    handler = logging.StreamHandler(logs)
+    logging.getLogger().addHandler(handler)
+    try:
+        with time_limit(LIMIT_S), contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            try:
+                code = cli_main(["refine", *args, "--out", str(out / "run"), *TINY])
+            except SystemExit as exc:  # argparse
+                code = exc.code
+    finally:
+        logging.getLogger().removeHandler(handler)
+    return code, err.getvalue(), logs.getvalue(), out
+
+
+def assert_result_or_one_line(code, err, logs, out):
+    event(f"exit {code}")  # --hypothesis-show-statistics: how often each ending was reached
+    try:
+        assert "Traceback" not in err + logs, err + logs
+        if code == 0:
+            data = json.loads((out / "run" / "result.json").read_text())
+            lo, hi = data["success_ci"]
+            assert 0 <= lo <= data["success_rate"] <= hi <= 1 and data["episodes"] == 2, data
+        else:
+            lines = err.strip().splitlines()
+            assert code == 2 and len(lines) == 1 and lines[0].startswith("specrefine: error: "), (code, err)
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+FUZZ_N = os.environ.get("FUZZ_N")  # a longer, random search: FUZZ_N=200 pytest tests/test_reliability_fuzz.py
+FUZZ = settings(max_examples=int(FUZZ_N or 12), derandomize=FUZZ_N is None, deadline=None,
+                suppress_health_check=[HealthCheck.too_slow])
+
+
+# --- maze files -----------------------------------------------------------------------------------------
+GRID_ROW = st.text(alphabet="#.SGab~", min_size=1, max_size=7)
+ROOM = b"; a room\n#######\n#S.a.G#\n#..~..#\n#######\n"
+
+
+@st.composite
+def mutated_room(draw) -> bytes:
+    """The room with a few bytes replaced: often still a maze, sometimes just not."""
+    data = bytearray(ROOM)
+    for _ in range(draw(st.integers(0, 3))):
+        data[draw(st.integers(0, len(data) - 1))] = draw(st.sampled_from(b"#.SGab~;\n\xff"))
+    return bytes(data)
+
+
+MAZE_TEXT = st.one_of(
+    mutated_room(), mutated_room(),
+    st.binary(max_size=160),
+    st.text(alphabet="#.SGab~ \t;:\r\n\ufeff\u00e9\x00", max_size=160).map(str.encode),
+    st.tuples(st.sampled_from(["", "; spec: b -> G\n", "; spec: (a | b) -> G\n", "; spec: ->\n", "; spec: z\n"]),
+              st.lists(GRID_ROW, min_size=1, max_size=6).map("\n".join))
+    .map(lambda parts: (parts[0] + parts[1]).encode()),
+)
+
+
+@FUZZ
+@given(data=MAZE_TEXT)
+def test_random_maze_files_give_a_maze_or_one_line(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("maze") / "fuzz.maze"
+    path.write_bytes(data)
+    try:
+        assert isinstance(load_maze(path), Maze)
+    except MazeError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith(str(path)), exc
+    assert_result_or_one_line(*refine(str(path), "--method", "ours"))
+
+
+# --- VLM replies ----------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def fake_vlm():
+    server = Server()
+    old = {name: os.environ.get(name) for name in ("OPENAI_API_KEY", "OPENAI_BASE_URL", "SPECREFINE_VLM_DEADLINE")}
+    os.environ.update(OPENAI_API_KEY=KEY, OPENAI_BASE_URL=server.base, SPECREFINE_VLM_DEADLINE="30")
+    yield server
+    for name, value in old.items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value
+    server.close()
+
+
+VLM_RUN = ("split_doorway", "--method", "ours", "--proposer", "litellm:openai/test-model")
+REPLAY_RUN = ("split_doorway", "--method", "ours", "--proposer")
+
+
+REPLY = st.one_of(st.binary(max_size=200),  # a raw HTTP 200 body
+                  st.text(max_size=200).map(lambda text: [text]),  # one answer's text
+                  st.sampled_from([b"{}", b"null", b'{"choices": []}', b'{"choices": [{"message": null}]}', [GOOD]]))
+
+
+@FUZZ
+@given(replies=st.lists(REPLY, min_size=1, max_size=4))
+def test_random_vlm_replies_give_a_result_or_one_line(fake_vlm, replies):
+    fake_vlm.script[:] = list(replies)  # then good answers
+    assert_result_or_one_line(*refine(*VLM_RUN))
+
+
+# --- replay lines ---------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def recording(fake_vlm, tmp_path_factory) -> list[bytes]:
+    """The lines of a recorded run (good answers) that the replays below repeat, edited."""
+    fake_vlm.script.clear()
+    code, err, _, out = refine(*VLM_RUN)
+    assert code == 0, err
+    lines = (out / "run" / "vlm_recording.jsonl").read_bytes().splitlines()
+    shutil.rmtree(out)
+    return lines
+
+
+def answer_text(line: bytes, text: str) -> bytes:
+    """A recorded call with its answers replaced by ``text`` (a line that is no recorded call stays as it is)."""
+    try:
+        record = json.loads(line)
+        for choice in record["response"]["choices"]:
+            choice["text"] = text
+    except (ValueError, KeyError, TypeError):
+        return line
+    return json.dumps(record).encode()
+
+
+EDIT = st.one_of(st.tuples(st.just("answer"), st.integers(0, 9), st.text(max_size=60)),
+                 st.tuples(st.just("insert"), st.integers(0, 9), st.binary(max_size=60)),
+                 st.tuples(st.just("cut"), st.integers(0, 9), st.integers(0, 400)),
+                 st.tuples(st.just("drop"), st.integers(0, 9), st.none()))
+
+
+def edited(lines: list[bytes], edits) -> list[bytes]:
+    lines = list(lines)
+    for kind, at, value in edits:
+        if kind == "insert":
+            lines.insert(at % (len(lines) + 1), value)
+            continue
+        if not lines:
+            continue
+        i = at % len(lines)
+        if kind == "answer":
+            lines[i] = answer_text(lines[i], value)
+        elif kind == "cut":
+            lines[i] = lines[i][:value]
+        else:
+            del lines[i]
+    return lines
+
+
+@FUZZ
+@given(edits=st.lists(EDIT, max_size=3))
+def test_edited_replay_lines_give_a_result_or_one_line(recording, tmp_path_factory, edits):
+    path = tmp_path_factory.mktemp("replay") / "rec.jsonl"
+    path.write_bytes(b"\n".join(edited(recording, edits)) + b"\n")
+    assert_result_or_one_line(*refine(*REPLAY_RUN, f"replay:{path}"))
