@@ -153,3 +153,29 @@ def test_methods_without_the_vertex_dp_do_not_depend_on_the_evaluation(method, t
                         evaluation=ev).data for ev in ("fixed", "adaptive")]
     for key in ("success_rate", "evaluations", "sim_steps", "path", "predicted_ci"):
         assert runs[0][key] == runs[1][key], key
+
+
+class _ThreeRoutes:
+    """Three routes of three waypoints each, the same every round (a proposer that does not learn)."""
+
+    def propose_split(self, query, w, feedback=()):
+        return [[Box(x0 + 2.5 * j, 0, x0 + 2.5 * j + 2, 1) for j in range(3)] for x0 in (0.0, 0.2, 0.4)]
+
+
+class _Query:
+    goal, avoid = Box(7.5, 0, 9, 1), WALLS
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_adaptive_edge_split_picks_the_fixed_candidate_on_fewer_rollouts(seed):
+    from specrefine.refine.edge_split import edge_split
+
+    p_of_x = _eighths(_bumps(seed, 0.3))
+    out = {}
+    for name, racing in (("fixed", None), ("adaptive", Racing((8, 24)))):
+        ev = ExactEvaluator(p_of_x)
+        split = edge_split(ev, _ThreeRoutes(), _Query(), start=Box(-1, 0, 0, 1), w=3, d=2, k=5,
+                           rng=np.random.default_rng(seed), racing=racing)
+        out[name] = (split.best.p, ev.rollouts)
+    assert out["adaptive"][0] == pytest.approx(out["fixed"][0], rel=1e-12)
+    assert out["adaptive"][1] < out["fixed"][1]

@@ -69,8 +69,10 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
                 outcome.evaluations += len(legs)
                 candidate = SplitCandidate(list(waypoints), path.results, round_)
             else:
+                # adaptive: a candidate is only chosen if it beats the best so far, so nothing below it is explored
+                floor = max((c.p for c in outcome.candidates), default=0.0) if racing is not None else 0.0
                 choice = refine_chain(evaluator, start, list(waypoints), goal, [avoid] * (len(waypoints) + 1),
-                                      k, rng, goal_point, racing=racing)
+                                      k, rng, goal_point, racing=racing, floor=floor)
                 outcome.evaluations += choice.evaluations
                 candidate = SplitCandidate(choice.regions, choice.results, round_, tuned=True)
             outcome.candidates.append(candidate)

@@ -55,12 +55,15 @@ class ChainChoice:
 
 
 def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: Region, avoids: list[Region],
-                 k: int, rng: np.random.Generator, goal_point=None, racing: Racing | None = None) -> ChainChoice:
+                 k: int, rng: np.random.Generator, goal_point=None, racing: Racing | None = None,
+                 floor: float = 0.0) -> ChainChoice:
     """Best subsets for the inner vertices of u -> x_1 .. x_t -> v (Algorithm 2, chain DP).
 
     ``avoids`` has one avoid set per subtask (t + 1 of them); option 0 of each layer is I(x_j) itself.
     ``racing``: evaluate the DP adaptively (:mod:`specrefine.refine.racing`); None = every extension on
-    the evaluator's full n rollouts, as in the paper.
+    the evaluator's full n rollouts, as in the paper.  ``floor``: a value the chain must beat to matter
+    (another candidate's, in an edge split); what cannot beat it is not explored (the unrefined chain
+    is returned then, as when nothing beats it).
     """
     if len(avoids) != len(inner) + 1:
         raise ValueError("refine_chain needs one avoid set per subtask")
@@ -72,7 +75,7 @@ def refine_chain(evaluator: SubtaskEvaluator, start, inner: list[Region], goal: 
         return ChainChoice(regions=list(inner), results=unrefined.results, p=1.0, evaluations=calls)
 
     # one Path per option of the current layer: the best way found to reach it
-    bound = unrefined.p
+    bound = max(unrefined.p, floor)
     extend = _next_layer if racing is None else partial(_next_layer_racing, racing=racing)
     first_tasks = [(start, opt, avoids[0], None) for opt in options[0]]
     if racing is None:
