@@ -45,6 +45,10 @@ def test_refine_benchmark_runs_both_evaluations_and_resumes(tmp_path, capsys):
     assert len(rows) == 3 and rows[1].split(",")[5] == "adaptive"  # odd seed: adaptive first
     assert out["pairs"] == 1 and out["overall"]["sim_steps"]["fixed"] > 0
     assert set(out["per_maze"]) == {"u_chain_1"} and len(out["overall"]["success_adaptive"]) == 1
+    from specrefine.bench.refinement import _read, markdown
+
+    lines = markdown(_read(table)).splitlines()
+    assert len(lines) == 3 and lines[2].startswith("| u_chain_1 | 1 | ") and lines[2].count("x)") == 2
     assert main(args) == 0  # resumed: nothing rerun, the same summary
     assert len(table.read_text().splitlines()) == 3
     assert json.loads(capsys.readouterr().out.strip().splitlines()[-1]) == out

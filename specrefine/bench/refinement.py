@@ -78,6 +78,32 @@ def summary(rows: list[dict]) -> dict:
     return out
 
 
+def markdown(rows: list[dict]) -> str:
+    """One line per (maze, seed) run by both evaluations: steps, wall, success with CI, and the ratios."""
+    pairs = {}
+    for r in rows:
+        pairs.setdefault((r["maze"], int(r["seed"])), {})[r["evaluation"]] = r
+    lines = ["| maze | seed | sim steps fixed / adaptive (ratio) | wall s fixed / adaptive (ratio) | evaluations "
+             "fixed / adaptive | success fixed [95 % CI] | success adaptive [95 % CI] |", "|" + " --- |" * 7]
+    for (maze, seed), p in sorted(pairs.items()):
+        if set(EVALUATIONS) - set(p):
+            continue
+        f, a = p["fixed"], p["adaptive"]
+        cell = [maze, str(seed), _ratio_text(f, a, "sim_steps", "{:,.0f}"), _ratio_text(f, a, "wall_seconds", "{:.0f}"),
+                f"{int(float(f['evaluations']))} / {int(float(a['evaluations']))}", _success_text(f), _success_text(a)]
+        lines.append("| " + " | ".join(cell) + " |")
+    return "\n".join(lines)
+
+
+def _ratio_text(f: dict, a: dict, key: str, fmt: str) -> str:
+    x, y = float(f[key]), float(a[key])
+    return f"{fmt.format(x)} / {fmt.format(y)} ({x / y:.2f}x)"
+
+
+def _success_text(r: dict) -> str:
+    return f"{float(r['success_rate']):.3f} [{float(r['success_ci_low']):.3f}, {float(r['success_ci_high']):.3f}]"
+
+
 def _ratios(pairs: list[dict]) -> dict:
     res = {}
     for key in ("sim_steps", "wall_seconds", "cpu_seconds", "evaluations"):
