@@ -90,23 +90,41 @@ def coverage(rows) -> tuple[int, int]:
     return inside, total
 
 
-def predict_run(folder) -> dict:
-    """The prediction of an existing run folder (its result.json and run.json), made again with this module.
+def result_file(run) -> "Path":
+    """The result.json of ``run``: a run folder, or a result file itself (shipped runs keep only that)."""
+    from pathlib import Path
+
+    run = Path(run)
+    return run if run.is_file() else run / "result.json"
+
+
+def run_name(run) -> str:
+    """A run's name in a predictions table: the folder's name, or the result file's stem."""
+    from pathlib import Path
+
+    run = Path(run)
+    return run.stem if run.is_file() else run.name
+
+
+def predict_run(run) -> dict:
+    """The prediction of an existing run (a folder with result.json and run.json, or a result.json file),
+    made again with this module.
 
     For runs made before the prediction changed: the chosen graph and path are read back, a fresh
-    evaluator (shipped policy, the run's agent, rollouts and seed) runs the held-out episodes.
+    evaluator (shipped policy, the run's agent, rollouts and seed) runs the held-out episodes.  A bare
+    result file is taken to come from the shipped policy and the maze's own task (no run.json to say otherwise).
     """
     import json
-    from pathlib import Path
 
     from .experiment import setup
     from .graph import TaskGraph
 
-    folder = Path(folder)
-    data = json.loads((folder / "result.json").read_text())
-    run = json.loads((folder / "run.json").read_text()) if (folder / "run.json").exists() else {}
+    path = result_file(run)
+    data = json.loads(path.read_text())
+    run_json = path.with_name("run.json") if path.name == "result.json" else None
+    run = json.loads(run_json.read_text()) if run_json and run_json.exists() else {}
     if run.get("policy", "shipped") != "shipped":
-        raise ValueError(f"{folder}: made with policy {run['policy']!r}; only shipped-policy runs are redone")
+        raise ValueError(f"{path}: made with policy {run['policy']!r}; only shipped-policy runs are redone")
     exp = setup(data["maze"], agent=data["agent"], seed=int(data["seed"]),
                 rollouts=int(data["rollouts_per_evaluation"]), spec=run.get("spec"))
     graph, original = TaskGraph.from_dict(data["graph"]), TaskGraph.from_dict(data["input_graph"])
@@ -115,7 +133,7 @@ def predict_run(folder) -> dict:
 
 
 def main(argv=None) -> int:
-    """``python -m specrefine.calibrate RUN_FOLDER... --table OUT.csv``: predictions made again, and coverage."""
+    """``python -m specrefine.calibrate RUN... --table OUT.csv``: predictions made again, and coverage."""
     import csv
     from pathlib import Path
 
@@ -124,7 +142,7 @@ def main(argv=None) -> int:
     from .argtypes import OneLineParser
 
     ap = OneLineParser(prog="python -m specrefine.calibrate", description=main.__doc__.split(":")[0])
-    ap.add_argument("folders", nargs="+", type=Path, help="run folders (each with result.json)")
+    ap.add_argument("runs", nargs="+", type=Path, help="run folders (each with result.json) or result.json files")
     ap.add_argument("--table", type=Path, required=True, help="CSV: one row per folder (resumed if it exists)")
     args = ap.parse_args(argv)
     fields = ["cell", "success_rate", "predicted_success", "predicted_ci_low", "predicted_ci_high",
@@ -133,15 +151,18 @@ def main(argv=None) -> int:
     if args.table.exists():
         with args.table.open(newline="") as fh:
             done = {r["cell"] for r in csv.DictReader(fh)}
-    todo = [f for f in args.folders if (f / "result.json").exists() and f.name not in done]
+    missing = [r for r in args.runs if not result_file(r).exists()]
+    if missing:  # e.g. the folders of failed sweep cells in a glob
+        print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
+    todo = [r for r in args.runs if result_file(r).exists() and run_name(r) not in done]
     new = not args.table.exists()
     with args.table.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         if new:
             writer.writeheader()
-        for folder in tqdm(todo, desc="predictions"):
-            d = predict_run(folder)
-            writer.writerow({"cell": folder.name, **d, "predicted_ci_low": d["predicted_ci"][0],
+        for run in tqdm(todo, desc="predictions"):
+            d = predict_run(run)
+            writer.writerow({"cell": run_name(run), **d, "predicted_ci_low": d["predicted_ci"][0],
                              "predicted_ci_high": d["predicted_ci"][1]})
             fh.flush()
     with args.table.open(newline="") as fh:

@@ -71,6 +71,11 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
     again = predict_run(run)
     assert again["predicted_ci"] == data["predicted_ci"] and again["prediction_successes"] == \
         data["prediction_successes"]  # the same held-out episodes
+    shipped = tmp_path / "u_chain_1_s1_result.json"  # as shipped: the result file alone
+    shipped.write_bytes((run / "result.json").read_bytes())
+    assert predict_run(shipped)["prediction_successes"] == data["prediction_successes"]
     table = tmp_path / "predictions.csv"
-    assert main([str(run), "--table", str(table)]) == 0
-    assert len(table.read_text().splitlines()) == 2 and "/1 measured success rates inside" in capsys.readouterr().out
+    assert main([str(run), str(shipped), str(tmp_path / "failed_cell"), "--table", str(table)]) == 0
+    out = capsys.readouterr().out
+    assert [line.split(",")[0] for line in table.read_text().splitlines()] == ["cell", "run", "u_chain_1_s1_result"]
+    assert "/2 measured success rates inside" in out and "skipped 1 run(s) without a result.json" in out
