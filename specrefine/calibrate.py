@@ -23,6 +23,7 @@ The held-out episodes run on a copy of the evaluator, so the run's own counters 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -90,18 +91,14 @@ def coverage(rows) -> tuple[int, int]:
     return inside, total
 
 
-def result_file(run) -> "Path":
+def result_file(run) -> Path:
     """The result.json of ``run``: a run folder, or a result file itself (shipped runs keep only that)."""
-    from pathlib import Path
-
     run = Path(run)
     return run if run.is_file() else run / "result.json"
 
 
 def run_name(run) -> str:
     """A run's name in a predictions table: the folder's name, or the result file's stem."""
-    from pathlib import Path
-
     run = Path(run)
     return run.stem if run.is_file() else run.name
 
@@ -132,31 +129,43 @@ def predict_run(run) -> dict:
     return {"success_rate": data["success_rate"], **prediction.to_dict()}
 
 
-def main(argv=None) -> int:
-    """``python -m specrefine.calibrate RUN... --table OUT.csv``: predictions made again, and coverage."""
+def coverage_report(tables) -> str:
+    """One line per predictions table (any CSV with success_rate and predicted_ci_low/high) and the total."""
     import csv
-    from pathlib import Path
+
+    lines, inside_all, total_all = [], 0, 0
+    for table in tables:
+        with open(table, newline="") as fh:
+            inside, total = coverage(list(csv.DictReader(fh)))
+        inside_all, total_all = inside_all + inside, total_all + total
+        lines.append(f"{table}: {_covered(inside, total)}")
+    if len(lines) > 1:
+        lines.append(f"all: {_covered(inside_all, total_all)}")
+    return "\n".join(lines)
+
+
+def _covered(inside: int, total: int) -> str:
+    return f"{inside}/{total} measured success rates inside predicted_ci ({inside / max(total, 1):.1%})"
+
+
+def _predict_into(table, runs) -> None:
+    """Append one row per run not yet in ``table`` (resumable, flushed row by row)."""
+    import csv
 
     from tqdm.auto import tqdm
 
-    from .argtypes import OneLineParser
-
-    ap = OneLineParser(prog="python -m specrefine.calibrate", description=main.__doc__.split(":")[0])
-    ap.add_argument("runs", nargs="+", type=Path, help="run folders (each with result.json) or result.json files")
-    ap.add_argument("--table", type=Path, required=True, help="CSV: one row per folder (resumed if it exists)")
-    args = ap.parse_args(argv)
     fields = ["cell", "success_rate", "predicted_success", "predicted_ci_low", "predicted_ci_high",
               "prediction_successes", "prediction_episodes", "prediction_sim_steps"]
     done = set()
-    if args.table.exists():
-        with args.table.open(newline="") as fh:
+    if table.exists():
+        with table.open(newline="") as fh:
             done = {r["cell"] for r in csv.DictReader(fh)}
-    missing = [r for r in args.runs if not result_file(r).exists()]
+    missing = [r for r in runs if not result_file(r).exists()]
     if missing:  # e.g. the folders of failed sweep cells in a glob
         print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
-    todo = [r for r in args.runs if result_file(r).exists() and run_name(r) not in done]
-    new = not args.table.exists()
-    with args.table.open("a", newline="") as fh:
+    todo = [r for r in runs if result_file(r).exists() and run_name(r) not in done]
+    new = not table.exists()
+    with table.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         if new:
             writer.writeheader()
@@ -165,10 +174,33 @@ def main(argv=None) -> int:
             writer.writerow({"cell": run_name(run), **d, "predicted_ci_low": d["predicted_ci"][0],
                              "predicted_ci_high": d["predicted_ci"][1]})
             fh.flush()
+
+
+def main(argv=None) -> int:
+    """``python -m specrefine.calibrate RUN... --table OUT.csv``: predictions made again, and coverage;
+    ``python -m specrefine.calibrate --coverage TABLE...``: the coverage of existing tables."""
+    import csv
+
+    from .argtypes import OneLineParser
+
+    ap = OneLineParser(prog="python -m specrefine.calibrate", description=main.__doc__.split(":")[0])
+    ap.add_argument("runs", nargs="+", type=Path,
+                    help="run folders (each with result.json) or result.json files; with --coverage, tables")
+    ap.add_argument("--table", type=Path, help="CSV: one row per run (resumed if it exists)")
+    ap.add_argument("--coverage", action="store_true", help="only report the coverage of the given tables")
+    args = ap.parse_args(argv)
+    if args.coverage:
+        absent = [t for t in args.runs if not t.is_file()]
+        if absent:
+            ap.error(f"no such table: {absent[0]}")
+        print(coverage_report(args.runs))
+        return 0
+    if args.table is None:
+        ap.error("--table is required (or --coverage to read tables)")
+    _predict_into(args.table, args.runs)
+    print(coverage_report([args.table]))
     with args.table.open(newline="") as fh:
-        inside, total = coverage(list(csv.DictReader(fh)))
-    print(f"{inside}/{total} measured success rates inside predicted_ci ({inside / max(total, 1):.1%})")
-    return 0 if total else 1
+        return 0 if coverage(list(csv.DictReader(fh)))[1] else 1
 
 
 if __name__ == "__main__":

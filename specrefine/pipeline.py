@@ -215,6 +215,9 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         "proposer_is_vlm": bool(getattr(proposer, "is_vlm", False)), "seed": seed,
         "success_rate": measured.rate, "success_ci": list(wilson_ci(n_ok, n)), "episodes": n,
         "path_success_rate": float(measured.path_result.p) if measured.path_result else 0.0,
+        # where the measured episodes of the path end (success, avoid, flipped, timeout) and each leg's rate
+        "episode_outcomes": measured.path_result.counts() if measured.path_result else {},
+        "leg_success": measured.path_result.leg_success if measured.path_result else [],
         "predicted_success": search.predicted_success, "edge_probabilities": search.edge_probabilities,
         # evaluations the result rests on: simulated now, or by an earlier run of the same --out (resume)
         "evaluations": evaluator.evaluations + getattr(evaluator, "disk_hits", 0),

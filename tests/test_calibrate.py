@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 
 import numpy as np
@@ -79,3 +80,10 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
     out = capsys.readouterr().out
     assert [line.split(",")[0] for line in table.read_text().splitlines()] == ["cell", "run", "u_chain_1_s1_result"]
     assert "/2 measured success rates inside" in out and "skipped 1 run(s) without a result.json" in out
+    inside = sum(float(r["predicted_ci_low"]) <= float(r["success_rate"]) <= float(r["predicted_ci_high"])
+                 for r in csv.DictReader(table.open()))
+    assert main(["--coverage", str(table), str(table)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].startswith(f"all: {2 * inside}/4 measured")
+    with pytest.raises(SystemExit) as exit_:
+        main(["--coverage", str(tmp_path / "nope.csv")])
+    assert exit_.value.code == 2 and "no such table" in capsys.readouterr().err

@@ -134,6 +134,11 @@ def test_geometric_refinement_beats_the_straight_line(pool):
     ours = refine_maze("hazard_pool", method="ours", evaluator=ev, episodes=16, out=_tmp("ours"))
     assert dirl.data["success_rate"] == 0.0 and ours.data["success_rate"] >= 0.75
     assert ours.data["refines_input"] is True
+    # where the episodes ended: the straight line runs into the pool (the avoid set) on its only leg
+    assert dirl.data["episode_outcomes"] == {"avoid": 16} and dirl.data["leg_success"] == [0.0]
+    outcomes, legs = ours.data["episode_outcomes"], ours.data["leg_success"]
+    assert sum(outcomes.values()) == 16 and outcomes.get("success", 0) / 16 == ours.data["path_success_rate"]
+    assert len(legs) == ours.data["path_edges"] and all(p is None or 0.0 <= p <= 1.0 for p in legs)
 
 
 def _tmp(name):
