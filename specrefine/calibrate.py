@@ -103,13 +103,15 @@ def run_name(run) -> str:
     return run.stem if run.is_file() else run.name
 
 
-def predict_run(run) -> dict:
+def predict_run(run, maze_dir=None) -> dict:
     """The prediction of an existing run (a folder with result.json and run.json, or a result.json file),
     made again with this module.
 
     For runs made before the prediction changed: the chosen graph and path are read back, a fresh
     evaluator (shipped policy, the run's agent, rollouts and seed) runs the held-out episodes.  A bare
     result file is taken to come from the shipped policy and the maze's own task (no run.json to say otherwise).
+    ``maze_dir``: where to find a maze the result names by its stem when it is not in ``data/mazes/``
+    (e.g. ``data/mazes/unseen``).
     """
     import json
 
@@ -122,7 +124,10 @@ def predict_run(run) -> dict:
     run = json.loads(run_json.read_text()) if run_json and run_json.exists() else {}
     if run.get("policy", "shipped") != "shipped":
         raise ValueError(f"{path}: made with policy {run['policy']!r}; only shipped-policy runs are redone")
-    exp = setup(data["maze"], agent=data["agent"], seed=int(data["seed"]),
+    maze = data["maze"]
+    if maze_dir is not None and (Path(maze_dir) / f"{maze}.maze").is_file():
+        maze = Path(maze_dir) / f"{maze}.maze"
+    exp = setup(maze, agent=data["agent"], seed=int(data["seed"]),
                 rollouts=int(data["rollouts_per_evaluation"]), spec=run.get("spec"))
     graph, original = TaskGraph.from_dict(data["graph"]), TaskGraph.from_dict(data["input_graph"])
     prediction = predict(exp.evaluator, original, graph, data["path"], int(data["seed"]), int(data["episodes"]))
@@ -148,11 +153,14 @@ def _covered(inside: int, total: int) -> str:
     return f"{inside}/{total} measured success rates inside predicted_ci ({inside / max(total, 1):.1%})"
 
 
-def _predict_into(table, runs) -> None:
-    """Append one row per run not yet in ``table`` (resumable, flushed row by row)."""
+def _predict_into(table, runs, maze_dir=None) -> int:
+    """Append one row per run not yet in ``table`` (resumable, flushed row by row); the number of runs that
+    failed (each named on one line; the others go on)."""
     import csv
 
     from tqdm.auto import tqdm
+
+    from .errors import SpecrefineError
 
     fields = ["cell", "success_rate", "predicted_success", "predicted_ci_low", "predicted_ci_high",
               "prediction_successes", "prediction_episodes", "prediction_sim_steps"]
@@ -169,11 +177,18 @@ def _predict_into(table, runs) -> None:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         if new:
             writer.writeheader()
+        failed = 0
         for run in tqdm(todo, desc="predictions"):
-            d = predict_run(run)
+            try:
+                d = predict_run(run, maze_dir)
+            except (SpecrefineError, ValueError, KeyError, OSError) as exc:
+                failed += 1
+                print(f"{run}: {exc}" if not isinstance(exc, KeyError) else f"{run}: result.json lacks {exc}")
+                continue
             writer.writerow({"cell": run_name(run), **d, "predicted_ci_low": d["predicted_ci"][0],
                              "predicted_ci_high": d["predicted_ci"][1]})
             fh.flush()
+    return failed
 
 
 def main(argv=None) -> int:
@@ -188,6 +203,7 @@ def main(argv=None) -> int:
                     help="run folders (each with result.json) or result.json files; with --coverage, tables")
     ap.add_argument("--table", type=Path, help="CSV: one row per run (resumed if it exists)")
     ap.add_argument("--coverage", action="store_true", help="only report the coverage of the given tables")
+    ap.add_argument("--maze-dir", type=Path, help="where mazes named by stem live when not in data/mazes/")
     args = ap.parse_args(argv)
     if args.coverage:
         absent = [t for t in args.runs if not t.is_file()]
@@ -197,10 +213,10 @@ def main(argv=None) -> int:
         return 0
     if args.table is None:
         ap.error("--table is required (or --coverage to read tables)")
-    _predict_into(args.table, args.runs)
+    failed = _predict_into(args.table, args.runs, args.maze_dir)
     print(coverage_report([args.table]))
     with args.table.open(newline="") as fh:
-        return 0 if coverage(list(csv.DictReader(fh)))[1] else 1
+        return 0 if coverage(list(csv.DictReader(fh)))[1] and not failed else 1
 
 
 if __name__ == "__main__":

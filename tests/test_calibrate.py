@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from specrefine.calibrate import coverage, product_posterior
+from specrefine.mazes import MAZE_DIR
 from specrefine.pipeline import refine_maze
 
 
@@ -84,6 +85,15 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
                  for r in csv.DictReader(table.open()))
     assert main(["--coverage", str(table), str(table)]) == 0
     assert capsys.readouterr().out.splitlines()[-1].startswith(f"all: {2 * inside}/4 measured")
+    elsewhere = tmp_path / "mazes"  # a result naming a maze outside data/mazes/ by its stem
+    elsewhere.mkdir()
+    (elsewhere / "my_maze.maze").write_bytes((MAZE_DIR / "u_chain_1.maze").read_bytes())
+    moved = tmp_path / "moved_result.json"
+    moved.write_text(json.dumps({**json.loads(shipped.read_text()), "maze": "my_maze"}))
+    assert main([str(moved), "--table", str(tmp_path / "moved.csv")]) == 1  # not found: one line, no traceback
+    assert "moved_result.json: my_maze: cannot read maze file" in capsys.readouterr().out
+    assert main([str(moved), "--table", str(tmp_path / "moved.csv"), "--maze-dir", str(elsewhere)]) == 0
+    assert predict_run(moved, elsewhere)["prediction_successes"] == data["prediction_successes"]
     with pytest.raises(SystemExit) as exit_:
         main(["--coverage", str(tmp_path / "nope.csv")])
     assert exit_.value.code == 2 and "no such table" in capsys.readouterr().err
