@@ -121,27 +121,32 @@ def predict_run(run, maze_dir=None) -> dict:
     path = result_file(run)
     data = json.loads(path.read_text())
     run_json = path.with_name("run.json") if path.name == "result.json" else None
-    run = json.loads(run_json.read_text()) if run_json and run_json.exists() else {}
-    if run.get("policy", "shipped") != "shipped":
-        raise ValueError(f"{path}: made with policy {run['policy']!r}; only shipped-policy runs are redone")
+    args = json.loads(run_json.read_text()) if run_json and run_json.exists() else {}
+    if args.get("policy", "shipped") != "shipped":
+        raise ValueError(f"{path}: made with policy {args['policy']!r}; only shipped-policy runs are redone")
     maze = data["maze"]
     if maze_dir is not None and (Path(maze_dir) / f"{maze}.maze").is_file():
         maze = Path(maze_dir) / f"{maze}.maze"
     exp = setup(maze, agent=data["agent"], seed=int(data["seed"]),
-                rollouts=int(data["rollouts_per_evaluation"]), spec=run.get("spec"))
+                rollouts=int(data["rollouts_per_evaluation"]), spec=args.get("spec"))
     graph, original = TaskGraph.from_dict(data["graph"]), TaskGraph.from_dict(data["input_graph"])
     prediction = predict(exp.evaluator, original, graph, data["path"], int(data["seed"]), int(data["episodes"]))
     return {"success_rate": data["success_rate"], **prediction.to_dict()}
 
 
-def coverage_report(tables) -> str:
-    """One line per predictions table (any CSV with success_rate and predicted_ci_low/high) and the total."""
+def table_coverage(table) -> tuple[int, int]:
+    """``coverage`` of a predictions table (any CSV with success_rate and predicted_ci_low/high)."""
     import csv
 
+    with open(table, newline="") as fh:
+        return coverage(list(csv.DictReader(fh)))
+
+
+def coverage_report(tables) -> str:
+    """One line per predictions table and the total."""
     lines, inside_all, total_all = [], 0, 0
     for table in tables:
-        with open(table, newline="") as fh:
-            inside, total = coverage(list(csv.DictReader(fh)))
+        inside, total = table_coverage(table)
         inside_all, total_all = inside_all + inside, total_all + total
         lines.append(f"{table}: {_covered(inside, total)}")
     if len(lines) > 1:
@@ -171,7 +176,7 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     missing = [r for r in runs if not result_file(r).exists()]
     if missing:  # e.g. the folders of failed sweep cells in a glob
         print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
-    todo = [r for r in runs if result_file(r).exists() and run_name(r) not in done]
+    todo = [r for r in runs if r not in missing and run_name(r) not in done]
     new = not table.exists()
     with table.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
@@ -194,8 +199,6 @@ def _predict_into(table, runs, maze_dir=None) -> int:
 def main(argv=None) -> int:
     """``python -m specrefine.calibrate RUN... --table OUT.csv``: predictions made again, and coverage;
     ``python -m specrefine.calibrate --coverage TABLE...``: the coverage of existing tables."""
-    import csv
-
     from .argtypes import OneLineParser
 
     ap = OneLineParser(prog="python -m specrefine.calibrate", description=main.__doc__.split(":")[0])
@@ -214,9 +217,9 @@ def main(argv=None) -> int:
     if args.table is None:
         ap.error("--table is required (or --coverage to read tables)")
     failed = _predict_into(args.table, args.runs, args.maze_dir)
-    print(coverage_report([args.table]))
-    with args.table.open(newline="") as fh:
-        return 0 if coverage(list(csv.DictReader(fh)))[1] and not failed else 1
+    inside, total = table_coverage(args.table)
+    print(f"{args.table}: {_covered(inside, total)}")
+    return 0 if total and not failed else 1
 
 
 if __name__ == "__main__":
