@@ -1,0 +1,70 @@
+"""Per-leg failure reports of a finished run's path (specrefine.failures)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from specrefine.failures import leg_table, main, open_floor, path_failures, turn_angles
+from specrefine.mazes import load_maze
+from specrefine.pipeline import refine_maze
+from specrefine.results import OUTCOMES
+
+
+def test_open_floor_frees_inner_walls_and_keeps_the_border_and_coordinates():
+    maze = load_maze("u_chain_2")
+    bare = open_floor(maze)
+    assert bare.grid[0] == maze.grid[0] and bare.grid[-1] == maze.grid[-1]
+    assert all(row[0] == "#" and row[-1] == "#" for row in bare.grid)
+    inner = [row[1:-1] for row in bare.grid[1:-1]]
+    assert "#" not in "".join(inner) and "#" in "".join(row[1:-1] for row in maze.grid[1:-1])
+    assert bare.cells("S") == maze.cells("S") and bare.cells("G") == maze.cells("G")
+    np.testing.assert_allclose(bare.cell_to_xy(1, 1), maze.cell_to_xy(1, 1))
+
+
+def test_turn_angles_of_a_polyline():
+    angles = turn_angles([(0, 0), (1, 0), (1, 1), (2, 2), (3, 3), (2, 2)])
+    assert angles[0] is None
+    np.testing.assert_allclose(angles[1:], [90.0, 45.0, 0.0, 180.0], atol=1e-9)
+
+
+def test_leg_table_counts_where_and_how_episodes_end():
+    class Run:  # 5 episodes over 3 legs: two succeed, one flips on leg 0, one touches a wall on leg 2, one times out
+        legs_done = np.array([3, 0, 2, 3, 1])
+        success = legs_done == 3
+        outcome = np.array([OUTCOMES.index(o) for o in ("success", "flipped", "avoid", "success", "timeout")])
+
+    rows = leg_table(Run, 3)
+    assert [r["started"] for r in rows] == [5, 4, 3]
+    assert [(r["flipped"], r["avoid"], r["timeout"]) for r in rows] == [(1, 0, 0), (0, 0, 1), (0, 1, 0)]
+
+
+def test_a_finished_runs_path_is_rerun_with_and_without_inner_walls(tmp_path, capsys):
+    data = refine_maze("u_chain_1", agent="point", method="ours", proposer="geometric", seed=0, rollouts=8,
+                       episodes=20, out=tmp_path / "run").data
+    report = path_failures(data, episodes=40, seed=5)
+    assert len(report["legs"]) == len(data["path"]) - 1
+    for variant in ("walls", "no_inner_walls"):
+        r = report[variant]
+        failed = sum(leg["flipped"] + leg["avoid"] + leg["timeout"] for leg in r["per_leg"])
+        assert r["success"] + failed == 40 and sum(r["outcomes"].values()) == 40
+        assert r["per_leg"][0]["started"] == 40
+    out = tmp_path / "failures.json"
+    assert main([str(tmp_path / "run" / "result.json"), "--episodes", "16", "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["episodes"] == 16 and "no_inner_walls" in capsys.readouterr().out
+
+
+def test_a_result_without_a_path_is_one_line(tmp_path, capsys):
+    bad = tmp_path / "result.json"
+    bad.write_text(json.dumps({"maze": "u_chain_1", "agent": "point", "path": []}))
+    assert main([str(bad)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "no selected path" in err
+
+
+@pytest.mark.parametrize("text", ["{", "[]"])
+def test_an_unreadable_result_is_one_line(tmp_path, capsys, text):
+    bad = tmp_path / "result.json"
+    bad.write_text(text)
+    assert main([str(bad)]) == 1
+    assert capsys.readouterr().err.count("\n") == 1
