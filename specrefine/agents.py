@@ -30,6 +30,7 @@ class ReachTask:
     lateral_cost: float = 0.0  # per metre moved across the line to the goal: keeps paths straight in corridors
     goals_per_episode: int = 1  # > 1: on success a new goal is drawn from where the agent is, without a reset
     tilt_cost: float = 0.0  # per step x (1 - the torso's up-vector z): a dense warning long before a flip
+    goal_radius: tuple[float, float] | None = None  # each goal's success radius drawn from [lo, hi] (None: fixed)
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,9 @@ class GoalReachEnv(EnvBase):
     it - ``flip_penalty`` on flipping - ``step_cost`` per step.  Done on success, flip or ``max_steps``; finished
     envs are reset by TorchRL's partial ``_reset`` (the collector does it automatically).  With
     ``task.goals_per_episode`` = m > 1, the first m - 1 successes draw a new goal from the current (moving)
-    state instead, as a compositional policy switches subtasks, and ``max_steps`` counts per goal.
+    state instead, as a compositional policy switches subtasks, and ``max_steps`` counts per goal.  With
+    ``task.goal_radius`` = (lo, hi), each goal counts as reached within its own radius drawn from [lo, hi]
+    (a refined graph's goal regions are that size: the next goal arrives while the agent still moves).
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None):
@@ -33,6 +35,7 @@ class GoalReachEnv(EnvBase):
         self.rng = np.random.default_rng(seed)
         self.goals = np.zeros((n, 2))
         self.dist = np.zeros(n)
+        self.radius = np.full(n, self.task.success_radius)
         self.t = np.zeros(n, dtype=np.int64)
         self.goal_index = np.zeros(n, dtype=np.int64)  # goals reached so far in this episode
         bs = self.batch_size
@@ -60,14 +63,21 @@ class GoalReachEnv(EnvBase):
             mask = tensordict["_reset"].reshape(self.sim.n).numpy().copy()
         idx = np.flatnonzero(mask)
         self.sim.reset(rng=self.rng, idx=idx)
-        self.goals[idx] = sample_goals(self.sim.xy[idx], self.task.goal_min, self.task.goal_max, self.rng)
-        self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
+        self._new_goals(idx)
         self.t[idx] = 0
         self.goal_index[idx] = 0
         zeros = np.zeros(self.sim.n, dtype=bool)
         out = self._obs_td(zeros, zeros)
         out.update(self._dones(zeros, zeros))
         return out
+
+    def _new_goals(self, idx: np.ndarray) -> None:
+        """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are."""
+        task = self.task
+        self.goals[idx] = sample_goals(self.sim.xy[idx], task.goal_min, task.goal_max, self.rng)
+        self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
+        if task.goal_radius is not None:
+            self.radius[idx] = self.rng.uniform(*task.goal_radius, size=len(idx))
 
     def _dones(self, terminated: np.ndarray, truncated: np.ndarray) -> dict:
         t = torch.from_numpy(terminated).unsqueeze(-1)
@@ -86,7 +96,7 @@ class GoalReachEnv(EnvBase):
         self.sim.step(tensordict["action"].numpy())
         self.t += 1
         dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
-        success, flipped = dist < self.task.success_radius, self.sim.flipped
+        success, flipped = dist < self.radius, self.sim.flipped
         task = self.task
         if task.arrive_speed is not None:
             success &= np.linalg.norm(self.sim.qvel[:, :2], axis=1) < task.arrive_speed
@@ -98,8 +108,7 @@ class GoalReachEnv(EnvBase):
         if more.any():  # chained goals: the next one starts from here, at whatever speed the agent has
             self.goal_index[more] += 1
             self.t[more] = 0
-            self.goals[more] = sample_goals(self.sim.xy[more], task.goal_min, task.goal_max, self.rng)
-            self.dist[more] = np.linalg.norm(self.goals[more] - self.sim.xy[more], axis=1)
+            self._new_goals(np.flatnonzero(more))
         terminated = (success & ~more) | flipped
         truncated = ~terminated & (self.t >= task.max_steps)
         out = self._obs_td(success, flipped)

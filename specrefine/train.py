@@ -73,9 +73,15 @@ class Config:
     sim_threads: int = knob(2, "mujoco.rollout threads")
     checkpoint_every_s: float = knob(120.0, "seconds between checkpoints")
     goals_per_episode: int = knob(1, "> 1: chain this many goals per episode, each drawn where the last was reached")
-    init: str | None = knob(None, "fine-tune: actor + critic weights from this trainer checkpoint.pt")
+    init: str | None = knob(None, "fine-tune from a trainer checkpoint.pt (actor + critic) or a policy file "
+                                  "('ant', 'point' or a policy.pt: actor only, the critic starts afresh)")
+    critic_warmup_frames: int = knob(0, "first train the critic alone for this many frames (after --init POLICY)")
     tilt_cost: float | None = knob(None, "reward -= this x (1 - torso up z) per step (default: the agent's task)")
     flip_penalty: float | None = knob(None, "reward -= this on flipping (default: the agent's task)")
+    lateral_cost: float | None = knob(None, "reward -= this x metres moved across the line to the goal "
+                                            "(default: the agent's task)")
+    switch_radius: tuple[float, float] | None = knob(None, "each goal counts as reached within a radius drawn "
+                                                           "from [LO, HI] m (default: the task's success radius)")
 
     @property
     def frames_per_batch(self) -> int:
@@ -94,6 +100,13 @@ def explained_variance(target: torch.Tensor, value: torch.Tensor) -> float:
     return float(1.0 - (target - value).var() / var) if var > 0 else float("nan")
 
 
+def _radius_range(pair) -> tuple[float, float]:
+    lo, hi = (float(x) for x in pair)
+    if not 0 < lo <= hi:
+        raise SpecrefineError(f"--switch-radius {lo:g} {hi:g}: needs 0 < LO <= HI (metres)")
+    return lo, hi
+
+
 def config_arguments(parser: argparse.ArgumentParser) -> None:
     """One ``--field-name`` option per :class:`Config` field (except ``agent``), default None = the agent's."""
     types = {"int": int, "float": float, "str | None": str, "float | None": float, "int | None": int}
@@ -104,6 +117,8 @@ def config_arguments(parser: argparse.ArgumentParser) -> None:
         help_text = f"{f.metadata['help']} (default: {f.default})"
         if f.type == "bool":
             parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=None, help=help_text)
+        elif f.type == "tuple[float, float] | None":
+            parser.add_argument(flag, type=float, nargs=2, metavar=("LO", "HI"), default=None, help=help_text)
         else:
             parser.add_argument(flag, type=types[f.type], default=None, help=help_text)
 
@@ -137,7 +152,9 @@ class Trainer:
         self.out.mkdir(parents=True, exist_ok=True)
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
-        optional = {k: v for k in ("tilt_cost", "flip_penalty") if (v := getattr(cfg, k)) is not None}
+        optional = {k: v for k in ("tilt_cost", "flip_penalty", "lateral_cost") if (v := getattr(cfg, k)) is not None}
+        if cfg.switch_radius is not None:
+            optional["goal_radius"] = _radius_range(cfg.switch_radius)
         task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
         self.policy = GoalPolicy(cfg.agent)
@@ -151,7 +168,7 @@ class Trainer:
         if resume and (self.out / "checkpoint.pt").is_file():
             self._load_checkpoint(self.out / "checkpoint.pt")
         elif cfg.init:
-            self._load_weights(Path(cfg.init))
+            self._load_weights(cfg.init)
         self.collector = Collector(self.env, self.actor, frames_per_batch=cfg.frames_per_batch, total_frames=-1,
                                    auto_register_policy_transforms=False)
         self.ep_return = np.zeros(cfg.num_envs)
@@ -165,10 +182,23 @@ class Trainer:
         torch.set_rng_state(ck["torch_rng"])
         self.env.rng = np.random.default_rng(self.cfg.seed + self.iteration)
 
-    def _load_weights(self, path: Path) -> None:
-        """Start from another run's actor, critic and observation statistics (frames and optimiser start afresh)."""
+    def _load_weights(self, init: str) -> None:
+        """Start from another run's actor, critic and observation statistics (frames and optimiser start afresh),
+        or from a policy file's actor and observation statistics (the critic starts afresh)."""
         import pickle
 
+        from .errors import PolicyError
+
+        path = Path(init)
+        try:
+            shipped = load_policy(init)
+        except PolicyError:
+            shipped = None
+        if shipped is not None:
+            if shipped.agent != self.cfg.agent:
+                raise SpecrefineError(f"--init {init}: a {shipped.agent} policy, not one for the {self.cfg.agent}")
+            self.policy.load_state_dict(shipped.state_dict())
+            return
         try:
             ck = torch.load(path, map_location="cpu", weights_only=False)
             self.loss.load_state_dict(ck["loss"])
@@ -193,11 +223,13 @@ class Trainer:
         with torch.no_grad():
             self.gae(batch)
         flat = batch.reshape(-1)
+        critic_only = self.frames < cfg.critic_warmup_frames  # a fresh critic's advantages would steer the actor wrong
         stats: dict[str, list[float]] = {key: [] for key in ("loss", *PPO_DIAGNOSTICS)}
         for _ in range(cfg.epochs):
             for idx in torch.randperm(flat.shape[0]).split(cfg.minibatch):
                 losses = self.loss(flat[idx])
-                total = losses["loss_objective"] + losses["loss_critic"] + losses.get("loss_entropy", 0.0)
+                total = losses["loss_critic"] if critic_only else \
+                    losses["loss_objective"] + losses["loss_critic"] + losses.get("loss_entropy", 0.0)
                 self.optim.zero_grad()
                 total.backward()
                 nn.utils.clip_grad_norm_(self.loss.parameters(), cfg.max_grad_norm)

@@ -175,3 +175,23 @@ def test_tilt_cost_charges_an_ant_on_its_side():
         assert env.sim.up[0] > 0.9 and abs(env.sim.up[1]) < 0.4  # after one step of falling
     extra = rewards[0.0] - rewards[0.5]
     assert extra[1] > 0.3 and extra[0] < 0.05  # about tilt_cost x 1 on its side, next to nothing upright
+
+
+def test_goal_radius_draws_each_goals_own_radius_and_success_uses_it():
+    from dataclasses import replace
+
+    from specrefine.agents import AGENTS
+
+    task = replace(AGENTS["point"].reach_task, goals_per_episode=3, goal_radius=(0.5, 1.6))
+    env = GoalReachEnv("point", 64, seed=0, nthread=1, task=task)
+    td = env.reset()
+    assert ((env.radius >= 0.5) & (env.radius <= 1.6)).all() and env.radius.std() > 0.1
+    first = env.radius.copy()
+    env.goals[:] = env.sim.xy + np.stack([env.radius - 0.05, np.zeros(64)], axis=1)  # just inside each radius
+    td["action"] = torch.zeros(64, 2)
+    out, _ = env.step_and_maybe_reset(td)
+    assert out["next", "success"].all() and (env.goal_index == 1).all()  # all reached within their own radius
+    assert not np.allclose(env.radius, first)  # the next goals drew radii of their own
+    plain = GoalReachEnv("point", 64, seed=0, nthread=1)
+    plain.reset()
+    assert (plain.radius == AGENTS["point"].reach_task.success_radius).all()

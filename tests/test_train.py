@@ -153,3 +153,31 @@ def test_notebook_imports_from_train_still_work():
         assert getattr(train, name) is getattr(policy_eval, name)
     for name in ("plot_curve", "plot_rollouts", "plot_success_by_distance", "read_log"):
         assert getattr(train, name) is getattr(curves, name)
+
+
+def test_init_from_a_policy_file_trains_the_fresh_critic_alone_first(tiny_run, tmp_path):
+    out, path = tiny_run
+    cfg = make_config("point", frames=4096, seed=1, init=str(path), critic_warmup_frames=2048, lateral_cost=0.3,
+                      switch_radius=(0.3, 0.6), checkpoint_every_s=1e9)
+    trainer = Trainer(cfg, tmp_path / "ft", progress=False)
+    shipped = load_policy(path)
+    assert trainer.frames == 0 and trainer.policy.fingerprint == shipped.fingerprint
+    assert trainer.env.task.lateral_cost == 0.3 and trainer.env.task.goal_radius == (0.3, 0.6)
+    actor = {k: v.clone() for k, v in trainer.policy.net.state_dict().items()}
+    critic = [p.detach().clone() for p in trainer.critic.parameters()]
+    batch = next(iter(trainer.collector))
+    trainer.update(batch)  # inside the warm-up: the critic moves, the actor does not
+    for k, v in trainer.policy.net.state_dict().items():
+        torch.testing.assert_close(v, actor[k], rtol=0, atol=0)
+    assert any(not torch.equal(a, b.detach()) for a, b in zip(critic, trainer.critic.parameters()))
+    trainer.frames = 2048
+    trainer.update(next(iter(trainer.collector)))  # after it: both
+    assert any(not torch.equal(v, actor[k]) for k, v in trainer.policy.net.state_dict().items())
+    trainer.collector.shutdown()
+    with pytest.raises(SpecrefineError, match="a point policy, not one for the ant"):
+        Trainer(make_config("ant", frames=2048, init=str(path)), tmp_path / "ft3", progress=False)
+
+
+def test_a_bad_switch_radius_is_one_line(capsys, tmp_path):
+    assert main(["--agent", "point", "--out", str(tmp_path / "r"), "--switch-radius", "1.0", "0.5"]) == 2
+    assert "needs 0 < LO <= HI" in capsys.readouterr().err
