@@ -111,6 +111,7 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"] = evaluation
+    data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)

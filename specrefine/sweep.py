@@ -55,7 +55,7 @@ COLUMNS = [
     "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
-    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation",
+    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
 ]
 
 
@@ -70,6 +70,7 @@ class Cell:
     episodes: int = 200
     spec: str = ""  # the task as a spec expression; "" = the maze's own task
     evaluation: str = "fixed"  # "fixed" (the paper's protocol) or "adaptive" (specrefine.refine.racing)
+    policy: str = "shipped"  # the goal-conditioned policy: "shipped" (data/policies/AGENT.pt) or a checkpoint path
 
     @property
     def id(self) -> str:
@@ -111,7 +112,7 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = 32, episodes: int = 200,
-         specs: Iterable[str | None] = (None,), evaluation: str = "fixed") -> list[Cell]:
+         specs: Iterable[str | None] = (None,), evaluation: str = "fixed", policy: str = "shipped") -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
@@ -128,7 +129,7 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                 for proposer in props:
                     for seed in seeds:
                         cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
-                                          spec, evaluation))
+                                          spec, evaluation, policy))
     return cells
 
 
@@ -141,7 +142,8 @@ def run_cell(cell: Cell, out_root: str) -> dict:
         result = refine_maze(cell.maze, agent=cell.agent, method=cell.method,
                              proposer="geometric" if cell.proposer == "none" else cell.proposer, seed=cell.seed,
                              out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes,
-                             spec=cell.spec or None, evaluation=cell.evaluation)
+                             spec=cell.spec or None, evaluation=cell.evaluation,
+                             policy_path=None if cell.policy == "shipped" else cell.policy)
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
@@ -208,6 +210,8 @@ def _append(path: Path, row: dict) -> None:
             raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
         if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
             raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
+        if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
+            raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
     with path.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
@@ -249,7 +253,7 @@ def compact(table: Path) -> None:
     os.replace(tmp, table)
 
 
-PARAMS = ("rollouts", "episodes")  # what a cell's rows depend on beyond its id
+PARAMS = ("rollouts", "episodes", "policy")  # what a cell's rows depend on beyond its id
 
 
 def check_params(cells: list[Cell], out_root: Path) -> None:
@@ -406,6 +410,19 @@ def _check_specs(cells: list[Cell]) -> str | None:
     return None
 
 
+def _check_policy(policy: str, agent: str) -> str | None:
+    """One line if ``policy`` is not a usable checkpoint for ``agent`` (before any cell runs)."""
+    from .experiment import load_goal_policy
+
+    if policy == "shipped":
+        return None
+    try:
+        load_goal_policy(agent, policy)
+    except SpecrefineError as exc:
+        return f"--policy {exc}"
+    return None
+
+
 def main(argv=None) -> int:
     from .mazes import benchmark_mazes
 
@@ -424,6 +441,9 @@ def main(argv=None) -> int:
     p.add_argument("--evaluation", choices=["fixed", "adaptive"], default="fixed",
                    help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
                         "when adaptive)")
+    p.add_argument("--policy", default="shipped",
+                   help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
+                        "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")
     p.add_argument("--out", default="runs/sweep")
     p.add_argument("--backend", choices=["local", "ray"], default="local",
                    help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
@@ -432,8 +452,9 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
-                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation)
-    bad = _check_specs(cells)
+                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation,
+                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
+    bad = _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
         return _fail(bad, 2)
     t0 = time.time()

@@ -103,3 +103,27 @@ def test_ray_backend_runs_two_cells_on_a_local_head(tmp_path):
         subprocess.run([ray_bin, "stop", "--force"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                        timeout=120)
         shutil.rmtree(temp_dir, ignore_errors=True)
+
+
+def test_a_sweep_runs_every_cell_with_the_policy_it_is_given(tmp_path, capsys):
+    import json
+
+    from specrefine.policy import POLICY_DIR, load_policy
+    from specrefine.sweep import main
+
+    policy = tmp_path / "my_point.pt"
+    shutil.copy(POLICY_DIR / "point.pt", policy)
+    args = ["--mazes", "u_maze", "--methods", "dirl", "--seeds", "0", "--rollouts", "8", "--episodes", "16",
+            "--workers", "1", "--out", str(tmp_path / "out")]
+    assert main([*args, "--policy", str(policy)]) == 0
+    (row,) = read_table(tmp_path / "out" / "results.csv")
+    assert row["status"] == "ok" and row["policy"] == str(policy.resolve())
+    result = json.loads((tmp_path / "out" / "cells" / row["cell"] / "result.json").read_text())
+    assert result["policy_fingerprint"] == load_policy(policy).fingerprint and "my_point.pt" in result["policy"]
+    capsys.readouterr()
+    assert main([*args]) == 2  # the same cells with the shipped policy: refused, nothing mixed
+    assert "--policy" in capsys.readouterr().err
+    assert main([*args[:-1], str(tmp_path / "other"), "--policy", str(tmp_path / "missing.pt")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "missing.pt: policy file not found" in err
+    assert not (tmp_path / "other" / "results.csv").exists()
