@@ -56,7 +56,7 @@ def leg_table(run, n_legs: int) -> list[dict]:
 def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> dict:
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures."""
     from .evaluate import Evaluator, path_legs
-    from .experiment import load_goal_policy, setup
+    from .experiment import setup
     from .graph import TaskGraph
 
     if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
@@ -72,10 +72,9 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> d
     out = {"maze": result["maze"], "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
            "legs": [{"leg": k, "from": path[k], "to": path[k + 1], "turn_deg": turns[k], "length_m": lengths[k]}
                     for k in range(len(legs))]}
-    goal_policy, _ = load_goal_policy(agent, policy)
     bare = open_floor(exp.maze)
     variants = {"walls": (exp.evaluator, legs),
-                "no_inner_walls": (Evaluator(bare, agent, goal_policy, n=exp.evaluator.n, seed=seed),
+                "no_inner_walls": (Evaluator(bare, agent, exp.policy, n=exp.evaluator.n, seed=seed),
                                    [(goal, bare.walls, point) for goal, _avoid, point in legs])}
     for name, (evaluator, variant_legs) in variants.items():
         run = evaluator.run_compositional(start, variant_legs, n=episodes, seed=seed)
