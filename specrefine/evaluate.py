@@ -124,7 +124,7 @@ class Evaluator:
         self.n, self.seed, self.nthread = int(n), seed, nthread
         self.horizon = int(horizon) if horizon is not None else spec.default_horizon
         self.agent_radius = float(spec.body_radius)  # the agent entry's (and BatchedSim's) body radius
-        model = build_model(agent, maze)
+        self._model = model = build_model(agent, maze)  # shared by the sims of every batch size
         #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
         self.contact_margin = contact_margin(model)
         #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < clearance
@@ -166,7 +166,7 @@ class Evaluator:
 
         batch = int(batch or self.n)
         if batch not in self._sims:
-            self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread)
+            self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread, model=self._model)
         return self._sims[batch]
 
     def compiled(self, region: Region) -> CompiledRegion:
@@ -211,12 +211,12 @@ class Evaluator:
         probe = region.sample(256, np.random.default_rng(rng.integers(2**32)))
         return bool((~self._walls.below(probe, clearance)).mean() > 0.01)
 
-    def _key(self, kind: str, start, legs, n: int, seed) -> tuple[str, str]:
+    def _key(self, kind: str, start, legs, n: int, seed, fp: str | None) -> tuple[str, str]:
         if isinstance(start, StartStates):
             start_key = {"states": start.digest(), "m": len(start)}
         else:
             start_key = _region_key(start)
-        fp = self.policy_fingerprint or f"id:{id(self.policy)}"
+        fp = fp or f"id:{id(self.policy)}"
         legs_key = [[_region_key(g), _region_key(a), None if p is None else [float(v) for v in np.ravel(p)]]
                     for g, a, p in legs]
         body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
@@ -227,7 +227,7 @@ class Evaluator:
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
     def _cache_path(self, key: str) -> Path | None:
-        if self.cache_dir is None or self.policy_fingerprint is None:
+        if self.cache_dir is None:
             return None
         return self.cache_dir / key[:2] / f"{key}.npz"
 
@@ -290,14 +290,15 @@ class Evaluator:
         """
         n = int(n or self.n)
         seed = self.seed if seed is None else seed
+        fp = self.policy_fingerprint  # hashed once per call (it hashes the weights); None: no disk cache
         results: list[EdgeResult | None] = [None] * len(subtasks)
         todo: dict[str, tuple] = {}  # key -> (text, task, positions)
         for i, (start, goal, avoid, goal_point) in enumerate(subtasks):
             legs = [(goal, avoid, goal_point)]
-            key, text = self._key("edge", start, legs, n, seed)
+            key, text = self._key("edge", start, legs, n, seed, fp)
             if key in todo:  # asked twice in one batch: simulated once, the second is a cache hit
                 todo[key][2].append(i)
-            elif (hit := self._lookup(key, text)) is not None:
+            elif (hit := self._lookup(key, text, disk=fp is not None)) is not None:
                 results[i] = hit
             elif isinstance(start, StartStates) and len(start) == 0:
                 # nothing reached the start: p = 0, nothing run
@@ -312,22 +313,21 @@ class Evaluator:
                 res = _edge_result(out, n)
                 self.evaluations += 1
                 self._remember(key, res)
-                self._store(key, text, res)
+                if fp is not None:
+                    self._store(key, text, res)
                 results[positions[0]] = res
                 for i in positions[1:]:
                     self.cache_hits += 1
                     results[i] = replace(res, cached=True)
         return results
 
-    def _lookup(self, key: str, text: str) -> EdgeResult | None:
+    def _lookup(self, key: str, text: str, disk: bool) -> EdgeResult | None:
         hit = self._memo.get(key)
-        if hit is None:
-            hit = self._load(key, text)
-            if hit is not None:
-                self.disk_hits += 1
-                self._remember(key, replace(hit, cached=False))
-        else:
+        if hit is not None:
             self._memo.move_to_end(key)
+        elif disk and (hit := self._load(key, text)) is not None:
+            self.disk_hits += 1
+            self._remember(key, replace(hit, cached=False))
         if hit is None:
             return None
         self.cache_hits += 1

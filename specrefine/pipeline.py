@@ -129,9 +129,10 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
     if method.startswith("ours"):
         cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
                            vertex_refinement=method != "ours-novertex", evaluation=evaluation)
-        query_for = edge_query_builder(maze, agent, evaluator.facts())
+        images = getattr(proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
+        query_for = edge_query_builder(maze, agent, evaluator.facts(), images=images)
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
-                                query_for=query_for, picture=candidate_picture(maze)).run()
+                                query_for=query_for, picture=candidate_picture(maze) if images else None).run()
     if method.startswith("vlm-oneshot"):
         from .refine.oneshot import oneshot
 
@@ -154,22 +155,27 @@ def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, 
     return proposer.proposer_calls, twin.evaluations + twin.disk_hits
 
 
-def edge_query_builder(maze, agent, facts=None):
+def edge_query_builder(maze, agent, facts=None, *, images: bool = True):
     """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts.
 
     ``facts``: the evaluator's ``facts()``, what the prompt says about the evaluation (default: an
-    evaluator with default settings on ``maze``).
+    evaluator with default settings on ``maze``). ``images=False``: no picture (``image_png`` None).
     """
     from .proposers import EdgeQuery
     from .render import render_task, to_png
 
-    def build(graph, u, v, result):
+    def picture(graph, u, v, result):
+        if not images:
+            return None
         fig = render_task(maze, _edge_graph(graph, u, v), trajectories=getattr(result, "trajectories", None),
                           success=getattr(result, "success", None), lengths=getattr(result, "lengths", None),
                           title=f"{u} -> {v}: {result.p:.0%} of {result.n} rollouts succeed")
+        return to_png(fig)
+
+    def build(graph, u, v, result):
         return EdgeQuery(maze=maze, agent=agent, start=graph.region(u), goal=graph.region(v),
-                         avoid=graph.avoid(u, v), success=result.p, n=result.n, image_png=to_png(fig), graph=graph,
-                         facts=facts)
+                         avoid=graph.avoid(u, v), success=result.p, n=result.n,
+                         image_png=picture(graph, u, v, result), graph=graph, facts=facts)
 
     return build
 

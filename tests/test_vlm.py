@@ -75,7 +75,8 @@ class Server:
         class Handler(http.server.BaseHTTPRequestHandler):
             def do_POST(self):
                 body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
-                outer.requests.append({"path": self.path, "headers": dict(self.headers), "body": body})
+                headers = {k.lower(): v for k, v in self.headers.items()}  # HTTP names are case-insensitive
+                outer.requests.append({"path": self.path, "headers": headers, "body": body})
                 item = outer.script.pop(0) if outer.script else [GOOD]
                 status, headers = item if isinstance(item, tuple) else (item, {})
                 if isinstance(status, int):
@@ -163,7 +164,7 @@ def test_request_carries_image_prompt_and_key_header(srv, tmp_path, query):
     assert len(srv.requests) == 1
     req = srv.requests[0]
     assert req["path"] == "/v1/chat/completions"
-    assert req["headers"]["Authorization"] == f"Bearer {KEY}"  # the key came from the environment
+    assert req["headers"]["authorization"] == f"Bearer {KEY}"  # the key came from the environment
     body = req["body"]
     assert body["model"] == "test-model" and body["n"] == 3
     assert body["response_format"] == {"type": "json_object"}

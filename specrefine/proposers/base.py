@@ -78,6 +78,8 @@ class Proposer:
     name: str = "?"
     spec: str = "?"
     is_vlm: bool = False
+    #: whether its answers depend on the queries' pictures (offline proposers: no, so none are rendered)
+    sees_images: bool = False
 
     def __init__(self):
         self.queries = 0  # propose_* calls answered

@@ -291,6 +291,7 @@ class ImperfectProposer(VLMProposer):
     """``imperfect:PRESET`` or ``imperfect:key=value,...``: a VLM-like error model, offline. NOT a VLM."""
 
     is_vlm = False
+    sees_images = False  # it answers from the query's geometry (``client.context``), never from a picture
 
     def __init__(self, config: ImperfectConfig, *, spec: str = "imperfect", seed: int = 0):
         super().__init__(ErrorModelClient(config, seed), spec=spec)

@@ -23,6 +23,7 @@ class VLMProposer(Proposer):
     """Asks a vision-language model (through a :class:`~specrefine.vlm.VLMClient`)."""
 
     is_vlm = True
+    sees_images = True
 
     def __init__(self, client: VLMClient, *, spec: str | None = None, reask: bool = True, max_waypoints: int = 32):
         super().__init__()

@@ -31,9 +31,10 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
         if on_step:
             on_step(step)
 
+    draw = _picture if getattr(proposer, "sees_images", True) else (lambda *_: None)
     base = shortest_path(original, evaluator, seed=seed)
     query = GraphQuery(maze=maze, agent=agent, graph=original, success=base.predicted_success, n=evaluator.n,
-                       image_png=_picture(maze, evaluator, original, base), edge_success=_edge_success(base),
+                       image_png=draw(maze, evaluator, original, base), edge_success=_edge_success(base),
                        facts=evaluator.facts())
     log("input-evaluated", predicted_success=base.predicted_success, path=base.path)
     best, feedback = None, []
@@ -46,7 +47,7 @@ def oneshot(original, evaluator, proposer, *, maze, agent, w=3, rounds=2, seed=0
             if budget is None:
                 feedback.append(GraphFeedback(graph=graph, edge_success=_edge_success(result),
                                               success=result.predicted_success,
-                                              image_png=_picture(maze, evaluator, graph, result)))
+                                              image_png=draw(maze, evaluator, graph, result)))
             if best is None or result.predicted_success > best.predicted_success:
                 best = result
     if best is None:  # every reply was rejected: the input graph is all there is
