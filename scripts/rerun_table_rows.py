@@ -1,0 +1,56 @@
+"""Run again, with this checkout's code, the cells behind the first N rows of a sweep table, into a new OUT.
+
+    python scripts/rerun_table_rows.py data/results/imperfect/results.csv --rows 485 --out runs/imperfect_rerun \
+        --workers 2
+
+For a table whose first rows came from older code (data/results/imperfect: rows 1-485, commit 6f3114f): the cells
+are rebuilt from the rows (maze, agent, method, proposer, seed, rollouts, episodes, spec), the sweep runs them
+(resumable, as ``specrefine.sweep``), and ``--compare`` lists the columns in which the new rows differ from the old.
+"""
+import argparse
+from pathlib import Path
+
+from specrefine.sweep import Cell, read_table, run_sweep
+
+SEARCH_COLUMNS = ("success_rate", "evaluations", "proposer_calls", "path_edges", "graph_vertices", "graph_edges",
+                  "refinements", "search_estimate")  # what a code change that keeps the search must keep
+
+
+def cells_of(rows) -> list[Cell]:
+    return [Cell(r["maze"], r["agent"], r["method"], r["proposer"], int(r["seed"]),
+                 int(r.get("rollouts_per_evaluation") or 32), int(r.get("episodes") or 200), r.get("spec") or "",
+                 r.get("evaluation") or "fixed", r.get("policy") or "shipped") for r in rows]
+
+
+def compare(old_rows, new_rows) -> list[str]:
+    """One line per cell whose new row differs from the old one in a SEARCH_COLUMNS column."""
+    new = {r["cell"]: r for r in new_rows}
+    out = []
+    for o in old_rows:
+        n = new.get(o["cell"])
+        if n is None:
+            out.append(f"{o['cell']}: not rerun yet")
+            continue
+        diff = [f"{c} {o.get(c)} -> {n.get(c)}" for c in SEARCH_COLUMNS if o.get(c) != n.get(c)]
+        if diff:
+            out.append(f"{o['cell']}: " + "; ".join(diff))
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("table")
+    ap.add_argument("--rows", type=int, required=True, help="the first ROWS rows of TABLE")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--compare", action="store_true", help="only compare OUT/results.csv with TABLE's rows")
+    args = ap.parse_args()
+    old = read_table(args.table)[: args.rows]
+    if not args.compare:
+        run_sweep(cells_of(old), args.out, workers=args.workers)
+    lines = compare(old, read_table(Path(args.out) / "results.csv"))
+    print("\n".join(lines) or f"all {len(old)} rows agree in {', '.join(SEARCH_COLUMNS)}")
+
+
+if __name__ == "__main__":
+    main()
