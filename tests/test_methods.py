@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import json
 
-from specrefine.pipeline import METHODS, PROPOSER_METHODS, refine_maze
+import pytest
+
+from specrefine.experiment import setup
+from specrefine.pipeline import METHODS, PROPOSER_METHODS, _search, refine_maze
+from specrefine.proposers.geometric import GeometricProposer
 
 SMALL = dict(agent="point", rollouts=8, episodes=20, seed=0)
 
@@ -44,3 +48,30 @@ def test_matched_one_shot_spends_what_ours_spent(tmp_path):
     assert plain["proposer_calls"] == 2  # the paper's baseline: one query + one feedback round
     assert sum(s["event"] == "candidate" for s in steps) == 3 * matched["proposer_calls"]  # w = 3 per call
     assert all(s["round"] == 1 for s in steps if s["event"] == "candidate")  # best-of-N: no feedback rounds
+
+
+class _Seeing(GeometricProposer):
+    """The geometric proposer, recording the pictures each query hands it."""
+
+    def __init__(self, sees_images: bool):
+        super().__init__(seed=0)
+        self.sees_images, self.pictures = sees_images, []
+
+    def propose_split(self, q, w, feedback=()):
+        self.pictures += [q.image_png] + [f.image_png for f in feedback]
+        return super().propose_split(q, w, feedback)
+
+    def propose_graph(self, q, w, feedback=()):
+        self.pictures += [q.image_png] + [f.image_png for f in feedback]
+        return super().propose_graph(q, w, feedback)
+
+
+@pytest.mark.parametrize("method", ["ours", "vlm-oneshot"])
+def test_pictures_are_drawn_only_for_a_proposer_that_looks_at_them(method):
+    exp = setup("u_chain_2", agent="point", rollouts=8, seed=0)
+    blind, seeing = _Seeing(False), _Seeing(True)
+    for proposer in (blind, seeing):
+        _search(method, exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze, "point", 0, 3, 2, 5, None)
+    assert blind.pictures and all(p is None for p in blind.pictures)
+    assert seeing.pictures[0][:8] == b"\x89PNG\r\n\x1a\n"  # the query's map
+    assert [p is None for p in blind.pictures] == [True] * len(seeing.pictures)  # the same queries were asked
