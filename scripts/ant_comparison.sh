@@ -2,7 +2,7 @@
 # The Ant grids of docs/ant_experiments.md (sections 2 and 3), in the order they were fixed, into one resumable table:
 #   mkdir -p runs && nohup setsid bash scripts/ant_comparison.sh > runs/ant_comparison.log 2>&1 &
 # 1. the U-chain grid (ours + geometric, U-chain 1-5 with and without subgoals, seeds 0-2; the paper's Figure 5);
-# 2. the comparison, one seed at a time (all 15 mazes x dirl, symbolic, vlm-oneshot, ours x geometric,
+# 2. the comparison, one seed at a time (all 17 mazes x dirl, symbolic, vlm-oneshot, ours x geometric,
 #    imperfect:moderate), so that an interrupted run leaves whole seeds behind it.
 # Stage 1's cells are also stage 2's (same ids), so they run once. Every done row is copied to SHIPPED every two
 # minutes: a new machine resumes from it (the table is copied back into OUT when OUT has none).

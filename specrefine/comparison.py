@@ -14,13 +14,16 @@ A cell of the fixed grid without an ``ok`` row is reported as missing: every ent
 it used (``n_cells`` of ``n_expected``), the seeds, and which are missing. An entry with a missing cell
 is ``complete = False`` and is not the comparison the grid fixed.
 
-``python -m specrefine.comparison TABLE --out DIR`` writes the figures, ``claims.md`` and ``claims.json``.
+``python -m specrefine.comparison TABLE --out DIR`` writes the figures, ``claims.md`` and ``claims.json``;
+``--grid ant`` reads the Ant comparison of docs/ant_experiments.md instead (the paper's four methods, proposers
+``geometric`` and ``imperfect:moderate``, seeds 0-2; the claims on ``ours`` and ``vlm-oneshot``).
 """
 
 from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -50,9 +53,31 @@ PAPER_ROOM_CLAIMS = {"ours": "flat", "vlm-oneshot": "falls"}
 BOOTSTRAP_RESAMPLES = 10_000
 BOOTSTRAP_SEED = 0
 
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A comparison's fixed grid: whose rows, which methods (figures) and which of them the claims test,
+    which proposers and seeds; ``levels``: the error levels of the error-level figure (none: no such figure)."""
+    agent: str
+    methods: tuple
+    claim_methods: tuple
+    proposers: tuple
+    seeds: tuple
+    levels: tuple = ()
+
+
+#: The offline comparison of docs/proposers.md (point mass, five methods, four presets, four seeds).
+POINT_GRID = Grid("point", tuple(COMPARISON_METHODS), tuple(COMPARISON_METHODS), tuple(PRESETS), SEEDS,
+                  tuple(ERROR_LEVELS))
+#: The Ant comparison of docs/ant_experiments.md section 3: the paper's methods, claims on ours and one-shot.
+ANT_GRID = Grid("ant", ("dirl", "symbolic", "vlm-oneshot", "ours"), ("ours", "vlm-oneshot"),
+                ("geometric", "imperfect:moderate"), (0, 1, 2))
+GRIDS = {"point": POINT_GRID, "ant": ANT_GRID}
+
 RATIO_CLAIM_TEXT = "ours >= 2x one-shot on multi-room tasks"
 ROOMS_CLAIM_TEXT = "success over 1-5 rooms"  # the paper: flat for ours, falling for vlm-oneshot
-OFFLINE_NOTE = "proposer imperfect:* is an offline error model, NOT a VLM"
+OFFLINE_NOTE = "every proposer here is offline, NOT a VLM (geometric: a planner on the map; imperfect:*: error model)"
 
 
 def table_cells(rows, agent: str = "point") -> tuple[dict, set]:
@@ -178,13 +203,13 @@ def rooms_claim(cells, failed, proposer, method, seeds=SEEDS) -> dict:
     return _entry(claim, proposer, method, estimate, ci, rooms_verdict(ci), n_expected, used_seeds, missing, note)
 
 
-def claims(rows, proposers=PRESETS, methods=COMPARISON_METHODS, seeds=SEEDS, agent: str = "point") -> list[dict]:
-    """Both claims for every preset: per proposer, the ratio entry, then the rooms entry of each method."""
-    cells, failed = table_cells(rows, agent)
+def claims(rows, grid: Grid = POINT_GRID) -> list[dict]:
+    """Both claims for every proposer of ``grid``: the ratio entry, then the rooms entry of each claim method."""
+    cells, failed = table_cells(rows, grid.agent)
     out = []
-    for proposer in proposers:
-        out.append(ratio_claim(cells, failed, proposer, seeds))
-        out += [rooms_claim(cells, failed, proposer, method, seeds) for method in methods]
+    for proposer in grid.proposers:
+        out.append(ratio_claim(cells, failed, proposer, grid.seeds))
+        out += [rooms_claim(cells, failed, proposer, method, grid.seeds) for method in grid.claim_methods]
     return out
 
 
@@ -282,31 +307,44 @@ def error_level_figure(rows, methods=COMPARISON_METHODS, levels=ERROR_LEVELS, ex
     return fig
 
 
-def comparison_figures(rows) -> dict:
-    """name -> figure: Figures 4 and 5 for the five methods, one panel per preset, and the error-level figure."""
-    present = [p for p in PRESETS if any(r.get("proposer") == p for r in rows)]
+def comparison_figures(rows, grid: Grid = POINT_GRID) -> dict:
+    """name -> figure: Figures 4 and 5 of the grid's methods, one panel per proposer, and (for a grid with error
+    levels) the error-level figure."""
+    rows = [r for r in rows if r.get("agent", grid.agent) == grid.agent]
+    present = [p for p in grid.proposers if any(r.get("proposer") == p for r in rows)]
     if not present:
         return {}
-    return {"figure4": figure4(rows, methods=COMPARISON_METHODS, proposers=present, legend_outside=True),
-            "figure5": figure5(rows, methods=COMPARISON_METHODS, proposers=present, legend_outside=True),
-            "error_levels": error_level_figure(rows)}
+    figures = {"figure4": figure4(rows, methods=list(grid.methods), proposers=present, legend_outside=True),
+               "figure5": figure5(rows, methods=list(grid.methods), proposers=present, legend_outside=True)}
+    if grid.levels:
+        figures["error_levels"] = error_level_figure(rows, methods=list(grid.methods), levels=list(grid.levels),
+                                                     agent=grid.agent)
+    return figures
 
 
-def expected_cells() -> int:
-    """Runs in the fixed grid: every maze in data/mazes x the five methods x the four presets x the seeds."""
+def grid_cells(grid: Grid = POINT_GRID) -> set:
+    """The fixed grid's (maze, method, proposer, seed) keys: every maze in data/mazes; a method without a
+    proposer (dirl, symbolic) once per seed, with proposer ``none``, as ``specrefine.sweep`` runs it."""
     from .mazes import benchmark_mazes
+    from .pipeline import PROPOSER_METHODS
 
-    return len(benchmark_mazes()) * len(COMPARISON_METHODS) * len(PRESETS) * len(SEEDS)
+    return {(maze, method, proposer if method in PROPOSER_METHODS else "none", seed)
+            for maze in benchmark_mazes() for method in grid.methods for proposer in grid.proposers
+            for seed in grid.seeds}
 
 
-def table_note(path, rows) -> str:
+def expected_cells(grid: Grid = POINT_GRID) -> int:
+    return len(grid_cells(grid))
+
+
+def table_note(path, rows, grid: Grid = POINT_GRID) -> str:
     """One line on how much of the fixed grid a table holds (a missing or partial table is no error)."""
     if not Path(path).exists():
-        return f"no comparison table at {path}: nothing to draw (the sweep of docs/proposers.md has not run here)"
-    cells, _ = table_cells(rows)
-    done = sum(1 for (_, method, proposer, _) in cells if method in COMPARISON_METHODS and proposer in PRESETS)
-    if done < expected_cells():
-        return (f"{path}: PARTIAL, {done} of {expected_cells()} runs of the fixed grid have an ok row; "
+        return f"no comparison table at {path}: nothing to draw (its sweep has not run here)"
+    cells, _ = table_cells(rows, grid.agent)
+    done, expected = len(grid_cells(grid) & set(cells)), expected_cells(grid)
+    if done < expected:
+        return (f"{path}: PARTIAL, {done} of {expected} runs of the fixed grid have an ok row; "
                 "what follows is not the comparison the grid fixed")
     return f"{path}: all {done} runs of the fixed grid have an ok row"
 
@@ -321,9 +359,10 @@ def _jsonable(value):
     return value
 
 
-def write_claims(entries, out: Path, table) -> None:
-    about = {"table": str(table), "note": OFFLINE_NOTE, "multi_room_mazes": list(MULTI_ROOM_MAZES),
-             "ratio_threshold": RATIO_CLAIM, "flat_tolerance": FLAT_TOLERANCE, "seeds": list(SEEDS),
+def write_claims(entries, out: Path, table, grid: Grid = POINT_GRID) -> None:
+    about = {"table": str(table), "note": OFFLINE_NOTE, "agent": grid.agent,
+             "multi_room_mazes": list(MULTI_ROOM_MAZES),
+             "ratio_threshold": RATIO_CLAIM, "flat_tolerance": FLAT_TOLERANCE, "seeds": list(grid.seeds),
              "bootstrap_resamples": BOOTSTRAP_RESAMPLES, "bootstrap_seed": BOOTSTRAP_SEED}
     (out / "claims.json").write_text(json.dumps(_jsonable({"about": about, "claims": entries}), indent=1) + "\n")
     (out / "claims.md").write_text(markdown(entries) + "\n")
@@ -337,18 +376,21 @@ def main(argv=None) -> int:
     p.add_argument("table", help="results.csv of the comparison sweep (specrefine.sweep)")
     p.add_argument("--out", required=True,
                    help="folder for figure4.png, figure5.png, error_levels.png, claims.md and claims.json")
+    p.add_argument("--grid", choices=sorted(GRIDS), default="point",
+                   help="point: docs/proposers.md's comparison (default); ant: docs/ant_experiments.md section 3")
     args = p.parse_args(argv)
+    grid = GRIDS[args.grid]
     if not Path(args.table).is_file():
         p.exit(2, f"{p.prog}: error: no table at {args.table}\n")
     rows = read_table(args.table)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    print(table_note(args.table, rows))
-    for name, fig in comparison_figures(rows).items():
+    print(table_note(args.table, rows, grid))
+    for name, fig in comparison_figures(rows, grid).items():
         fig.savefig(out / f"{name}.png", dpi=110)
         plt.close(fig)
-    entries = claims(rows)
-    write_claims(entries, out, args.table)
+    entries = claims(rows, grid)
+    write_claims(entries, out, args.table, grid)
     partial = sum(not e["complete"] for e in entries)
     print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")
     return 0

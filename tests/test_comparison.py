@@ -206,3 +206,47 @@ def test_calibration_figure_counts_runs_inside_the_predicted_interval():
     fig = calibration_figure({"runs": rows})
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert labels == ["runs: 1/2 covered"]
+
+
+def ant_row(maze, method, success, seed, proposer):
+    return {**row(maze, method, success, seed, proposer), "agent": "ant",
+            "cell": f"{maze}__ant__{method}__{proposer}__s{seed}"}
+
+
+def test_ant_grid_counts_methods_without_a_proposer_once_per_seed():
+    from specrefine.mazes import benchmark_mazes
+
+    # dirl and symbolic once per seed, vlm-oneshot and ours once per proposer: 6 runs per maze and seed
+    assert cmp.expected_cells(cmp.ANT_GRID) == len(benchmark_mazes()) * 6 * 3
+    rows = [ant_row("u_maze", "dirl", 0.0, 0, "none"), ant_row("u_maze", "ours", 0.9, 0, "geometric"),
+            row("u_maze", "ours", 0.9, 1, "geometric")]  # a point row: another agent, not counted
+    note = cmp.table_note(__file__, rows, cmp.ANT_GRID)
+    assert f"PARTIAL, 2 of {cmp.expected_cells(cmp.ANT_GRID)} runs" in note
+
+
+def test_ant_grid_claims_test_ours_and_oneshot_per_proposer_on_ant_rows_only():
+    rows = []
+    for proposer in cmp.ANT_GRID.proposers:
+        for maze in cmp.MULTI_ROOM_MAZES:
+            for seed in cmp.ANT_GRID.seeds:
+                rows += [ant_row(maze, "vlm-oneshot", 0.2, seed, proposer), ant_row(maze, "ours", 0.8, seed, proposer)]
+    rows += [row(maze, "vlm-oneshot", 0.8, 0, "geometric") for maze in cmp.MULTI_ROOM_MAZES]  # point: ignored
+    entries = cmp.claims(rows, cmp.ANT_GRID)
+    assert [(e["proposer"], e["kind"], e["method"]) for e in entries] == [
+        (p, kind, m) for p in cmp.ANT_GRID.proposers
+        for kind, m in (("ratio", "ours / vlm-oneshot"), ("rooms", "ours"), ("rooms", "vlm-oneshot"))]
+    ratio = entries[0]
+    assert ratio["estimate"] == pytest.approx(4.0) and ratio["verdict"] == "holds" and ratio["complete"]
+    assert ratio["n_expected"] == len(cmp.MULTI_ROOM_MAZES) * 3
+
+
+def test_ant_cli_draws_figures_4_and_5_without_error_levels(tmp_path):
+    rows = [ant_row(maze, method, 0.5, seed, "none" if method in ("dirl", "symbolic") else proposer)
+            for proposer in cmp.ANT_GRID.proposers for maze in ("u_chain_1", "u_chain_2", "u_maze")
+            for method in cmp.ANT_GRID.methods for seed in (0, 1)]
+    table = tmp_path / "results.csv"
+    write_csv(table, rows)
+    out = tmp_path / "out"
+    assert cmp.main([str(table), "--out", str(out), "--grid", "ant"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["claims.json", "claims.md", "figure4.png", "figure5.png"]
+    assert json.loads((out / "claims.json").read_text())["about"]["agent"] == "ant"
