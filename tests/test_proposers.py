@@ -73,8 +73,26 @@ def test_names_never_claim_a_vlm():
         p = make_proposer(spec)
         assert isinstance(p, Proposer) and not p.is_vlm and word in p.name
         assert p.describe()["is_vlm"] is False and p.describe()["proposer"] == spec
-    with pytest.raises(SpecrefineError):
-        make_proposer("geometric:x")
+    for bad in ("geometric:x", "geometric:max_waypoints=0", "geometric:max_waypoints=4.5", "geometric:radius=2"):
+        with pytest.raises(SpecrefineError, match="max_waypoints=N"):
+            make_proposer(bad)
+
+
+def _longest_leg_cells(maze, q, cand) -> float:
+    pts = [q.start.centre()] + [r.centre() for r in cand] + [q.goal.centre()]
+    return max(float(np.linalg.norm(np.subtract(a, b))) for a, b in zip(pts, pts[1:])) / maze.cell_size
+
+
+def test_geometric_waypoint_cap():
+    """U-chain 5 with the Ant needs 37 one-cell legs: the default cap of 32 doubles the legs, a higher cap keeps them."""
+    maze = load_maze("u_chain_5").for_agent("ant")
+    q = edge_queries(maze, "ant")[0]
+    capped = make_proposer("geometric", seed=0).propose_split(q, 1)[0]
+    p = make_proposer("geometric:max_waypoints=48", seed=0)
+    assert p.describe()["proposer"] == "geometric:max_waypoints=48" and not p.is_vlm
+    free = p.propose_split(q, 1)[0]
+    assert len(capped) <= 32 < len(free) <= 48
+    assert _longest_leg_cells(maze, q, capped) > 1.5 and _longest_leg_cells(maze, q, free) < 1.5
 
 
 @pytest.mark.parametrize("spec", ["geometric", "random"])

@@ -4,6 +4,8 @@
   recorded to ``data/vlm/`` (or ``record_path``);
 * ``replay:PATH`` — answers from such a recording, deterministically;
 * ``geometric`` — an OFFLINE STAND-IN, not a VLM (shortest free-space path waypoints);
+  ``geometric:max_waypoints=N`` raises its cap of 32 waypoints per split (when a route needs more, it
+  lengthens its legs instead, beyond the agent's reach);
 * ``random`` — random free-space waypoints (an ablation; also not a VLM);
 * ``imperfect:PRESET`` / ``imperfect:key=value,...`` — a VLM-like error model, offline (NOT a VLM).
 
@@ -28,8 +30,9 @@ log = logging.getLogger(__name__)
 def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = None, **client_kw) -> Proposer:
     """``geometric`` | ``random`` | ``replay:PATH`` | ``litellm:MODEL`` (extra keywords go to LiteLLMClient)."""
     kind, _, rest = str(spec).partition(":")
-    if kind == "geometric" and not rest:
-        proposer: Proposer = GeometricProposer(seed=seed)
+    if kind == "geometric":
+        proposer: Proposer = GeometricProposer(seed=seed, max_waypoints=_max_waypoints(rest))
+        proposer.spec = spec
     elif kind == "random" and not rest:
         proposer = RandomProposer(seed=seed)
     elif kind == "replay" and rest:
@@ -39,7 +42,18 @@ def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = 
     elif kind == "litellm" and rest:
         proposer = VLMProposer(LiteLLMClient(rest, record_path=record_path, **client_kw), spec=spec)
     else:
-        raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, random, imperfect:PRESET, replay:PATH "
-                              "or litellm:MODEL")
+        raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, geometric:max_waypoints=N, random, "
+                              "imperfect:PRESET, replay:PATH or litellm:MODEL")
     log.info("proposer: %s", proposer.name)
     return proposer
+
+
+def _max_waypoints(options: str) -> int:
+    """``''`` -> 32; ``'max_waypoints=N'`` -> N (a positive integer); anything else is a one-line error."""
+    if not options:
+        return 32
+    key, eq, value = (t.strip() for t in options.partition("="))
+    if key != "max_waypoints" or not eq or not value.isdigit() or int(value) < 1:
+        raise SpecrefineError(f"invalid proposer 'geometric:{options}': the one option is max_waypoints=N "
+                              "(a positive integer)")
+    return int(value)
