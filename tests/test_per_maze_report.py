@@ -1,0 +1,26 @@
+"""scripts/per_maze_report.py: the closing notes' per-maze lines pool episodes, not rates."""
+import importlib.util
+from pathlib import Path
+
+from specrefine.results import wilson_ci
+from specrefine.sweep import _NUMBERS
+
+_spec = importlib.util.spec_from_file_location("per_maze_report",
+                                               Path(__file__).parents[1] / "scripts" / "per_maze_report.py")
+report = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(report)
+
+
+def _row(seed, rate, episodes, lo=0.5, hi=0.9, status="ok"):
+    return {key: 1 for key in _NUMBERS} | {"maze": "m", "seed": seed, "status": status, "error": "", "success_rate": rate, "episodes": episodes,
+            "success_ci_low": 0.0, "success_ci_high": 1.0, "predicted_success": 0.7, "predicted_ci_low": lo,
+            "predicted_ci_high": hi, "evaluations": 10 * (seed + 1), "sim_steps": 1_000_000, "wall_seconds": 60.0}
+
+
+def test_pooled_line_pools_episodes_and_counts_inside():
+    rows = [_row(0, 0.8, 200), _row(1, 0.5, 100, lo=0.6), _row(2, 0.0, 0, status="error")]
+    line = report.pooled_line("m", rows)
+    lo, hi = wilson_ci(210, 300)
+    assert f"2 of 3 | 210/300 = 0.700 [{lo:.3f}, {hi:.3f}] (0.800, 0.500)" in line
+    assert "(1 of 2 inside)" in line and "| 15 | 1.00M | 60 |" in line
+    assert report.pooled_line("m", [rows[2]]).startswith("| m | 0 of 1 |")
