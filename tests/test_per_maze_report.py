@@ -12,7 +12,8 @@ _spec.loader.exec_module(report)
 
 
 def _row(seed, rate, episodes, lo=0.5, hi=0.9, status="ok"):
-    return {key: 1 for key in _NUMBERS} | {"maze": "m", "seed": seed, "status": status, "error": "", "success_rate": rate, "episodes": episodes,
+    return {key: 1 for key in _NUMBERS} | {"maze": "m", "seed": seed, "status": status, "error": "",
+            "success_rate": rate, "episodes": episodes,
             "success_ci_low": 0.0, "success_ci_high": 1.0, "predicted_success": 0.7, "predicted_ci_low": lo,
             "predicted_ci_high": hi, "evaluations": 10 * (seed + 1), "sim_steps": 1_000_000, "wall_seconds": 60.0}
 

@@ -84,7 +84,8 @@ def _longest_leg_cells(maze, q, cand) -> float:
 
 
 def test_geometric_waypoint_cap():
-    """U-chain 5 with the Ant needs 37 one-cell legs: the default cap of 32 doubles the legs, a higher cap keeps them."""
+    """U-chain 5 with the Ant needs 37 one-cell legs: the default cap of 32 doubles the legs, a higher cap
+    keeps them."""
     maze = load_maze("u_chain_5").for_agent("ant")
     q = edge_queries(maze, "ant")[0]
     capped = make_proposer("geometric", seed=0).propose_split(q, 1)[0]
