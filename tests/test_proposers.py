@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pytest
 
@@ -83,15 +85,20 @@ def _longest_leg_cells(maze, q, cand) -> float:
     return max(float(np.linalg.norm(np.subtract(a, b))) for a, b in zip(pts, pts[1:])) / maze.cell_size
 
 
-def test_geometric_waypoint_cap():
+def test_geometric_waypoint_cap(caplog):
     """U-chain 5 with the Ant needs 37 one-cell legs: the default cap of 32 doubles the legs, a higher cap
     keeps them."""
     maze = load_maze("u_chain_5").for_agent("ant")
     q = edge_queries(maze, "ant")[0]
-    capped = make_proposer("geometric", seed=0).propose_split(q, 1)[0]
+    with caplog.at_level(logging.WARNING, logger="specrefine.proposers.geometric"):
+        capped = make_proposer("geometric", seed=0).propose_split(q, 1)[0]
+    assert "geometric:max_waypoints=N" in caplog.text  # the user is told why the legs grew and what to pass
+    caplog.clear()
     p = make_proposer("geometric:max_waypoints=48", seed=0)
     assert p.describe()["proposer"] == "geometric:max_waypoints=48" and not p.is_vlm
-    free = p.propose_split(q, 1)[0]
+    with caplog.at_level(logging.WARNING, logger="specrefine.proposers.geometric"):
+        free = p.propose_split(q, 1)[0]
+    assert "max_waypoints" not in caplog.text
     assert len(capped) <= 32 < len(free) <= 48
     assert _longest_leg_cells(maze, q, capped) > 1.5 and _longest_leg_cells(maze, q, free) < 1.5
 

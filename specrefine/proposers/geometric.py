@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import heapq
 import json
+import logging
 import math
 from collections.abc import Sequence
 
@@ -22,6 +23,7 @@ from ..regions import CompiledRegion, Disc, Region
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, Proposer, _jsonable, graph_score
 from .schema import region_json
 
+log = logging.getLogger(__name__)
 
 def reach_cells(maze, agent: str) -> int:
     """How many cells one subtask should span at most: the policy's reach, at least one cell."""
@@ -278,6 +280,10 @@ class GeometricProposer(_GridProposer):
             if j:  # a noisy route is drawn afresh each time, as it always was (seeded runs stay reproducible)
                 route = self._route(maze, a, b, j, rng, margin)
             pts = self._turns(route, max_leg)
+        if j == 0 and max_leg > reach:
+            log.warning("geometric: this route needs more than %d waypoints at the agent's reach of %d cell(s), so "
+                        "its legs span up to %d cells, past that reach (more waypoints: geometric:max_waypoints=N)",
+                        self.max_waypoints, reach, max_leg)
         pts = [p for p in pts if not (bool(start.contains(p)) or bool(goal.contains(p)))]
         if j and len(pts) > 1:  # drop redundant waypoints (neighbours still see each other) now and then
             kept = []
