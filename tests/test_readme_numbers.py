@@ -1,0 +1,85 @@
+"""README's result tables are their files' numbers: each row recomputed from the shipped table it names.
+
+A hand-typed or stale figure (a rounding of a rounding, a count from before a table grew) fails here naming the
+row. Only tables whose files are complete are checked; the growing Ant comparison is reported, not pinned.
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import re
+from pathlib import Path
+
+from specrefine.sweep import read_table, summarise
+
+ROOT = Path(__file__).parents[1]
+README = (ROOT / "README.md").read_text()
+
+_spec = importlib.util.spec_from_file_location("per_maze_report", ROOT / "scripts" / "per_maze_report.py")
+per_maze_report = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(per_maze_report)
+
+
+def _table_after(header_start: str) -> list[list[str]]:
+    """The cells of each body row of the README table whose header line starts with ``header_start``."""
+    lines = README[README.index(header_start):].splitlines()
+    body = []
+    for line in lines[2:]:
+        if not line.startswith("|"):
+            break
+        body.append([c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]])
+    assert body, f"no rows under {header_start!r}"
+    return body
+
+
+def test_point_table_is_results_csv():
+    rows = read_table(ROOT / "data/results/results.csv")
+    seed0 = {(r["maze"], r["method"], r["proposer"]): r for r in rows if r["seed"] == 0}
+    summary = {(s["maze"], s["method"], s["proposer"]): s for s in summarise(rows)}  # summary.md's numbers
+    columns = [("ours", "geometric"), ("vlm-oneshot", "geometric"), ("dirl", "none"), ("symbolic", "none"),
+               ("ours", "random")]
+    table = _table_after("| maze | ours, seed 0 [95 % CI] |")
+    assert len(table) == 17
+    for cells in table:
+        maze = cells[0].split()[0]
+        r = seed0[maze, "ours", "geometric"]
+        want = [f"{r['success_rate']:.3f} [{r['success_ci_low']:.3f}, {r['success_ci_high']:.3f}]"]
+        for m, p in columns:
+            s = summary[maze, m, p]
+            assert s["seeds"] == [0, 1, 2, 3], (maze, m, p)
+            want.append(f"{s['success_mean']:.3f} ± {s['success_std']:.3f}")
+        assert cells[1:] == want, maze
+
+
+def test_ant_uchain_table_is_per_maze_report():
+    rows = [r for r in read_table(ROOT / "data/results/ant/comparison.csv")
+            if r["method"] == "ours" and r["proposer"] == "geometric"]
+    table = _table_after("| maze | success, pooled [95 % CI] (seeds 0, 1, 2) |")
+    assert [c[0] for c in table] == [f"u_chain_{n}" for n in range(1, 6)] + [
+        f"u_chain_{n}_subgoals" for n in range(2, 6)]
+    for cells in table:
+        runs = sorted((r for r in rows if r["maze"] == cells[0]), key=lambda r: r["seed"])
+        assert [r["seed"] for r in runs] == [0, 1, 2], cells[0]
+        report = [c.strip() for c in per_maze_report.pooled_line(cells[0], runs).split("|")[1:-1]]
+        del report[1]  # "3 of 3": runs done
+        report[2] = report[2].replace(" inside)", ")")
+        assert cells == report, cells[0]
+
+
+def test_offline_claims_table_is_claims_json():
+    claims = json.loads((ROOT / "data/results/imperfect/claims.json").read_text())["claims"]
+    by = {(c["proposer"], c["method"]): c for c in claims}
+    fmt = lambda c: f"{c['estimate']:.2f} [{c['ci_low']:.2f}, {c['ci_high']:.2f}]"  # noqa: E731
+    table = _table_after("| preset | ours / one-shot, multi-room |")
+    presets = {"mild": "imperfect:mild", "moderate": "imperfect:moderate", "severe": "imperfect:severe",
+               "moderate, alpha = 0.1": "imperfect:moderate,alpha=0.1"}
+    assert [c[0] for c in table] == list(presets)
+    for cells in table:
+        p = presets[cells[0]]
+        ratio, ours, oneshot = by[p, "ours / vlm-oneshot"], by[p, "ours"], by[p, "vlm-oneshot"]
+        if all(isinstance(x, float) and math.isfinite(x) for x in (ratio["ci_low"], ratio["ci_high"])):
+            assert cells[1] == fmt(ratio) and cells[2] == ratio["verdict"], p
+        assert cells[3] == fmt(ours) and cells[4] == ours["verdict"], p
+        assert cells[5] == f"{fmt(oneshot)}, {oneshot['verdict']}", p
+
