@@ -83,3 +83,12 @@ def test_offline_claims_table_is_claims_json():
         assert cells[3] == fmt(ours) and cells[4] == ours["verdict"], p
         assert cells[5] == f"{fmt(oneshot)}, {oneshot['verdict']}", p
 
+
+
+def test_adaptive_table_is_the_bench_markdown():
+    from specrefine.bench.refinement import _read, markdown
+
+    table = markdown(_read(ROOT / "data/results/ant/adaptive_bench.csv")).splitlines()
+    assert len(table) == 2 + 9  # header, rule, 3 mazes x 3 seeds
+    missing = [line for line in table if line not in README.splitlines()]
+    assert not missing, missing
