@@ -55,6 +55,7 @@ class Agent:
     reset_noise: float = 0.0  # Gymnasium's uniform qpos / normal qvel reset noise (never on x, y)
     wall_half_height: float = 0.5  # m
     bench_room_cells: int = 31  # open-room side for the throughput benchmark: rollouts never reach a wall
+    default_evaluation: str = "fixed"  # subtask evaluation when none is asked for: "fixed" (the paper) or "adaptive"
 
 
 AGENTS: dict[str, Agent] = {
@@ -76,7 +77,10 @@ AGENTS: dict[str, Agent] = {
         timestep=0.01, frame_skip=5, body_radius=0.5, default_horizon=300, obs_dim=29, act_dim=8, policy_reach=6.0,
         reach_task=ReachTask(1.0, 8.0, 0.5, 400, 1.0, 5.0, 5.0, 0.0),
         train=dict(frames=10_000_000, num_envs=64, steps_per_env=64, epochs=5, minibatch=2048),
-        reset_noise=0.1, bench_room_cells=31),
+        reset_noise=0.1, bench_room_cells=31,
+        # adaptive passed its rule on held-out Ant runs (3.9x fewer simulator steps, equal success; README); the
+        # point mass keeps the paper's protocol, on which all its tables rest and where the rule was never run
+        default_evaluation="adaptive"),
 }
 
 

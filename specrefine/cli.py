@@ -80,10 +80,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="VLM query rounds per edge split (paper: 2; at most 10)")
     r.add_argument("-k", type=bounded_int("k"), default=5,
                    help="subsets sampled per vertex refinement (paper: 5; at most 100)")
-    r.add_argument("--evaluation", choices=["fixed", "adaptive"], default="fixed",
+    r.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
                    help="fixed: every subtask estimate on --rollouts rollouts (the paper); adaptive: the vertex "
                         "refinement's candidates in stages, stopping those that cannot be chosen (same full "
-                        "budget for what is chosen; far fewer simulator steps)")
+                        "budget for what is chosen; far fewer simulator steps) (default: fixed for point, "
+                        "adaptive for ant)")
     return parser
 
 

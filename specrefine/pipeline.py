@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents import get_agent
 from .calibrate import predict
 from .errors import SpecrefineError
 from .graph import check_refines
@@ -61,12 +62,13 @@ class RunResult:
 
 def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
                 rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
-                spec: str | None = None, evaluation: str = "fixed") -> RunResult:
+                spec: str | None = None, evaluation: str | None = None) -> RunResult:
     """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
     ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain).
 
     ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts, the paper's protocol) or
-    "adaptive" (the chain DP by branch and bound with staged rollouts: :mod:`specrefine.refine.racing`).
+    "adaptive" (the chain DP by branch and bound with staged rollouts: :mod:`specrefine.refine.racing`);
+    None: the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
 
     ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
@@ -79,6 +81,7 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
     t0 = time.time()
     maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
     maze_task(maze.for_agent(agent), spec)  # a bad agent or spec fails before the folder is touched
+    evaluation = evaluation or get_agent(agent).default_evaluation
     args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": agent,
             "method": method, "proposer": proposer if method in PROPOSER_METHODS else None, "seed": seed,
             "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,

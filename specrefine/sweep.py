@@ -112,14 +112,18 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = 32, episodes: int = 200,
-         specs: Iterable[str | None] = (None,), evaluation: str = "fixed", policy: str = "shipped") -> list[Cell]:
+         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped") -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
+
+    ``evaluation``: None = the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
     ``MAZE=SPEC`` runs that spec only.
     """
+    from .agents import get_agent
     from .pipeline import PROPOSER_METHODS
 
+    evaluation = evaluation or get_agent(agent).default_evaluation
     cells = []
     for arg in mazes:
         maze, own = split_maze_arg(str(arg))
@@ -438,9 +442,9 @@ def main(argv=None) -> int:
     p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
     p.add_argument("--episodes", type=bounded_int("episodes"), default=200)
-    p.add_argument("--evaluation", choices=["fixed", "adaptive"], default="fixed",
+    p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
                    help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
-                        "when adaptive)")
+                        "when adaptive) (default: fixed for point, adaptive for ant)")
     p.add_argument("--policy", default="shipped",
                    help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
                         "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")

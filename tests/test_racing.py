@@ -145,6 +145,24 @@ def test_cli_adaptive_run_records_its_evaluation(tmp_path, capsys):
     assert rc == 2 and "evaluation" in capsys.readouterr().err  # another run's folder is refused
 
 
+def test_default_evaluation_is_the_agents():
+    """Unasked, the Ant evaluates adaptively (its held-out benchmark) and the point mass as the paper does."""
+    from specrefine.sweep import grid
+
+    ant, point = (grid(["u_maze"], ["ours"], ["geometric"], [0], agent=a)[0] for a in ("ant", "point"))
+    assert (ant.evaluation, point.evaluation) == ("adaptive", "fixed")
+    assert ant.id.endswith("__adaptive") and not point.id.endswith("fixed")
+    assert grid(["u_maze"], ["ours"], ["geometric"], [0], agent="ant", evaluation="fixed")[0].evaluation == "fixed"
+
+
+def test_ant_run_without_evaluation_records_adaptive(tmp_path):
+    from specrefine.pipeline import refine_maze
+
+    run = refine_maze("u_chain_1", agent="ant", method="dirl", rollouts=4, episodes=4, out=tmp_path / "ant")
+    assert run.data["evaluation"] == "adaptive"
+    assert json.loads((tmp_path / "ant" / "run.json").read_text())["evaluation"] == "adaptive"
+
+
 @pytest.mark.parametrize("method", ["dirl", "vlm-oneshot"])
 def test_methods_without_the_vertex_dp_do_not_depend_on_the_evaluation(method, tmp_path):
     from specrefine.pipeline import refine_maze
