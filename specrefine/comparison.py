@@ -349,6 +349,28 @@ def table_note(path, rows, grid: Grid = POINT_GRID) -> str:
     return f"{path}: all {done} runs of the fixed grid have an ok row"
 
 
+def seed_table(rows, grid: Grid, seed: int) -> tuple[str, int, int]:
+    """One seed of the grid as markdown (a line per maze; success [95 % Wilson CI] per method and proposer, "—"
+    where the cell has no ok row), with the number of cells it shows and the grid's number at that seed."""
+    from .mazes import benchmark_mazes
+    from .pipeline import PROPOSER_METHODS
+
+    done = {(r["maze"], r["method"], r["proposer"]): r for r in rows
+            if r.get("agent", grid.agent) == grid.agent and r.get("seed") == seed and not r.get("spec") and is_done(r)}
+    columns = [(m, "none") for m in grid.methods if m not in PROPOSER_METHODS]
+    columns += [(m, p) for p in grid.proposers for m in grid.methods if m in PROPOSER_METHODS]
+    lines = ["| maze | " + " | ".join(m if p == "none" else f"{m}, {p}" for m, p in columns) + " |",
+             "|---" * (len(columns) + 1) + "|"]
+    shown = 0
+    for maze in benchmark_mazes():
+        cells = [done.get((maze, m, p)) for m, p in columns]
+        shown += sum(r is not None for r in cells)
+        lines.append(f"| {maze} | " + " | ".join(
+            "—" if r is None else f"{r['success_rate']:.3f} [{r['success_ci_low']:.3f}, {r['success_ci_high']:.3f}]"
+            for r in cells) + " |")
+    return "\n".join(lines), shown, len(benchmark_mazes()) * len(columns)
+
+
 def _jsonable(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
@@ -375,7 +397,8 @@ def main(argv=None) -> int:
     p = OneLineParser(prog="python -m specrefine.comparison", description=__doc__.split("\n")[0])
     p.add_argument("table", help="results.csv of the comparison sweep (specrefine.sweep)")
     p.add_argument("--out", required=True,
-                   help="folder for figure4.png, figure5.png, error_levels.png, claims.md and claims.json")
+                   help="folder for figure4.png, figure5.png, error_levels.png, claims.md, claims.json and "
+                        "seedS.md (one table per seed)")
     p.add_argument("--grid", choices=sorted(GRIDS), default="point",
                    help="point: docs/proposers.md's comparison (default); ant: docs/ant_experiments.md section 3")
     args = p.parse_args(argv)
@@ -391,6 +414,10 @@ def main(argv=None) -> int:
         plt.close(fig)
     entries = claims(rows, grid)
     write_claims(entries, out, args.table, grid)
+    for seed in grid.seeds:
+        table, shown, expected = seed_table(rows, grid, seed)
+        (out / f"seed{seed}.md").write_text(f"Seed {seed}: {shown} of {expected} cells ({OFFLINE_NOTE}; success "
+                                            f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n")
     partial = sum(not e["complete"] for e in entries)
     print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")
     return 0

@@ -248,5 +248,24 @@ def test_ant_cli_draws_figures_4_and_5_without_error_levels(tmp_path):
     write_csv(table, rows)
     out = tmp_path / "out"
     assert cmp.main([str(table), "--out", str(out), "--grid", "ant"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["claims.json", "claims.md", "figure4.png", "figure5.png"]
+    assert sorted(p.name for p in out.iterdir()) == ["claims.json", "claims.md", "figure4.png", "figure5.png",
+                                                     "seed0.md", "seed1.md", "seed2.md"]
     assert json.loads((out / "claims.json").read_text())["about"]["agent"] == "ant"
+    assert (out / "seed2.md").read_text().startswith(f"Seed 2: 0 of {cmp.expected_cells(cmp.ANT_GRID) // 3} cells")
+
+
+def test_seed_table_one_line_per_maze_methods_without_a_proposer_once():
+    from specrefine.mazes import benchmark_mazes
+
+    rows = [ant_row("u_maze", "dirl", 0.0, 1, "none"), ant_row("u_maze", "ours", 0.9, 1, "imperfect:moderate"),
+            ant_row("u_maze", "ours", 0.8, 0, "geometric"),  # another seed
+            ant_row("x_maze", "ours", 0.7, 1, "geometric") | {"status": "error"},  # failed: no result
+            row("x_maze", "ours", 0.6, 1, "geometric")]  # the point mass: another agent
+    rows[1] |= {"success_ci_low": 0.85, "success_ci_high": 0.94}
+    table, shown, expected = cmp.seed_table(rows, cmp.ANT_GRID, 1)
+    lines = table.splitlines()
+    assert lines[0] == ("| maze | dirl | symbolic | vlm-oneshot, geometric | ours, geometric | "
+                        "vlm-oneshot, imperfect:moderate | ours, imperfect:moderate |")
+    assert len(lines) == 2 + len(benchmark_mazes()) and (shown, expected) == (2, 6 * len(benchmark_mazes()))
+    assert "| u_maze | 0.000 [0.000, 1.000] | — | — | — | — | 0.900 [0.850, 0.940] |" in lines
+    assert "| x_maze | — | — | — | — | — | — |" in lines
