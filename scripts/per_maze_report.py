@@ -2,6 +2,7 @@
 
     python scripts/per_maze_report.py data/results/ant/comparison.csv --method ours --proposer geometric
     python scripts/per_maze_report.py data/results/ant/comparison.csv --method ours --proposer geometric --pooled
+    python scripts/per_maze_report.py data/results/ant/comparison.csv --pooled    # every method and proposer
 
 The closing notes' per-maze lists (issue 15) are this script's output; runs without an ``ok`` row are listed as
 such, so a partial table says what it lacks.
@@ -43,15 +44,23 @@ def pooled_line(maze: str, runs: list[dict]) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("table")
-    ap.add_argument("--method", required=True)
+    ap.add_argument("--method", default=None, help="default: every method, one section per method and proposer")
     ap.add_argument("--proposer", default=None, help="default: any (dirl and symbolic have 'none')")
     ap.add_argument("--pooled", action="store_true", help="one line per maze, seeds pooled (means of the costs)")
     args = ap.parse_args()
-    rows = [r for r in read_table(args.table) if r.get("method") == args.method
-            and (args.proposer is None or r.get("proposer") == args.proposer)]
-    rows.sort(key=lambda r: (r["maze"], r["seed"]))
-    print(f"{args.method} / {args.proposer or 'any proposer'}: {len(rows)} runs ({args.table})\n")
-    if args.pooled:
+    table = read_table(args.table)
+    sections = [(args.method, args.proposer)] if args.method else sorted(
+        {(r["method"], r["proposer"]) for r in table if args.proposer in (None, r["proposer"])})
+    for i, (method, proposer) in enumerate(sections):
+        print("\n" * (i > 0), end="")
+        report(args.table, [r for r in table if r.get("method") == method
+                            and (proposer is None or r.get("proposer") == proposer)], method, proposer, args.pooled)
+
+
+def report(path, rows: list[dict], method: str, proposer: str | None, pooled: bool) -> None:
+    rows = sorted(rows, key=lambda r: (r["maze"], r["seed"]))
+    print(f"{method} / {proposer or 'any proposer'}: {len(rows)} runs ({path})\n")
+    if pooled:
         print("| maze | runs done | success, pooled [95 % CI] (per seed) | predicted, mean (runs inside their CI) | "
               "evaluations | sim steps | wall s |")
         print("|---|---|---|---|---|---|---|")

@@ -25,3 +25,21 @@ def test_pooled_line_pools_episodes_and_counts_inside():
     assert f"2 of 3 | 210/300 = 0.700 [{lo:.3f}, {hi:.3f}] (0.800, 0.500)" in line
     assert "(1 of 2 inside)" in line and "| 15 | 1.00M | 60 |" in line
     assert report.pooled_line("m", [rows[2]]).startswith("| m | 0 of 1 |")
+
+
+def test_without_method_one_section_per_method_and_proposer(tmp_path, monkeypatch, capsys):
+    import csv
+
+    rows = [_row(0, 0.8, 200) | {"method": "ours", "proposer": "geometric"},
+            _row(0, 0.0, 200) | {"method": "dirl", "proposer": "none"},
+            _row(1, 0.9, 200) | {"method": "ours", "proposer": "geometric"}]
+    table = tmp_path / "t.csv"
+    with open(table, "w", newline="") as fh:
+        w = csv.DictWriter(fh, list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    monkeypatch.setattr("sys.argv", ["per_maze_report.py", str(table), "--pooled"])
+    report.main()
+    out = capsys.readouterr().out
+    assert out.index("dirl / none: 1 runs") < out.index("ours / geometric: 2 runs")
+    assert "| m | 2 of 2 | 340/400 = 0.850" in out and "| m | 1 of 1 | 0/200 = 0.000" in out
