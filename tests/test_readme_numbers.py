@@ -92,3 +92,16 @@ def test_adaptive_table_is_the_bench_markdown():
     assert len(table) == 2 + 9  # header, rule, 3 mazes x 3 seeds
     missing = [line for line in table if line not in README.splitlines()]
     assert not missing, missing
+
+
+def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
+    """Each seed of the growing Ant comparison that README shows is complete in the table and shown as it is."""
+    from specrefine.comparison import ANT_GRID, seed_table
+
+    rows = read_table(ROOT / "data/results/ant/comparison.csv")
+    seeds = re.findall(r"<!-- ant comparison seed (\d+) -->", README)
+    assert seeds, "README shows no seed of the Ant comparison"
+    for seed in seeds:
+        table, shown, expected = seed_table(rows, ANT_GRID, int(seed))
+        assert shown == expected, f"seed {seed}: {shown} of {expected} cells in the table"
+        assert f"<!-- ant comparison seed {seed} -->\n{table}\n" in README, f"seed {seed}"
