@@ -80,13 +80,17 @@ ROOMS_CLAIM_TEXT = "success over 1-5 rooms"  # the paper: flat for ours, falling
 OFFLINE_NOTE = "every proposer here is offline, NOT a VLM (geometric: a planner on the map; imperfect:*: error model)"
 
 
+def _task_rows(rows, agent: str) -> list[dict]:
+    """The rows of ``agent`` on each maze's own task (not another task or agent, nor a row cut short before its
+    seed)."""
+    return [r for r in rows if not r.get("spec") and r.get("agent", agent) == agent and isinstance(r.get("seed"), int)]
+
+
 def table_cells(rows, agent: str = "point") -> tuple[dict, set]:
     """(maze, method, proposer, seed) -> success of the last ``ok`` row of the maze's own task; and the cells
     whose rows all failed (a failed run has no success to report)."""
     ok, tried = {}, set()
-    for r in rows:
-        if r.get("spec") or r.get("agent", agent) != agent or not isinstance(r.get("seed"), int):
-            continue  # another task or agent, or a row cut short before its seed
+    for r in _task_rows(rows, agent):
         key = (r["maze"], r["method"], r["proposer"], r["seed"])
         tried.add(key)
         if is_done(r):
@@ -355,20 +359,20 @@ def seed_table(rows, grid: Grid, seed: int) -> tuple[str, int, int]:
     from .mazes import benchmark_mazes
     from .pipeline import PROPOSER_METHODS
 
-    done = {(r["maze"], r["method"], r["proposer"]): r for r in rows
-            if r.get("agent", grid.agent) == grid.agent and r.get("seed") == seed and not r.get("spec") and is_done(r)}
+    done = {(r["maze"], r["method"], r["proposer"]): r for r in _task_rows(rows, grid.agent)
+            if r["seed"] == seed and is_done(r)}
     columns = [(m, "none") for m in grid.methods if m not in PROPOSER_METHODS]
     columns += [(m, p) for p in grid.proposers for m in grid.methods if m in PROPOSER_METHODS]
     lines = ["| maze | " + " | ".join(m if p == "none" else f"{m}, {p}" for m, p in columns) + " |",
              "|---" * (len(columns) + 1) + "|"]
-    shown = 0
-    for maze in benchmark_mazes():
+    shown, mazes = 0, benchmark_mazes()
+    for maze in mazes:
         cells = [done.get((maze, m, p)) for m, p in columns]
         shown += sum(r is not None for r in cells)
         lines.append(f"| {maze} | " + " | ".join(
             "—" if r is None else f"{r['success_rate']:.3f} [{r['success_ci_low']:.3f}, {r['success_ci_high']:.3f}]"
             for r in cells) + " |")
-    return "\n".join(lines), shown, len(benchmark_mazes()) * len(columns)
+    return "\n".join(lines), shown, len(mazes) * len(columns)
 
 
 def _jsonable(value):

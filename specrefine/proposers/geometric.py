@@ -25,6 +25,7 @@ from .schema import region_json
 
 log = logging.getLogger(__name__)
 
+
 def reach_cells(maze, agent: str) -> int:
     """How many cells one subtask should span at most: the policy's reach, at least one cell."""
     return max(1, int(get_agent(agent).policy_reach // maze.cell_size))
