@@ -9,6 +9,7 @@ such, so a partial table says what it lacks.
 """
 import argparse
 
+from specrefine.argtypes import exit_code_quiet_on_broken_pipe
 from specrefine.results import wilson_ci
 from specrefine.sweep import is_done, read_table
 
@@ -74,4 +75,4 @@ def report(path, rows: list[dict], method: str, proposer: str | None, pooled: bo
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

@@ -1,5 +1,6 @@
 """argparse ``type=`` functions for the command lines' numbers: a nonsense or absurd value is a one-line usage
-error (exit 2) before anything runs, never a hang, a traceback or a silently meaningless result.
+error (exit 2) before anything runs, never a hang, a traceback or a silently meaningless result. Also the
+command lines' quiet exit when their reader goes away (``... | head``).
 
 The caps are far above what the paper uses (w = 3, d = 2, k = 5, 32 rollouts, 200 episodes): they only stop
 values that would run for days (``-w 1000000``) or overflow a seed.
@@ -8,6 +9,8 @@ values that would run for days (``-w 1000000``) or overflow a seed.
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -15,6 +18,21 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def exit_code_quiet_on_broken_pipe(main, *args) -> int:
+    """``main(*args)``'s exit code; when stdout's reader has gone (``... | head``), the rest of the output is dropped
+    without a traceback (exit 1, as in Python's docs on SIGPIPE). Files a command writes before it prints are kept."""
+    try:
+        return main(*args) or 0
+    except BrokenPipeError:
+        silence_stdout()
+        return 1
+
+
+def silence_stdout() -> None:
+    """Point stdout at /dev/null, so that the interpreter's last flush after a broken pipe does not raise."""
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 MAX_SEED = 2**31 - 1

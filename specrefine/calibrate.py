@@ -223,4 +223,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from .argtypes import exit_code_quiet_on_broken_pipe
+
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

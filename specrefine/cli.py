@@ -9,12 +9,11 @@ Bad input exits 2 with one line on stderr; never a traceback.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int
+from .argtypes import OneLineParser, bounded_int, silence_stdout
 from .errors import SpecrefineError
 from .pipeline import METHODS
 
@@ -106,7 +105,7 @@ def main(argv=None) -> int:
     try:
         print(result.summary(), flush=True)
     except BrokenPipeError:  # `specrefine refine ... | head`: the run is done and written; no traceback at exit
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        silence_stdout()
     return 0
 
 

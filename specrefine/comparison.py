@@ -412,7 +412,6 @@ def main(argv=None) -> int:
     rows = read_table(args.table)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    print(table_note(args.table, rows, grid))
     for name, fig in comparison_figures(rows, grid).items():
         fig.savefig(out / f"{name}.png", dpi=110)
         plt.close(fig)
@@ -423,9 +422,12 @@ def main(argv=None) -> int:
         (out / f"seed{seed}.md").write_text(f"Seed {seed}: {shown} of {expected} cells ({OFFLINE_NOTE}; success "
                                             f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n")
     partial = sum(not e["complete"] for e in entries)
+    print(table_note(args.table, rows, grid))  # after the files: a closed stdout (`| head`) loses none of them
     print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")
     return 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from .argtypes import exit_code_quiet_on_broken_pipe
+
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

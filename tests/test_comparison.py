@@ -269,3 +269,20 @@ def test_seed_table_one_line_per_maze_methods_without_a_proposer_once():
     assert len(lines) == 2 + len(benchmark_mazes()) and (shown, expected) == (2, 6 * len(benchmark_mazes()))
     assert "| u_maze | 0.000 [0.000, 1.000] | — | — | — | — | 0.900 [0.850, 0.940] |" in lines
     assert "| x_maze | — | — | — | — | — | — |" in lines
+
+
+def test_cli_keeps_its_files_when_stdout_is_closed(tmp_path):
+    """`python -m specrefine.comparison ... | head`: the reader gone, the figures and claims are still written."""
+    import os
+    import subprocess
+    import sys
+
+    table, out = tmp_path / "results.csv", tmp_path / "out"
+    write_csv(table, ratio_rows(lambda i, seed: 0.3, 2.5))
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # every write to stdout now fails with a broken pipe
+    proc = subprocess.run([sys.executable, "-m", "specrefine.comparison", str(table), "--out", str(out)],
+                          stdout=write_end, stderr=subprocess.PIPE, text=True)
+    os.close(write_end)
+    assert (proc.returncode, proc.stderr) == (1, "")
+    assert all((out / name).stat().st_size > 0 for name in ("figure4.png", "claims.md", "claims.json"))

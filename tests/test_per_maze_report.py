@@ -43,3 +43,23 @@ def test_without_method_one_section_per_method_and_proposer(tmp_path, monkeypatc
     out = capsys.readouterr().out
     assert out.index("dirl / none: 1 runs") < out.index("ours / geometric: 2 runs")
     assert "| m | 2 of 2 | 340/400 = 0.850" in out and "| m | 1 of 1 | 0/200 = 0.000" in out
+
+
+def test_a_closed_stdout_ends_quietly(tmp_path):
+    """`per_maze_report.py TABLE | head`: exit 1 without a traceback once the reader has gone."""
+    import csv
+    import os
+    import subprocess
+    import sys
+
+    table = tmp_path / "t.csv"
+    with open(table, "w", newline="") as fh:
+        w = csv.DictWriter(fh, list(_row(0, 0.8, 200)) + ["method", "proposer"])
+        w.writeheader()
+        w.writerow(_row(0, 0.8, 200) | {"method": "ours", "proposer": "geometric"})
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    proc = subprocess.run([sys.executable, str(Path(__file__).parents[1] / "scripts" / "per_maze_report.py"),
+                           str(table)], stdout=write_end, stderr=subprocess.PIPE, text=True)
+    os.close(write_end)
+    assert (proc.returncode, proc.stderr) == (1, "")
