@@ -4,7 +4,9 @@ Each cell is one ``refine_maze`` run (the CLI's code path) in its own output dir
 ``OUT/cells/<cell id>/``; its row is appended to ``OUT/results.csv`` as soon as it
 finishes.  Rerunning a sweep skips cells that already have a row with status ``ok``
 (resume after a kill), retries failed ones, and keeps each cell's evaluation cache, so
-an interrupted cell restarts from what it had evaluated.
+an interrupted cell restarts from what it had evaluated.  A cell's warnings and log records (a proposer's
+rejected candidates, a region with little room) go to its own ``OUT/cells/<cell id>/log.txt``, not to the
+sweep's stderr, where two workers' lines would interleave around the progress bar.
 
 A cell's ``spec`` (``--specs``, or ``MAZE=SPEC`` in ``--mazes``) is the task as a spec expression
 (``specrefine refine --spec``); empty = the maze's own task.  It is part of the cell id only when
@@ -32,12 +34,14 @@ import contextlib
 import csv
 import hashlib
 import json
+import logging
 import os
 import signal
 import sys
 import threading
 import time
 import traceback
+import warnings
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
@@ -142,17 +146,45 @@ def run_cell(cell: Cell, out_root: str) -> dict:
     from .pipeline import refine_maze
 
     row = {**asdict(cell), "cell": cell.id}
+    out = Path(out_root) / "cells" / cell.id
+    proposer = "geometric" if cell.proposer == "none" else cell.proposer
+    policy = None if cell.policy == "shipped" else cell.policy
     try:
-        result = refine_maze(cell.maze, agent=cell.agent, method=cell.method,
-                             proposer="geometric" if cell.proposer == "none" else cell.proposer, seed=cell.seed,
-                             out=Path(out_root) / "cells" / cell.id, rollouts=cell.rollouts, episodes=cell.episodes,
-                             spec=cell.spec or None, evaluation=cell.evaluation,
-                             policy_path=None if cell.policy == "shipped" else cell.policy)
+        with cell_log(out / "log.txt"):
+            result = refine_maze(cell.maze, agent=cell.agent, method=cell.method, proposer=proposer, seed=cell.seed,
+                                 out=out, rollouts=cell.rollouts, episodes=cell.episodes, spec=cell.spec or None,
+                                 evaluation=cell.evaluation, policy_path=policy)
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
     return result_row(result.data, row) | {"proposer_is_vlm": result.data["proposer_is_vlm"]
                                            if cell.proposer != "none" else False}
+
+
+@contextlib.contextmanager
+def cell_log(path: Path):
+    """The package's log records and Python warnings raised inside the block are appended to ``path`` (a rerun
+    adds to it), not printed."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    logger = logging.getLogger("specrefine")
+    handler = logging.FileHandler(path, encoding="utf-8")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+
+    def to_file(message, category, filename, lineno, file=None, line=None):
+        handler.stream.write(warnings.formatwarning(message, category, filename, lineno, line))
+        handler.flush()
+
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = to_file
+            yield
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+        handler.close()
 
 
 def result_row(data: dict, row: dict | None = None) -> dict:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.sweep import COLUMNS, grid, read_table, run_sweep, summarise
+from specrefine.sweep import COLUMNS, cell_log, grid, read_table, run_sweep, summarise
 
 TINY = dict(agent="point", rollouts=8, episodes=16)
 
@@ -41,6 +41,23 @@ def test_table_schema_is_stable(tmp_path):
     assert 0.0 <= row["success_ci_low"] <= row["success_rate"] <= row["success_ci_high"] <= 1.0
     assert row["episodes"] == 16 and row["proposer"] == "none" and row["proposer_is_vlm"] is False
     assert (tmp_path / "cells" / row["cell"] / "result.json").exists()
+    assert (tmp_path / "cells" / row["cell"] / "log.txt").exists()
+
+
+def test_a_cells_warnings_and_log_records_go_to_its_log_file(tmp_path, capfd, caplog):
+    import logging
+    import warnings
+
+    path = tmp_path / "cell" / "log.txt"
+    with cell_log(path):
+        logging.getLogger("specrefine.proposers.vlm").warning("rejected edge split candidate: inside a wall")
+        warnings.warn("region has almost no room", UserWarning, stacklevel=1)
+    text = path.read_text()
+    assert "WARNING specrefine.proposers.vlm: rejected edge split candidate" in text
+    assert "UserWarning: region has almost no room" in text
+    assert capfd.readouterr().err == "" and caplog.text == ""  # neither printed nor passed to the root logger
+    logging.getLogger("specrefine.proposers.vlm").warning("after the cell")  # the block's end restores both
+    assert "after the cell" in caplog.text and "after the cell" not in path.read_text()
 
 
 def test_failed_cell_is_recorded_and_retried(tmp_path, capsys):
