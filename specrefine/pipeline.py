@@ -31,6 +31,8 @@ METHODS = {
     "ours": (True, "Alg. 3: Dijkstra-order search with proposer edge splits and vertex subsets"),
     "ours-novertex": (True, "control: ours without vertex refinement (edge splits only)"),
     "ours-d1": (True, "control: ours with d = 1 (no feedback round in an edge split)"),
+    "ours-repair": (True, "beyond the paper: ours, and when no split candidate succeeds end to end, its failing "
+                          "legs are split once more before it is judged (refine/repair.py)"),
     "vlm-oneshot": (True, "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w"),
     "vlm-oneshot-matched": (True, "control: one-shot best-of-N, spending what ours spent (proposer calls, "
                                   "subtask evaluations) on the same task and seed"),
@@ -131,7 +133,8 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
     if method.startswith("ours"):
         cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
-                           vertex_refinement=method != "ours-novertex", evaluation=evaluation)
+                           vertex_refinement=method != "ours-novertex", evaluation=evaluation,
+                           repair=method == "ours-repair")
         images = getattr(proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(maze, agent, evaluator.facts(), images=images)
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,

@@ -20,9 +20,8 @@ def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2"):
 
 
 def test_every_method_is_listed_once_with_what_it_is():
-    assert set(METHODS) == {"ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched", "symbolic",
-                            "dirl"}
-    assert set(PROPOSER_METHODS) == {"ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"}
+    asking = {"ours", "ours-novertex", "ours-d1", "ours-repair", "vlm-oneshot", "vlm-oneshot-matched"}
+    assert set(METHODS) == asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) == asking
 
 
 def test_controls_of_ours(tmp_path):
@@ -35,6 +34,15 @@ def test_controls_of_ours(tmp_path):
     assert {c["round"] for s in full_steps if s["event"] == "split-generated" for c in s["candidates"]} >= {0, 1}
     for data in (full, novertex, d1):
         assert data["proposer_calls"] >= 1 and data["vlm_calls"] == 0 and data["proposer_is_vlm"] is False
+
+
+def test_repair_keeps_a_split_that_ours_never_keeps(tmp_path):
+    """u_chain_2 with moderate errors: ours keeps no split (success 0); ours-repair splits the failing legs."""
+    plain, _ = run(tmp_path, "ours", "imperfect:moderate")
+    repaired, steps = run(tmp_path, "ours-repair", "imperfect:moderate")
+    assert plain["refinements"] == 0 and plain["success_rate"] == 0.0
+    assert any(s["event"] == "split-repaired" and s["legs_repaired"] >= 1 for s in steps)
+    assert repaired["refinements"] >= 1 and repaired["refines_input"] is True and repaired["success_rate"] > 0.0
 
 
 def test_matched_one_shot_spends_what_ours_spent(tmp_path):

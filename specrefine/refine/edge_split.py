@@ -30,6 +30,7 @@ class SplitCandidate:
     results: list  # EdgeResults of the k subtasks
     round: int
     tuned: bool = False  # went through the chain vertex refinement
+    repaired: int = 0  # legs split once more by the look-ahead repair (repair.py; method ours-repair)
 
     @property
     def probabilities(self) -> list[float]:

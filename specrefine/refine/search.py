@@ -32,6 +32,7 @@ from ..graph import TaskGraph, assert_refines
 from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .racing import Racing
+from .repair import cheapest, repair
 from .vertex import refine_chain
 
 EVALUATIONS = ("fixed", "adaptive")
@@ -50,6 +51,7 @@ class SearchConfig:
     max_edge_splits: int = 30  # budget of Algorithm 1 calls (proposer queries) per search
     seed: int = 0
     evaluation: str = "fixed"  # "fixed": every estimate on n rollouts (the paper); "adaptive": racing.py
+    repair: bool = False  # beyond the paper: split a candidate's failing legs before it is judged (repair.py)
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -221,8 +223,24 @@ class RefinementSearch:
         best = outcome.best
         if best is None:
             return None
+        if self.cfg.repair and best.p == 0.0:
+            best = self._repair(u, v, cheapest(outcome.candidates, self.evaluator.n)) or best
         cost = f.cost[u] + sum(weight(p, self.evaluator.n) for p in best.probabilities)
         return Refinement("split", u, v, cost, best)
+
+    def _repair(self, u, v, candidate):
+        def split_leg(chain_graph, a, b, result, start):
+            self.splits_generated += 1
+            return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
+                              goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=self.cfg.d, k=self.cfg.k,
+                              rng=self.rng, picture=self.picture, racing=self.racing)
+
+        repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,
+                          split_leg=split_leg, may_split=lambda: self.splits_generated < self.cfg.max_edge_splits)
+        self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities,
+                  p_after=repaired.probabilities if repaired else None, legs_repaired=repaired.repaired if repaired
+                  else 0, waypoints=[x.to_dict() for x in repaired.waypoints] if repaired else None)
+        return repaired
 
     def _gen_vertex(self, u, v, w) -> Refinement | None:
         self.vertex_generated += 1
