@@ -1,0 +1,45 @@
+#!/bin/bash
+# One specrefine.sweep run with the code of one commit (a detached worktree), whatever the checkout holds, so that
+# a session may edit specrefine/ while a long grid runs and its table stays one code's; the sweep's done rows are
+# copied to a shipped table every two minutes, and a new machine resumes from that table (copied into OUT when
+# OUT has none). Every argument is passed to the sweep (--out is added):
+#   CODE=COMMIT OUT=runs/NAME SHIPPED=data/results/NAME.csv bash scripts/pinned_sweep.sh --mazes ... --seeds ...
+# TREE: the worktree (default runs/code_COMMIT); PYTHON: the interpreter (default the checkout's .venv).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+code=${CODE:?CODE=COMMIT: the code the grid runs}
+out=${OUT:?OUT=folder of the sweep}
+shipped=${SHIPPED:?SHIPPED=the table in data/results}
+py=${PYTHON:-$root/.venv/bin/python}
+tree=${TREE:-$root/runs/code_$code}
+[ -d "$tree" ] || git -C "$root" worktree add -q --detach "$tree" "$code"
+if [ "$(git -C "$tree" rev-parse HEAD)" != "$(git -C "$root" rev-parse "$code^{commit}")" ]; then
+    echo "$tree is not at $code: remove it (git worktree remove --force $tree) and start again" >&2
+    exit 2
+fi
+export PYTHONPATH=$tree  # before the checkout's editable install on sys.path
+mkdir -p "$out" "$(dirname "$shipped")"
+[ -s "$out/results.csv" ] || { [ -s "$shipped" ] && cp "$shipped" "$out/results.csv"; } || true
+
+ship() {  # the table's done rows only (a row being appended is never half-copied)
+    "$py" - "$out/results.csv" "$shipped" <<'PY'
+import csv, sys
+from specrefine.sweep import _typed, is_done
+src, dst = sys.argv[1:]
+with open(src, newline="") as fh:
+    reader = csv.DictReader(fh)
+    rows = [r for r in reader if None not in r and None not in r.values() and is_done(_typed(r))]
+with open(dst + ".tmp", "w", newline="") as fh:
+    w = csv.DictWriter(fh, reader.fieldnames)
+    w.writeheader()
+    w.writerows(rows)
+PY
+    mv "$shipped.tmp" "$shipped"
+}
+( while sleep 120; do [ -s "$out/results.csv" ] && ship || true; done ) &
+watcher=$!
+trap 'kill $watcher 2>/dev/null; [ -s "$out/results.csv" ] && ship' EXIT
+
+echo "code $(git -C "$tree" rev-parse --short HEAD) in $tree; table $out/results.csv -> $shipped"
+cd "$tree"
+"$py" -m specrefine.sweep "$@" --out "$out"
