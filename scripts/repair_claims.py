@@ -1,0 +1,162 @@
+"""The look-ahead repair grid's claims (docs/proposers.md, "Look-ahead repair"), decided as fixed there.
+
+    python scripts/repair_claims.py data/results/repair/results.csv --out data/results/repair
+
+Per preset, 95 % percentile bootstrap intervals over (maze, seed) cells (specrefine.comparison's resamples and
+seed): the paired difference ours-repair - ours on the multi-room cells and on every cell (helps / hurts /
+undecided), the paper's two claims with ours-repair in place of ours (specrefine.comparison's rules), and,
+descriptive, the runs at success 0 and the paired cost ratios. Writes claims.md, claims.json and mazes.md (mean
+success per maze and method, Student-t interval over seeds). A preset with a missing cell is marked partial.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from specrefine import comparison as cmp
+from specrefine.argtypes import exit_code_quiet_on_broken_pipe
+from specrefine.mazes import benchmark_mazes
+from specrefine.sweep import read_table
+
+PRESETS = ("imperfect:moderate", "imperfect:severe", "imperfect:mild")  # the order they run in
+METHODS = ("ours", "ours-repair", "vlm-oneshot")
+SEEDS = (0, 1, 2, 3)
+REPAIR_CLAIM = "ours-repair - ours"
+
+
+def paired_claim(cells: dict, failed: set, proposer: str, mazes, scope: str) -> dict:
+    """Mean of the paired success difference ours-repair - ours over (maze, seed) cells; helps if its interval
+    lies above 0, hurts if below."""
+    diffs, missing, seeds = [], [], set()
+    for maze in mazes:
+        for seed in SEEDS:
+            pair = [cells.get((maze, m, proposer, seed)) for m in ("ours-repair", "ours")]
+            if None in pair:
+                lacking = [m for m, v in zip(("ours-repair", "ours"), pair) if v is None]
+                missing.append(cmp._missing_text(maze, seed, lacking, failed, proposer))
+            else:
+                diffs.append(pair[0] - pair[1])
+                seeds.add(seed)
+    entry = {"claim": f"{REPAIR_CLAIM}, {scope}", "kind": "paired", "proposer": proposer, "method": "ours-repair",
+             "paper": "", "n_expected": len(mazes) * len(SEEDS), "n_cells": len(diffs), "seeds": sorted(seeds),
+             "missing": missing, "complete": not missing, "note": ""}
+    if not diffs:
+        return entry | {"estimate": float("nan"), "ci_low": float("nan"), "ci_high": float("nan"),
+                        "verdict": "undecided", "note": "no cell with both methods"}
+    d = np.array(diffs)
+    idx = np.random.default_rng(cmp.BOOTSTRAP_SEED).integers(0, len(d), (cmp.BOOTSTRAP_RESAMPLES, len(d)))
+    lo, hi = cmp._percentile_ci(d[idx].mean(axis=1))
+    verdict = "helps" if lo > 0 else "hurts" if hi < 0 else "undecided"
+    return entry | {"estimate": float(d.mean()), "ci_low": lo, "ci_high": hi, "verdict": verdict}
+
+
+def as_ours(cells: dict) -> dict:
+    """The cells with ours-repair in the place of ours (for specrefine.comparison's claims on 'ours')."""
+    return {(maze, "ours" if m == "ours-repair" else m, p, s): v for (maze, m, p, s), v in cells.items()
+            if m != "ours"}
+
+
+def paper_claims(cells: dict, failed: set, proposer: str) -> list[dict]:
+    """The paper's two claims with ours-repair as 'ours', and the rooms entries of ours and vlm-oneshot beside."""
+    repaired, repaired_failed = as_ours(cells), as_ours(dict.fromkeys(failed))
+    ratio = cmp.ratio_claim(repaired, set(repaired_failed), proposer, SEEDS)
+    ratio |= {"claim": "ours-repair >= 2x one-shot on multi-room tasks", "method": "ours-repair / vlm-oneshot"}
+    rooms = cmp.rooms_claim(repaired, set(repaired_failed), proposer, "ours", SEEDS)
+    rooms |= {"claim": f"ours-repair {cmp.ROOMS_CLAIM_TEXT}", "method": "ours-repair", "paper": "flat"}
+    return [ratio, rooms] + [cmp.rooms_claim(cells, failed, proposer, m, SEEDS) for m in ("ours", "vlm-oneshot")]
+
+
+def costs(rows: list[dict], proposer: str) -> dict:
+    """Descriptive: runs at success 0 per method; ours-repair / ours ratio of mean evaluations and proposer calls
+    over the cells where both ran."""
+    by = {(r["maze"], r["method"], r["seed"]): r for r in cmp._task_rows(rows, "point")
+          if r["proposer"] == proposer and cmp.is_done(r)}
+    zeros = {m: sum(1 for (_, method, _), r in by.items() if method == m and r["success_rate"] == 0)
+             for m in METHODS}
+    runs = {m: sum(1 for (_, method, _) in by if method == m) for m in METHODS}
+    pairs = [(by[(maze, "ours-repair", s)], r) for (maze, m, s), r in by.items()
+             if m == "ours" and (maze, "ours-repair", s) in by]
+
+    def ratio(key):
+        return float(np.mean([a[key] for a, _ in pairs]) / np.mean([b[key] for _, b in pairs])) if pairs else None
+
+    return {"proposer": proposer, "zero_runs": zeros, "runs": runs, "pairs": len(pairs),
+            "evaluations_ratio": ratio("evaluations"), "proposer_calls_ratio": ratio("proposer_calls")}
+
+
+def _interval(e) -> str:
+    if e["estimate"] != e["estimate"]:  # nan
+        return "—"
+    sign = "" if e["kind"] == "ratio" else "+"
+    return f"{e['estimate']:{sign}.3f} [{e['ci_low']:{sign}.3f}, {e['ci_high']:{sign}.3f}]"
+
+
+def markdown(entries: list[dict], cost_rows: list[dict]) -> str:
+    lines = [f"{cmp.OFFLINE_NOTE}. Point mass; 95 % bootstrap percentile intervals ({cmp.BOOTSTRAP_RESAMPLES} "
+             f"resamples, numpy seed {cmp.BOOTSTRAP_SEED}) over (maze, seed) cells; multi-room = "
+             f"{', '.join(cmp.MULTI_ROOM_MAZES)}; change 1→5 rooms = least-squares slope x 4 on u_chain_1..5, flat "
+             f"within ±{cmp.FLAT_TOLERANCE}. *partial*: cells of the fixed grid are missing.", "",
+             "| proposer | claim | estimate [95 % CI] | verdict | cells (seeds) | missing |",
+             "|---|---|---|---|---|---|"]
+    for e in entries:
+        verdict = e["verdict"] + ("" if e["complete"] else " (*partial*)")
+        seeds = ",".join(map(str, e["seeds"])) or "none"
+        lines.append(f"| {e['proposer']} | {e['claim']} | {_interval(e)} | {verdict} | {e['n_cells']}/"
+                     f"{e['n_expected']} ({seeds}) | {cmp._missing_summary(e['missing'])} |")
+    lines += ["", "| proposer | runs at success 0 (of runs): " + ", ".join(METHODS) +
+              " | ours-repair / ours: evaluations, proposer calls (pairs) |", "|---|---|---|"]
+    for c in cost_rows:
+        zeros = ", ".join(f"{c['zero_runs'][m]}/{c['runs'][m]}" for m in METHODS)
+        fmt = (lambda x: "—" if x is None else f"{x:.2f}x")  # noqa: E731
+        lines.append(f"| {c['proposer']} | {zeros} | {fmt(c['evaluations_ratio'])}, "
+                     f"{fmt(c['proposer_calls_ratio'])} ({c['pairs']}) |")
+    return "\n".join(lines)
+
+
+def maze_table(cells: dict, proposer: str) -> str:
+    """Mean success per maze and method over the seeds that ran, with a Student-t 95 % interval."""
+    mazes = sorted(benchmark_mazes())
+    lines = [f"{proposer} ({cmp.OFFLINE_NOTE}): mean success over seeds {SEEDS} [95 % t interval]", "",
+             "| maze | " + " | ".join(METHODS) + " |", "|---|" + "---|" * len(METHODS)]
+    for maze in mazes:
+        row = []
+        for m in METHODS:
+            values = [cells[(maze, m, proposer, s)] for s in SEEDS if (maze, m, proposer, s) in cells]
+            mean, lo, hi = cmp.mean_ci(values) if values else (float("nan"),) * 3
+            row.append("—" if not values else f"{mean:.3f} [{lo:.3f}, {hi:.3f}] (n={len(values)})")
+        lines.append(f"| {maze} | " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("table")
+    ap.add_argument("--out", required=True, type=Path)
+    args = ap.parse_args(argv)
+    rows = read_table(args.table)
+    cells, failed = cmp.table_cells(rows, "point")
+    entries, cost_rows, tables = [], [], []
+    for p in PRESETS:
+        entries += [paired_claim(cells, failed, p, cmp.MULTI_ROOM_MAZES, "multi-room"),
+                    paired_claim(cells, failed, p, sorted(benchmark_mazes()), "every maze"),
+                    *paper_claims(cells, failed, p)]
+        cost_rows.append(costs(rows, p))
+        tables.append(maze_table(cells, p))
+    args.out.mkdir(parents=True, exist_ok=True)
+    about = {"table": str(args.table), "note": cmp.OFFLINE_NOTE, "presets": list(PRESETS), "seeds": list(SEEDS),
+             "bootstrap_resamples": cmp.BOOTSTRAP_RESAMPLES, "bootstrap_seed": cmp.BOOTSTRAP_SEED}
+    (args.out / "claims.json").write_text(json.dumps(cmp._jsonable(
+        {"about": about, "claims": entries, "costs": cost_rows}), indent=1) + "\n")
+    (args.out / "claims.md").write_text(markdown(entries, cost_rows) + "\n")
+    (args.out / "mazes.md").write_text("\n\n".join(tables) + "\n")
+    partial = sum(not e["complete"] for e in entries)
+    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md ({partial} of {len(entries)} partial)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

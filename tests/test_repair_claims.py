@@ -1,0 +1,91 @@
+"""scripts/repair_claims.py on synthetic tables: the paired verdicts, the paper's claims with ours-repair, partial
+presets and the descriptive counts."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+from test_comparison import row, write_csv
+
+from specrefine.comparison import MULTI_ROOM_MAZES
+from specrefine.mazes import benchmark_mazes
+
+_spec = importlib.util.spec_from_file_location("repair_claims",
+                                               Path(__file__).parents[1] / "scripts" / "repair_claims.py")
+rc = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(rc)
+
+MODERATE = "imperfect:moderate"
+
+
+def grid_rows(success, proposer=MODERATE, seeds=rc.SEEDS):
+    """One row per (maze, method, seed); success(maze, method, seed) -> rate; evaluations 10 (ours-repair 15)."""
+    return [row(maze, m, success(maze, m, seed), seed, proposer) | {
+        "evaluations": 15 if m == "ours-repair" else 10, "proposer_calls": 6 if m == "ours-repair" else 3}
+        for maze in sorted(benchmark_mazes()) for m in rc.METHODS for seed in seeds]
+
+
+def entries_of(rows, proposer=MODERATE):
+    from specrefine import comparison as cmp
+
+    cells, failed = cmp.table_cells(rows, "point")
+    return {e["claim"]: e for e in [rc.paired_claim(cells, failed, proposer, MULTI_ROOM_MAZES, "multi-room"),
+                                    rc.paired_claim(cells, failed, proposer, sorted(benchmark_mazes()), "every maze"),
+                                    *rc.paper_claims(cells, failed, proposer)]}
+
+
+def repair_lifts_multi_room(maze, method, seed):
+    base = {"ours": 0.4, "ours-repair": 0.4, "vlm-oneshot": 0.2}[method]
+    return base + (0.3 if method == "ours-repair" and maze in MULTI_ROOM_MAZES else 0.0)
+
+
+def test_a_lift_on_every_multi_room_cell_helps_and_is_diluted_over_every_maze():
+    e = entries_of(grid_rows(repair_lifts_multi_room))
+    multi, every = e["ours-repair - ours, multi-room"], e["ours-repair - ours, every maze"]
+    assert multi["verdict"] == "helps" and multi["estimate"] == pytest.approx(0.3)
+    assert (multi["ci_low"], multi["ci_high"]) == pytest.approx((0.3, 0.3))
+    assert every["estimate"] == pytest.approx(0.3 * len(MULTI_ROOM_MAZES) / len(benchmark_mazes()))
+    assert multi["complete"] and multi["n_cells"] == len(MULTI_ROOM_MAZES) * len(rc.SEEDS)
+    ratio = e["ours-repair >= 2x one-shot on multi-room tasks"]
+    assert ratio["estimate"] == pytest.approx(0.7 / 0.2) and ratio["verdict"] == "holds"
+
+
+def test_noise_around_zero_is_undecided_and_a_loss_hurts():
+    noisy = entries_of(grid_rows(lambda maze, m, seed: 0.5 + (0.1 if m == "ours-repair" and seed % 2 else
+                                                              -0.1 if m == "ours-repair" else 0.0)))
+    assert noisy["ours-repair - ours, every maze"]["verdict"] == "undecided"
+    worse = entries_of(grid_rows(lambda maze, m, seed: 0.3 if m == "ours-repair" else 0.5))
+    assert worse["ours-repair - ours, multi-room"]["verdict"] == "hurts"
+
+
+def test_rooms_claim_reads_ours_repair_not_ours():
+    def falls_for_ours_only(maze, m, seed):
+        rooms = int(maze.split("_")[2]) if maze.startswith("u_chain_") and not maze.endswith("subgoals") else 1
+        return 0.9 if m == "ours-repair" else 1.0 - 0.2 * rooms
+
+    e = entries_of(grid_rows(falls_for_ours_only))
+    assert e["ours-repair success over 1-5 rooms"]["verdict"] == "flat"
+    assert e["ours success over 1-5 rooms"]["verdict"] == "falls"
+
+
+def test_missing_cells_are_partial_and_named():
+    rows = [r for r in grid_rows(repair_lifts_multi_room) if not (r["maze"] == "u_chain_3" and r["seed"] == 2
+                                                                   and r["method"] == "ours-repair")]
+    multi = entries_of(rows)["ours-repair - ours, multi-room"]
+    assert not multi["complete"] and multi["missing"] == ["u_chain_3 s2: ours-repair (no row)"]
+
+
+def test_cli_writes_claims_counts_zeros_and_cost_ratios(tmp_path):
+    rows = grid_rows(lambda maze, m, seed: 0.0 if m == "ours" and maze == "u_chain_2" else 0.5)
+    write_csv(tmp_path / "t.csv", rows)  # one preset only: the other two are all missing
+    assert rc.main([str(tmp_path / "t.csv"), "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "claims.json").read_text())
+    (moderate,) = [c for c in data["costs"] if c["proposer"] == MODERATE]
+    assert moderate["zero_runs"] == {"ours": 4, "ours-repair": 0, "vlm-oneshot": 0}
+    assert moderate["evaluations_ratio"] == pytest.approx(1.5) and moderate["proposer_calls_ratio"] == 2.0
+    severe = [c for c in data["claims"] if c["proposer"] == "imperfect:severe"]
+    assert severe and not any(c["complete"] for c in severe)
+    assert "u_chain_2 | 0.000 [0.000, 0.000] (n=4) | 0.500" in (tmp_path / "out" / "mazes.md").read_text()
