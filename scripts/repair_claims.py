@@ -5,8 +5,9 @@
 Per preset, 95 % percentile bootstrap intervals over (maze, seed) cells (specrefine.comparison's resamples and
 seed): the paired difference ours-repair - ours on the multi-room cells and on every cell (helps / hurts /
 undecided), the paper's two claims with ours-repair in place of ours (specrefine.comparison's rules), and,
-descriptive, the runs at success 0 and the paired cost ratios. Writes claims.md, claims.json and mazes.md (mean
-success per maze and method, Student-t interval over seeds). A preset with a missing cell is marked partial.
+descriptive, the runs at success 0 and the paired cost ratios. Writes claims.md, claims.json, mazes.md (mean
+success per maze and method, Student-t interval over seeds) and specrefine.comparison's figures of the three
+methods (figure4.png, figure5.png, error_levels.png). A preset with a missing cell is marked partial.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from specrefine.sweep import read_table
 PRESETS = ("imperfect:moderate", "imperfect:severe", "imperfect:mild")  # the order they run in
 METHODS = ("ours", "ours-repair", "vlm-oneshot")
 SEEDS = (0, 1, 2, 3)
+GRID = cmp.Grid("point", METHODS, METHODS, PRESETS, SEEDS, levels=tuple(cmp.ERROR_LEVELS))  # for the figures
 REPAIR_CLAIM = "ours-repair - ours"
 
 
@@ -153,8 +155,11 @@ def main(argv=None) -> int:
         {"about": about, "claims": entries, "costs": cost_rows}), indent=1) + "\n")
     (args.out / "claims.md").write_text(markdown(entries, cost_rows) + "\n")
     (args.out / "mazes.md").write_text("\n\n".join(tables) + "\n")
+    for name, fig in cmp.comparison_figures(rows, GRID).items():
+        fig.savefig(args.out / f"{name}.png", dpi=110)
+        cmp.plt.close(fig)
     partial = sum(not e["complete"] for e in entries)
-    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md ({partial} of {len(entries)} partial)")
+    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, figures ({partial} of {len(entries)} partial)")
     return 0
 
 

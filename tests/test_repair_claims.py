@@ -89,3 +89,4 @@ def test_cli_writes_claims_counts_zeros_and_cost_ratios(tmp_path):
     severe = [c for c in data["claims"] if c["proposer"] == "imperfect:severe"]
     assert severe and not any(c["complete"] for c in severe)
     assert "u_chain_2 | 0.000 [0.000, 0.000] (n=4) | 0.500" in (tmp_path / "out" / "mazes.md").read_text()
+    assert all((tmp_path / "out" / f"{name}.png").stat().st_size > 0 for name in ("figure4", "figure5"))
