@@ -159,7 +159,8 @@ def main(argv=None) -> int:
         fig.savefig(args.out / f"{name}.png", dpi=110)
         cmp.plt.close(fig)
     partial = sum(not e["complete"] for e in entries)
-    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, figures ({partial} of {len(entries)} partial)")
+    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, figures "
+          f"({partial} of {len(entries)} entries partial)")
     return 0
 
 
