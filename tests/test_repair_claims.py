@@ -1,22 +1,16 @@
-"""scripts/repair_claims.py on synthetic tables: the paired verdicts, the paper's claims with ours-repair, partial
+"""specrefine.repair_claims on synthetic tables: the paired verdicts, the paper's claims with ours-repair, partial
 presets and the descriptive counts."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
 from test_comparison import row, write_csv
 
+from specrefine import repair_claims as rc
 from specrefine.comparison import MULTI_ROOM_MAZES
 from specrefine.mazes import benchmark_mazes
-
-_spec = importlib.util.spec_from_file_location("repair_claims",
-                                               Path(__file__).parents[1] / "scripts" / "repair_claims.py")
-rc = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(rc)
 
 MODERATE = "imperfect:moderate"
 
@@ -90,3 +84,9 @@ def test_cli_writes_claims_counts_zeros_and_cost_ratios(tmp_path):
     assert severe and not any(c["complete"] for c in severe)
     assert "u_chain_2 | 0.000 [0.000, 0.000] (n=4) | 0.500" in (tmp_path / "out" / "mazes.md").read_text()
     assert all((tmp_path / "out" / f"{name}.png").stat().st_size > 0 for name in ("figure4", "figure5"))
+
+
+def test_cli_refuses_a_missing_table(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        rc.main([str(tmp_path / "nope.csv"), "--out", str(tmp_path / "out")])
+    assert exc.value.code == 2 and "no table" in capsys.readouterr().err

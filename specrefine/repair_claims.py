@@ -1,6 +1,6 @@
 """The look-ahead repair grid's claims (docs/proposers.md, "Look-ahead repair"), decided as fixed there.
 
-    python scripts/repair_claims.py data/results/repair/results.csv --out data/results/repair
+    python -m specrefine.repair_claims data/results/repair/results.csv --out data/results/repair
 
 Per preset, 95 % percentile bootstrap intervals over (maze, seed) cells (specrefine.comparison's resamples and
 seed): the paired difference ours-repair - ours on the multi-room cells and on every cell (helps / hurts /
@@ -12,16 +12,15 @@ methods (figure4.png, figure5.png, error_levels.png). A preset with a missing ce
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
 import numpy as np
 
-from specrefine import comparison as cmp
-from specrefine.argtypes import exit_code_quiet_on_broken_pipe
-from specrefine.mazes import benchmark_mazes
-from specrefine.sweep import read_table
+from . import comparison as cmp
+from .argtypes import OneLineParser
+from .mazes import benchmark_mazes
+from .sweep import read_table
 
 PRESETS = ("imperfect:moderate", "imperfect:severe", "imperfect:mild")  # the order they run in
 METHODS = ("ours", "ours-repair", "vlm-oneshot")
@@ -135,10 +134,12 @@ def maze_table(cells: dict, proposer: str) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = OneLineParser(prog="python -m specrefine.repair_claims", description=__doc__.splitlines()[0])
     ap.add_argument("table")
     ap.add_argument("--out", required=True, type=Path)
     args = ap.parse_args(argv)
+    if not Path(args.table).is_file():
+        ap.error(f"no table at {args.table}")
     rows = read_table(args.table)
     cells, failed = cmp.table_cells(rows, "point")
     entries, cost_rows, tables = [], [], []
@@ -165,4 +166,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
+    from .argtypes import exit_code_quiet_on_broken_pipe
+
     raise SystemExit(exit_code_quiet_on_broken_pipe(main))
