@@ -13,6 +13,7 @@ methods (figure4.png, figure5.png, error_levels.png). A preset with a missing ce
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -133,6 +134,30 @@ def maze_table(cells: dict, proposer: str) -> str:
     return "\n".join(lines)
 
 
+@dataclass
+class Study:
+    """Everything the grid decides and describes, from its table's rows."""
+    entries: list  # the claims of every preset (paired, then the paper's)
+    costs: list  # one dict per preset: runs at success 0, cost ratios
+    maze_tables: list  # one markdown table per preset
+
+    @property
+    def markdown(self) -> str:
+        return markdown(self.entries, self.costs)
+
+
+def study(rows: list[dict]) -> Study:
+    cells, failed = cmp.table_cells(rows, "point")
+    out = Study([], [], [])
+    for p in PRESETS:
+        out.entries += [paired_claim(cells, failed, p, cmp.MULTI_ROOM_MAZES, "multi-room"),
+                        paired_claim(cells, failed, p, sorted(benchmark_mazes()), "every maze"),
+                        *paper_claims(cells, failed, p)]
+        out.costs.append(costs(rows, p))
+        out.maze_tables.append(maze_table(cells, p))
+    return out
+
+
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.repair_claims", description=__doc__.splitlines()[0])
     ap.add_argument("table")
@@ -141,27 +166,20 @@ def main(argv=None) -> int:
     if not Path(args.table).is_file():
         ap.error(f"no table at {args.table}")
     rows = read_table(args.table)
-    cells, failed = cmp.table_cells(rows, "point")
-    entries, cost_rows, tables = [], [], []
-    for p in PRESETS:
-        entries += [paired_claim(cells, failed, p, cmp.MULTI_ROOM_MAZES, "multi-room"),
-                    paired_claim(cells, failed, p, sorted(benchmark_mazes()), "every maze"),
-                    *paper_claims(cells, failed, p)]
-        cost_rows.append(costs(rows, p))
-        tables.append(maze_table(cells, p))
+    result = study(rows)
     args.out.mkdir(parents=True, exist_ok=True)
     about = {"table": str(args.table), "note": cmp.OFFLINE_NOTE, "presets": list(PRESETS), "seeds": list(SEEDS),
              "bootstrap_resamples": cmp.BOOTSTRAP_RESAMPLES, "bootstrap_seed": cmp.BOOTSTRAP_SEED}
     (args.out / "claims.json").write_text(json.dumps(cmp._jsonable(
-        {"about": about, "claims": entries, "costs": cost_rows}), indent=1) + "\n")
-    (args.out / "claims.md").write_text(markdown(entries, cost_rows) + "\n")
-    (args.out / "mazes.md").write_text("\n\n".join(tables) + "\n")
+        {"about": about, "claims": result.entries, "costs": result.costs}), indent=1) + "\n")
+    (args.out / "claims.md").write_text(result.markdown + "\n")
+    (args.out / "mazes.md").write_text("\n\n".join(result.maze_tables) + "\n")
     for name, fig in cmp.comparison_figures(rows, GRID).items():
         fig.savefig(args.out / f"{name}.png", dpi=110)
         cmp.plt.close(fig)
-    partial = sum(not e["complete"] for e in entries)
+    partial = sum(not e["complete"] for e in result.entries)
     print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, figures "
-          f"({partial} of {len(entries)} entries partial)")
+          f"({partial} of {len(result.entries)} entries partial)")
     return 0
 
 
