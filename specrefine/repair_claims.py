@@ -6,8 +6,9 @@ Per preset, 95 % percentile bootstrap intervals over (maze, seed) cells (specref
 seed): the paired difference ours-repair - ours on the multi-room cells and on every cell (helps / hurts /
 undecided), the paper's two claims with ours-repair in place of ours (specrefine.comparison's rules), and,
 descriptive, the runs at success 0 and the paired cost ratios. Writes claims.md, claims.json, mazes.md (mean
-success per maze and method, Student-t interval over seeds) and specrefine.comparison's figures of the three
-methods (figure4.png, figure5.png, error_levels.png). A preset with a missing cell is marked partial.
+success per maze and method, Student-t interval over seeds), summary.md (README's table, a line per preset) and
+specrefine.comparison's figures of the three methods (figure4.png, figure5.png, error_levels.png). A preset with a
+missing cell is marked partial.
 """
 
 from __future__ import annotations
@@ -145,6 +146,20 @@ class Study:
     def markdown(self) -> str:
         return markdown(self.entries, self.costs)
 
+    def summary(self) -> str:
+        """README's table: one line per preset, the decided claims with their verdicts and the descriptive counts."""
+        lines = ["| preset | ours-repair - ours, multi-room | ours-repair - ours, every maze | ours-repair / one-shot, "
+                 "multi-room | ours-repair, change 1→5 rooms | runs at 0: ours, ours-repair, one-shot | "
+                 "evaluations, proposer calls (ours-repair / ours) |", "|---|---|---|---|---|---|---|"]
+        for preset, cost in zip(PRESETS, self.costs):
+            mine = [e for e in self.entries if e["proposer"] == preset][:4]
+            cells = [f"{_interval(e)} {e['verdict']}" + ("" if e["complete"] else " (*partial*)") for e in mine]
+            zeros = ", ".join(f"{cost['zero_runs'][m]}/{cost['runs'][m]}" for m in METHODS)
+            ratios = ", ".join("—" if x is None else f"{x:.2f}x"
+                               for x in (cost["evaluations_ratio"], cost["proposer_calls_ratio"]))
+            lines.append(f"| {preset.split(':')[1]} | " + " | ".join(cells) + f" | {zeros} | {ratios} |")
+        return "\n".join(lines)
+
 
 def study(rows: list[dict]) -> Study:
     cells, failed = cmp.table_cells(rows, "point")
@@ -174,11 +189,12 @@ def main(argv=None) -> int:
         {"about": about, "claims": result.entries, "costs": result.costs}), indent=1) + "\n")
     (args.out / "claims.md").write_text(result.markdown + "\n")
     (args.out / "mazes.md").write_text("\n\n".join(result.maze_tables) + "\n")
+    (args.out / "summary.md").write_text(result.summary() + "\n")
     for name, fig in cmp.comparison_figures(rows, GRID).items():
         fig.savefig(args.out / f"{name}.png", dpi=110)
         cmp.plt.close(fig)
     partial = sum(not e["complete"] for e in result.entries)
-    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, figures "
+    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, summary.md, figures "
           f"({partial} of {len(result.entries)} entries partial)")
     return 0
 

@@ -84,6 +84,9 @@ def test_cli_writes_claims_counts_zeros_and_cost_ratios(tmp_path):
     assert severe and not any(c["complete"] for c in severe)
     assert "u_chain_2 | 0.000 [0.000, 0.000] (n=4) | 0.500" in (tmp_path / "out" / "mazes.md").read_text()
     assert all((tmp_path / "out" / f"{name}.png").stat().st_size > 0 for name in ("figure4", "figure5"))
+    summary = (tmp_path / "out" / "summary.md").read_text().splitlines()
+    assert len(summary) == 2 + len(rc.PRESETS) and summary[2].startswith("| moderate | +0.062 [")
+    assert summary[2].endswith("| 4/68, 0/68, 0/68 | 1.50x, 2.00x |") and "(*partial*)" in summary[3]
 
 
 def test_cli_refuses_a_missing_table(tmp_path, capsys):
