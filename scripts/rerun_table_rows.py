@@ -6,6 +6,10 @@
 For a table whose first rows came from older code (data/results/imperfect: rows 1-485, commit 6f3114f): the cells
 are rebuilt from the rows (maze, agent, method, proposer, seed, rollouts, episodes, spec), the sweep runs them
 (resumable, as ``specrefine.sweep``), and ``--compare`` lists the columns in which the new rows differ from the old.
+``--compare --shared`` compares only the cells both tables hold, e.g. the reruns inside another grid:
+
+    python scripts/rerun_table_rows.py data/results/imperfect/results.csv --rows 1360 --out data/results/repair \
+        --compare --shared
 """
 import argparse
 from pathlib import Path
@@ -22,14 +26,16 @@ def cells_of(rows) -> list[Cell]:
                  r.get("evaluation") or "fixed", r.get("policy") or "shipped") for r in rows]
 
 
-def compare(old_rows, new_rows) -> list[str]:
-    """One line per cell whose new row differs from the old one in a SEARCH_COLUMNS column."""
+def compare(old_rows, new_rows, shared_only: bool = False) -> list[str]:
+    """One line per cell whose new row differs from the old one in a SEARCH_COLUMNS column (and per old cell not
+    rerun, unless ``shared_only``)."""
     new = {r["cell"]: r for r in new_rows}
     out = []
     for o in old_rows:
         n = new.get(o["cell"])
         if n is None:
-            out.append(f"{o['cell']}: not rerun yet")
+            if not shared_only:
+                out.append(f"{o['cell']}: not rerun yet")
             continue
         diff = [f"{c} {o.get(c)} -> {n.get(c)}" for c in SEARCH_COLUMNS if o.get(c) != n.get(c)]
         if diff:
@@ -44,12 +50,20 @@ def main() -> None:
     ap.add_argument("--out", required=True)
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--compare", action="store_true", help="only compare OUT/results.csv with TABLE's rows")
+    ap.add_argument("--shared", action="store_true",
+                    help="with --compare: only the cells OUT/results.csv also holds (another grid's reruns)")
     args = ap.parse_args()
     old = read_table(args.table)[: args.rows]
     if not args.compare:
         run_sweep(cells_of(old), args.out, workers=args.workers)
-    lines = compare(old, read_table(Path(args.out) / "results.csv"))
+    new = read_table(Path(args.out) / "results.csv")
+    if args.shared:
+        ids = {r["cell"] for r in new}
+        old = [r for r in old if r["cell"] in ids]
+    lines = compare(old, new, shared_only=args.shared)
     print("\n".join(lines) or f"all {len(old)} rows agree in {', '.join(SEARCH_COLUMNS)}")
+    if lines and args.shared:
+        print(f"({len(lines)} of {len(old)} shared cells differ)")
 
 
 if __name__ == "__main__":
