@@ -105,3 +105,14 @@ def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
         table, shown, expected = seed_table(rows, ANT_GRID, int(seed))
         assert shown == expected, f"seed {seed}: {shown} of {expected} cells in the table"
         assert f"<!-- ant comparison seed {seed} -->\n{table}\n" in README, f"seed {seed}"
+
+
+def test_repair_summary_is_the_repair_grid():
+    """README's look-ahead repair table is specrefine.repair_claims' summary of the shipped, complete grid."""
+    from specrefine.repair_claims import study
+
+    rows = read_table(ROOT / "data/results/repair/results.csv")
+    summary = study(rows).summary()
+    assert "(*partial*)" not in summary
+    assert f"<!-- repair summary -->\n{summary}\n" in README
+    assert (ROOT / "data/results/repair/summary.md").read_text() == summary + "\n"
