@@ -36,7 +36,8 @@ with open(dst + ".tmp", "w", newline="") as fh:
 PY
     mv "$shipped.tmp" "$shipped"
 }
-( while sleep 120; do [ -s "$out/results.csv" ] && ship || true; done ) &
+# the sleep holds none of our output streams: a caller reading them sees their end when the sweep ends
+( while sleep 120 </dev/null >/dev/null 2>&1; do [ -s "$out/results.csv" ] && ship || true; done ) &
 watcher=$!
 trap 'kill $watcher 2>/dev/null; [ -s "$out/results.csv" ] && ship' EXIT
 

@@ -144,3 +144,26 @@ def test_a_sweep_runs_every_cell_with_the_policy_it_is_given(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "missing.pt: policy file not found" in err
     assert not (tmp_path / "other" / "results.csv").exists()
+
+
+def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path):
+    """scripts/pinned_sweep.sh: the sweep runs from a worktree at CODE (not the checkout) and its rows reach SHIPPED."""
+    root = Path(__file__).parents[1]
+    if not (root / ".git").exists():
+        pytest.skip("not a git checkout")
+    tree, shipped = tmp_path / "tree", tmp_path / "shipped" / "t.csv"
+    env = {**os.environ, "CODE": "HEAD", "OUT": str(tmp_path / "out"), "SHIPPED": str(shipped), "TREE": str(tree),
+           "PYTHON": sys.executable}
+    try:
+        proc = subprocess.run(["bash", str(root / "scripts" / "pinned_sweep.sh"), "--mazes", "u_maze", "--methods",
+                               "dirl", "--seeds", "0", "--rollouts", "8", "--episodes", "16", "--workers", "1"],
+                              env=env, capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        assert f"in {tree}" in proc.stdout
+        (row,) = read_table(shipped)
+        assert row["status"] == "ok" and row["maze"] == "u_maze"
+        head = subprocess.run(["git", "-C", str(tree), "rev-parse", "HEAD"], capture_output=True, text=True).stdout
+        assert head == subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
+                                      text=True).stdout
+    finally:
+        subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tree)], capture_output=True)
