@@ -26,16 +26,14 @@ def cells_of(rows) -> list[Cell]:
                  r.get("evaluation") or "fixed", r.get("policy") or "shipped") for r in rows]
 
 
-def compare(old_rows, new_rows, shared_only: bool = False) -> list[str]:
-    """One line per cell whose new row differs from the old one in a SEARCH_COLUMNS column (and per old cell not
-    rerun, unless ``shared_only``)."""
+def compare(old_rows, new_rows) -> list[str]:
+    """One line per cell whose new row differs from the old one in a SEARCH_COLUMNS column."""
     new = {r["cell"]: r for r in new_rows}
     out = []
     for o in old_rows:
         n = new.get(o["cell"])
         if n is None:
-            if not shared_only:
-                out.append(f"{o['cell']}: not rerun yet")
+            out.append(f"{o['cell']}: not rerun yet")
             continue
         diff = [f"{c} {o.get(c)} -> {n.get(c)}" for c in SEARCH_COLUMNS if o.get(c) != n.get(c)]
         if diff:
@@ -60,7 +58,7 @@ def main() -> None:
     if args.shared:
         ids = {r["cell"] for r in new}
         old = [r for r in old if r["cell"] in ids]
-    lines = compare(old, new, shared_only=args.shared)
+    lines = compare(old, new)
     print("\n".join(lines) or f"all {len(old)} rows agree in {', '.join(SEARCH_COLUMNS)}")
     if lines and args.shared:
         print(f"({len(lines)} of {len(old)} shared cells differ)")

@@ -65,10 +65,10 @@ def as_ours(cells: dict) -> dict:
 
 def paper_claims(cells: dict, failed: set, proposer: str) -> list[dict]:
     """The paper's two claims with ours-repair as 'ours', and the rooms entries of ours and vlm-oneshot beside."""
-    repaired, repaired_failed = as_ours(cells), as_ours(dict.fromkeys(failed))
-    ratio = cmp.ratio_claim(repaired, set(repaired_failed), proposer, SEEDS)
+    repaired, repaired_failed = as_ours(cells), set(as_ours(dict.fromkeys(failed)))
+    ratio = cmp.ratio_claim(repaired, repaired_failed, proposer, SEEDS)
     ratio |= {"claim": "ours-repair >= 2x one-shot on multi-room tasks", "method": "ours-repair / vlm-oneshot"}
-    rooms = cmp.rooms_claim(repaired, set(repaired_failed), proposer, "ours", SEEDS)
+    rooms = cmp.rooms_claim(repaired, repaired_failed, proposer, "ours", SEEDS)
     rooms |= {"claim": f"ours-repair {cmp.ROOMS_CLAIM_TEXT}", "method": "ours-repair", "paper": "flat"}
     return [ratio, rooms] + [cmp.rooms_claim(cells, failed, proposer, m, SEEDS) for m in ("ours", "vlm-oneshot")]
 
@@ -89,6 +89,14 @@ def costs(rows: list[dict], proposer: str) -> dict:
 
     return {"proposer": proposer, "zero_runs": zeros, "runs": runs, "pairs": len(pairs),
             "evaluations_ratio": ratio("evaluations"), "proposer_calls_ratio": ratio("proposer_calls")}
+
+
+def _zero_runs(cost: dict) -> str:
+    return ", ".join(f"{cost['zero_runs'][m]}/{cost['runs'][m]}" for m in METHODS)
+
+
+def _times(ratio: float | None) -> str:
+    return "—" if ratio is None else f"{ratio:.2f}x"
 
 
 def _interval(e) -> str:
@@ -113,26 +121,29 @@ def markdown(entries: list[dict], cost_rows: list[dict]) -> str:
     lines += ["", "| proposer | runs at success 0 (of runs): " + ", ".join(METHODS) +
               " | ours-repair / ours: evaluations, proposer calls (pairs) |", "|---|---|---|"]
     for c in cost_rows:
-        zeros = ", ".join(f"{c['zero_runs'][m]}/{c['runs'][m]}" for m in METHODS)
-        fmt = (lambda x: "—" if x is None else f"{x:.2f}x")  # noqa: E731
-        lines.append(f"| {c['proposer']} | {zeros} | {fmt(c['evaluations_ratio'])}, "
-                     f"{fmt(c['proposer_calls_ratio'])} ({c['pairs']}) |")
+        lines.append(f"| {c['proposer']} | {_zero_runs(c)} | {_times(c['evaluations_ratio'])}, "
+                     f"{_times(c['proposer_calls_ratio'])} ({c['pairs']}) |")
     return "\n".join(lines)
 
 
 def maze_table(cells: dict, proposer: str) -> str:
     """Mean success per maze and method over the seeds that ran, with a Student-t 95 % interval."""
-    mazes = sorted(benchmark_mazes())
     lines = [f"{proposer} ({cmp.OFFLINE_NOTE}): mean success over seeds {SEEDS} [95 % t interval]", "",
              "| maze | " + " | ".join(METHODS) + " |", "|---|" + "---|" * len(METHODS)]
-    for maze in mazes:
+    for maze in sorted(benchmark_mazes()):
         row = []
         for m in METHODS:
             values = [cells[(maze, m, proposer, s)] for s in SEEDS if (maze, m, proposer, s) in cells]
-            mean, lo, hi = cmp.mean_ci(values) if values else (float("nan"),) * 3
-            row.append("—" if not values else f"{mean:.3f} [{lo:.3f}, {hi:.3f}] (n={len(values)})")
+            row.append(_mean_text(values))
         lines.append(f"| {maze} | " + " | ".join(row) + " |")
     return "\n".join(lines)
+
+
+def _mean_text(values: list[float]) -> str:
+    if not values:
+        return "—"
+    mean, lo, hi = cmp.mean_ci(values)
+    return f"{mean:.3f} [{lo:.3f}, {hi:.3f}] (n={len(values)})"
 
 
 @dataclass
@@ -154,10 +165,8 @@ class Study:
         for preset, cost in zip(PRESETS, self.costs):
             mine = [e for e in self.entries if e["proposer"] == preset][:4]
             cells = [f"{_interval(e)} {e['verdict']}" + ("" if e["complete"] else " (*partial*)") for e in mine]
-            zeros = ", ".join(f"{cost['zero_runs'][m]}/{cost['runs'][m]}" for m in METHODS)
-            ratios = ", ".join("—" if x is None else f"{x:.2f}x"
-                               for x in (cost["evaluations_ratio"], cost["proposer_calls_ratio"]))
-            lines.append(f"| {preset.split(':')[1]} | " + " | ".join(cells) + f" | {zeros} | {ratios} |")
+            ratios = f"{_times(cost['evaluations_ratio'])}, {_times(cost['proposer_calls_ratio'])}"
+            lines.append(f"| {preset.split(':')[1]} | " + " | ".join(cells) + f" | {_zero_runs(cost)} | {ratios} |")
         return "\n".join(lines)
 
 

@@ -48,6 +48,11 @@ class SplitOutcome:
     evaluations: int = 0
 
 
+def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
+    """The subtasks of a split u -> x_1 -> ... -> v: one leg per waypoint, then the edge's own goal."""
+    return [Leg(x, avoid) for x in waypoints] + [Leg(goal, avoid, goal_point)]
+
+
 def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = 3, d: int = 2,
                k: int = 5, rng: np.random.Generator, picture: Callable | None = None, racing=None) -> SplitOutcome:
     """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
@@ -65,7 +70,7 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
             log.info("edge split round %d: the proposer returned no valid candidate", round_ + 1)
         for waypoints in (p for p in proposals if p):
             if round_ == 0:
-                legs = [Leg(x, avoid) for x in waypoints] + [Leg(goal, avoid, goal_point)]
+                legs = split_legs(waypoints, goal, avoid, goal_point)
                 path = estimate_legs(evaluator, start, legs)
                 outcome.evaluations += len(legs)
                 candidate = SplitCandidate(list(waypoints), path.results, round_)

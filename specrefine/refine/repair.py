@@ -18,8 +18,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..graph import TaskGraph
-from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
-from .edge_split import SplitCandidate, SplitOutcome
+from .common import SubtaskEvaluator, estimate_legs, start_of, weight
+from .edge_split import SplitCandidate, SplitOutcome, split_legs
 
 #: (graph holding the candidate's chain, a, b, the leg's EdgeResult, start of the leg) -> Algorithm 1 on a -> b
 SplitLeg = Callable[[TaskGraph, str, str, object, object], SplitOutcome]
@@ -44,7 +44,7 @@ def repair(candidate: SplitCandidate, graph: TaskGraph, u: str, v: str, *, start
         if fix is None or fix.p <= 0.0:
             break
         waypoints[i:i] = fix.waypoints
-        rest = _legs(graph, u, v, waypoints)[i + len(fix.results):]
+        rest = split_legs(waypoints, graph.region(v), graph.avoid(u, v), graph.goal_point(v))[i + len(fix.results):]
         results = results[:i] + fix.results + estimate_legs(evaluator, start_of(fix.results[-1]), rest).results
         repaired += 1
         i = _first_failing(results, i + len(fix.results))
@@ -56,7 +56,3 @@ def repair(candidate: SplitCandidate, graph: TaskGraph, u: str, v: str, *, start
 def _first_failing(results: list, begin: int) -> int | None:
     return next((j for j in range(begin, len(results)) if results[j].successes == 0), None)
 
-
-def _legs(graph: TaskGraph, u: str, v: str, waypoints) -> list[Leg]:
-    avoid = graph.avoid(u, v)
-    return [Leg(x, avoid) for x in waypoints] + [Leg(graph.region(v), avoid, graph.goal_point(v))]

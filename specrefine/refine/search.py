@@ -237,9 +237,10 @@ class RefinementSearch:
 
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,
                           split_leg=split_leg, may_split=lambda: self.splits_generated < self.cfg.max_edge_splits)
-        self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities,
-                  p_after=repaired.probabilities if repaired else None, legs_repaired=repaired.repaired if repaired
-                  else 0, waypoints=[x.to_dict() for x in repaired.waypoints] if repaired else None)
+        after = dict(p_after=repaired.probabilities, legs_repaired=repaired.repaired,
+                     waypoints=[x.to_dict() for x in repaired.waypoints]) if repaired else \
+            dict(p_after=None, legs_repaired=0, waypoints=None)
+        self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities, **after)
         return repaired
 
     def _gen_vertex(self, u, v, w) -> Refinement | None:
