@@ -375,6 +375,38 @@ def seed_table(rows, grid: Grid, seed: int) -> tuple[str, int, int]:
     return "\n".join(lines), shown, len(mazes) * len(columns)
 
 
+def _named(mazes) -> str:
+    return f"{len(mazes)} maze{'s' * (len(mazes) != 1)}" + (f" ({', '.join(mazes)})" if mazes else "")
+
+
+def seed_contrast(rows, grid: Grid, seed: int) -> list[str]:
+    """One seed, a line per proposer: the mazes where the first claim method (``ours``) is above or below the
+    second (``vlm-oneshot``) with disjoint 95 % CIs, how many overlap, and where the first measures 0 (descriptive:
+    one seed, one run per maze; the claims pool the seeds). Mazes without both runs are left out and counted."""
+    from .mazes import benchmark_mazes
+
+    first, second = grid.claim_methods[:2]
+    done = {(r["maze"], r["method"], r["proposer"]): r for r in _task_rows(rows, grid.agent)
+            if r["seed"] == seed and is_done(r)}
+    lines = []
+    for proposer in grid.proposers:
+        above, below, overlap, zero, absent = [], [], [], [], 0
+        for maze in benchmark_mazes():
+            a, b = done.get((maze, first, proposer)), done.get((maze, second, proposer))
+            if a is None or b is None:
+                absent += 1
+                continue
+            side = (above if a["success_ci_low"] > b["success_ci_high"]
+                    else below if a["success_ci_high"] < b["success_ci_low"] else overlap)
+            side.append(maze)
+            if a["success_rate"] == 0:
+                zero.append(maze)
+        lines.append(f"- `{proposer}`: `{first}` above `{second}` (disjoint 95 % CIs) on {_named(above)}, below on "
+                     f"{_named(below)}, overlapping on {len(overlap)}; `{first}` at 0.000 on {_named(zero)}"
+                     + (f"; {absent} mazes without both runs" if absent else "") + ".")
+    return lines
+
+
 def _jsonable(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
@@ -419,8 +451,9 @@ def main(argv=None) -> int:
     write_claims(entries, out, args.table, grid)
     for seed in grid.seeds:
         table, shown, expected = seed_table(rows, grid, seed)
+        contrast = "\n".join(seed_contrast(rows, grid, seed))
         (out / f"seed{seed}.md").write_text(f"Seed {seed}: {shown} of {expected} cells ({OFFLINE_NOTE}; success "
-                                            f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n")
+                                            f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n\n{contrast}\n")
     partial = sum(not e["complete"] for e in entries)
     print(table_note(args.table, rows, grid))  # after the files: a closed stdout (`| head`) loses none of them
     print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")

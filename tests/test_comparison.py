@@ -271,6 +271,27 @@ def test_seed_table_one_line_per_maze_methods_without_a_proposer_once():
     assert "| x_maze | — | — | — | — | — | — |" in lines
 
 
+def test_seed_contrast_sorts_mazes_by_disjoint_intervals_and_counts_the_absent():
+    from specrefine.mazes import benchmark_mazes
+
+    def run(maze, method, success, low, high, proposer="geometric", seed=2):
+        return ant_row(maze, method, success, seed, proposer) | {"success_ci_low": low, "success_ci_high": high}
+
+    rows = [run("u_maze", "ours", 0.9, 0.85, 0.94), run("u_maze", "vlm-oneshot", 0.5, 0.43, 0.57),  # above
+            run("x_maze", "ours", 0.0, 0.0, 0.02), run("x_maze", "vlm-oneshot", 0.3, 0.24, 0.37),  # below, at 0
+            run("or_maze", "ours", 0.5, 0.43, 0.57), run("or_maze", "vlm-oneshot", 0.55, 0.48, 0.62),  # overlap
+            run("two_doors", "ours", 0.9, 0.85, 0.94),  # no one-shot run: absent
+            run("u_maze", "ours", 0.0, 0.0, 0.02, seed=1),  # another seed
+            run("x_maze", "ours", 0.9, 0.85, 0.94) | {"status": "error"}]  # failed: not a result
+    geometric, moderate = cmp.seed_contrast(rows, cmp.ANT_GRID, 2)
+    absent = len(benchmark_mazes()) - 3
+    assert geometric == ("- `geometric`: `ours` above `vlm-oneshot` (disjoint 95 % CIs) on 1 maze (u_maze), below on "
+                         "1 maze (x_maze), overlapping on 1; `ours` at 0.000 on 1 maze (x_maze); "
+                         f"{absent} mazes without both runs.")
+    assert moderate.startswith("- `imperfect:moderate`: `ours` above `vlm-oneshot` (disjoint 95 % CIs) on 0 mazes,")
+    assert moderate.endswith(f"; {len(benchmark_mazes())} mazes without both runs.")
+
+
 def test_cli_keeps_its_files_when_stdout_is_closed(tmp_path):
     """`python -m specrefine.comparison ... | head`: the reader gone, the figures and claims are still written."""
     import os

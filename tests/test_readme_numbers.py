@@ -95,8 +95,9 @@ def test_adaptive_table_is_the_bench_markdown():
 
 
 def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
-    """Each seed of the growing Ant comparison that README shows is complete in the table and shown as it is."""
-    from specrefine.comparison import ANT_GRID, seed_table
+    """Each seed of the growing Ant comparison that README shows is complete in the table and shown as it is, with
+    the lines that contrast ours and the one-shot under it."""
+    from specrefine.comparison import ANT_GRID, seed_contrast, seed_table
 
     rows = read_table(ROOT / "data/results/ant/comparison.csv")
     seeds = re.findall(r"<!-- ant comparison seed (\d+) -->", README)
@@ -104,7 +105,8 @@ def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
     for seed in seeds:
         table, shown, expected = seed_table(rows, ANT_GRID, int(seed))
         assert shown == expected, f"seed {seed}: {shown} of {expected} cells in the table"
-        assert f"<!-- ant comparison seed {seed} -->\n{table}\n" in README, f"seed {seed}"
+        contrast = "\n".join(seed_contrast(rows, ANT_GRID, int(seed)))
+        assert f"<!-- ant comparison seed {seed} -->\n{table}\n\n{contrast}\n" in README, f"seed {seed}"
 
 
 def test_repair_summary_is_the_repair_grid():
