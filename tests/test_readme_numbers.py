@@ -109,6 +109,20 @@ def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
         assert f"<!-- ant comparison seed {seed} -->\n{table}\n\n{contrast}\n" in README, f"seed {seed}"
 
 
+def test_ant_comparison_claims_are_claims_md_of_the_complete_grid():
+    """README's Ant claims are the table of the shipped claims.md, drawn from every run of the fixed grid."""
+    from specrefine.comparison import ANT_GRID, expected_cells, grid_cells, table_cells
+
+    rows = read_table(ROOT / "data/results/ant/comparison.csv")
+    assert grid_cells(ANT_GRID) <= set(table_cells(rows, "ant")[0]), "the Ant grid is not complete"
+    assert len(grid_cells(ANT_GRID)) == expected_cells(ANT_GRID) == 306
+    claims = json.loads((ROOT / "data/results/ant/comparison/claims.json").read_text())["claims"]
+    assert claims and all(c["complete"] for c in claims)
+    table = "\n".join(line for line in (ROOT / "data/results/ant/comparison/claims.md").read_text().splitlines()
+                      if line.startswith("|"))
+    assert f"<!-- ant comparison claims -->\n{table}\n" in README
+
+
 def test_repair_summary_is_the_repair_grid():
     """README's look-ahead repair table is specrefine.repair_claims' summary of the shipped, complete grid."""
     from specrefine.repair_claims import study
