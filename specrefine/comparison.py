@@ -353,14 +353,19 @@ def table_note(path, rows, grid: Grid = POINT_GRID) -> str:
     return f"{path}: all {done} runs of the fixed grid have an ok row"
 
 
+def _seed_runs(rows, grid: Grid, seed: int) -> dict:
+    """The grid agent's done runs of one seed, by (maze, method, proposer)."""
+    return {(r["maze"], r["method"], r["proposer"]): r for r in _task_rows(rows, grid.agent)
+            if r["seed"] == seed and is_done(r)}
+
+
 def seed_table(rows, grid: Grid, seed: int) -> tuple[str, int, int]:
     """One seed of the grid as markdown (a line per maze; success [95 % Wilson CI] per method and proposer, "—"
     where the cell has no ok row), with the number of cells it shows and the grid's number at that seed."""
     from .mazes import benchmark_mazes
     from .pipeline import PROPOSER_METHODS
 
-    done = {(r["maze"], r["method"], r["proposer"]): r for r in _task_rows(rows, grid.agent)
-            if r["seed"] == seed and is_done(r)}
+    done = _seed_runs(rows, grid, seed)
     columns = [(m, "none") for m in grid.methods if m not in PROPOSER_METHODS]
     columns += [(m, p) for p in grid.proposers for m in grid.methods if m in PROPOSER_METHODS]
     lines = ["| maze | " + " | ".join(m if p == "none" else f"{m}, {p}" for m, p in columns) + " |",
@@ -386,8 +391,7 @@ def seed_contrast(rows, grid: Grid, seed: int) -> list[str]:
     from .mazes import benchmark_mazes
 
     first, second = grid.claim_methods[:2]
-    done = {(r["maze"], r["method"], r["proposer"]): r for r in _task_rows(rows, grid.agent)
-            if r["seed"] == seed and is_done(r)}
+    done = _seed_runs(rows, grid, seed)
     lines = []
     for proposer in grid.proposers:
         above, below, overlap, zero, absent = [], [], [], [], 0
