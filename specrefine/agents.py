@@ -13,6 +13,9 @@ from dataclasses import dataclass, field
 
 from .errors import SpecrefineError
 
+#: what a free-joint body's observation is expressed in (``sim.BatchedSim.observe``); a policy file records its own
+OBSERVATION_FRAMES = ("world", "heading")
+
 
 @dataclass(frozen=True)
 class ReachTask:

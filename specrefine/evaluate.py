@@ -137,6 +137,7 @@ class Evaluator:
         self.cache_hits = 0
         self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
         self._act = policy.act if hasattr(policy, "act") else policy
+        self.observation_frame = getattr(policy, "observation_frame", "world")
         self._sims: dict[int, object] = {}
         self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
         self._compiled: dict[Region, CompiledRegion] = {}
@@ -491,7 +492,7 @@ class Evaluator:
                     row[ids] = np.arange(len(ids))
                 live = episode >= 0
                 ep = np.where(live, episode, episode[0])
-                obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep])
+                obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep], self.observation_frame)
                 act = np.asarray(self._act(obs), dtype=np.float64)
                 act[~(live & active[ep])] = 0.0  # finished rollouts stay still
                 sim.step(act)

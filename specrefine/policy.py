@@ -14,7 +14,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from .agents import AGENTS
+from .agents import AGENTS, OBSERVATION_FRAMES
 from .errors import PolicyError
 from .paths import data_dir
 
@@ -57,11 +57,17 @@ class Normalizer(nn.Module):
 class GoalPolicy(nn.Module):
     """``forward(obs) -> (loc, scale)`` of a Gaussian squashed by tanh into [-1, 1]."""
 
-    def __init__(self, agent: str, obs_dim: int | None = None, act_dim: int | None = None):
+    def __init__(self, agent: str, obs_dim: int | None = None, act_dim: int | None = None,
+                 observation_frame: str = "world"):
         super().__init__()
         if agent not in OBS_ACT_DIMS:
             raise PolicyError(f"unknown agent {agent!r}; expected one of {', '.join(OBS_ACT_DIMS)}")
+        if observation_frame not in OBSERVATION_FRAMES:
+            raise PolicyError(f"observation frame {observation_frame!r}; expected one of "
+                              f"{', '.join(OBSERVATION_FRAMES)}")
         self.agent = agent
+        #: what ``sim.BatchedSim.observe`` must hand this policy ("world": every policy before the heading frame)
+        self.observation_frame = observation_frame
         self.obs_dim, self.act_dim = (obs_dim, act_dim) if obs_dim else OBS_ACT_DIMS[agent]
         self.norm = Normalizer(self.obs_dim)
         self.net = mlp(self.obs_dim, 2 * self.act_dim)
@@ -82,6 +88,8 @@ class GoalPolicy(nn.Module):
     @property
     def fingerprint(self) -> str:
         h = hashlib.sha1(self.agent.encode())
+        if self.observation_frame != "world":  # the same weights fed another observation are another policy
+            h.update(self.observation_frame.encode())
         for name, t in sorted(self.state_dict().items()):
             h.update(name.encode())
             h.update(t.detach().cpu().float().contiguous().numpy().tobytes())
@@ -93,7 +101,8 @@ def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     state = {k: v.detach().cpu().float().clone() for k, v in policy.state_dict().items()}
     torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
-                "act_dim": policy.act_dim, "state_dict": state, "meta": dict(meta or {})}, path)
+                "act_dim": policy.act_dim, "observation_frame": policy.observation_frame, "state_dict": state,
+                "meta": dict(meta or {})}, path)
 
 
 def _resolve(path_or_agent) -> Path:
@@ -121,7 +130,10 @@ def load_policy(path_or_agent) -> GoalPolicy:
                           "does not match a known agent")
     if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS and agent != path_or_agent:
         raise PolicyError(f"{path}: holds a {agent} policy, expected {path_or_agent}")
-    policy = GoalPolicy(agent)
+    frame = blob.get("observation_frame", "world")  # files written before the heading frame carry none
+    if frame not in OBSERVATION_FRAMES:
+        raise PolicyError(f"{path}: observation frame {frame!r} is not one of {', '.join(OBSERVATION_FRAMES)}")
+    policy = GoalPolicy(agent, observation_frame=frame)
     try:
         policy.load_state_dict(blob["state_dict"])
     except (RuntimeError, KeyError, TypeError) as e:

@@ -19,6 +19,10 @@ from .results import wilson_ci
 from .sim import BatchedSim, sample_goals
 
 
+def _frame(policy) -> str:
+    return getattr(policy, "observation_frame", "world")  # a scripted controller has none
+
+
 def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
     """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
     task = get_agent(policy.agent).reach_task
@@ -41,7 +45,7 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
     traj = np.zeros((episodes, horizon + 1, 2))
     traj[:, 0] = sim.xy
     for t in range(horizon):
-        sim.step(np.where(active[:, None], policy.act(sim.observe(goals)), 0.0))
+        sim.step(np.where(active[:, None], policy.act(sim.observe(goals, _frame(policy))), 0.0))
         xy = sim.xy
         traj[:, t + 1] = np.where(active[:, None], xy, traj[:, t])
         hit = active & (np.linalg.norm(goals - xy, axis=1) < task.success_radius)
@@ -75,7 +79,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
     with torch.inference_mode():
         while alive.any():
-            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal)), 0.0))
+            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal, _frame(policy))), 0.0))
             t += 1
             flip = alive & sim.flipped
             np.add.at(flips, index[flip], 1)

@@ -28,9 +28,11 @@ class GoalReachEnv(EnvBase):
     (a refined graph's goal regions are that size: the next goal arrives while the agent still moves).
     """
 
-    def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None):
+    def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None,
+                 frame: str = "world"):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
         self.sim = BatchedSim(agent, None, n, nthread=nthread)
+        self.frame = frame  # the observation frame of the policy being trained (sim.BatchedSim.observe)
         self.task = task or get_agent(agent).reach_task
         self.rng = np.random.default_rng(seed)
         self.goals = np.zeros((n, 2))
@@ -53,7 +55,7 @@ class GoalReachEnv(EnvBase):
 
     def _obs_td(self, success, flipped) -> TensorDict:
         return TensorDict({
-            "observation": torch.from_numpy(self.sim.observe(self.goals)),
+            "observation": torch.from_numpy(self.sim.observe(self.goals, self.frame)),
             "success": torch.from_numpy(success).unsqueeze(-1), "flipped": torch.from_numpy(flipped).unsqueeze(-1),
         }, batch_size=self.batch_size)
 

@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from .agents import get_agent
+from .agents import OBSERVATION_FRAMES, get_agent
 from .errors import SpecrefineError
 from .mazes import Maze
 
@@ -194,13 +194,29 @@ class BatchedSim:
         return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
     # --- observe / step --------------------------------------------------------------------
-    def observe(self, goals: np.ndarray) -> np.ndarray:
+    def observe(self, goals: np.ndarray, frame: str = "world") -> np.ndarray:
+        """The policy's observation of reaching ``goals`` (one per row).
+
+        ``frame="world"`` (the shipped policies): the torso's quaternion and linear velocity as MuJoCo holds them,
+        so they carry the absolute heading.  ``frame="heading"``: both with the heading taken out (the quaternion
+        of roll and pitch alone, the velocity in the heading frame), so behaviour cannot depend on the compass
+        direction of travel.  The goal is in the heading frame and the angular velocity in the body frame in both;
+        at heading 0 the two observations are equal.  The point mass has no heading: both frames are the same.
+        """
+        if frame not in OBSERVATION_FRAMES:
+            raise SpecrefineError(f"observation frame must be one of {', '.join(OBSERVATION_FRAMES)}, got {frame!r}")
         rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
         if self._spec.planar:
             return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
-        c, s = np.cos(self._yaw()), np.sin(self._yaw())
+        yaw = self._yaw()
+        c, s = np.cos(yaw), np.sin(yaw)
         local = np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
-        return np.concatenate([self.qpos[:, 2:], self.qvel, local], axis=1).astype(np.float32)
+        qpos, qvel = self.qpos[:, 2:].copy(), self.qvel.copy()
+        if frame == "heading":
+            qpos[:, 1:5] = _without_yaw(qpos[:, 1:5], yaw)
+            vx, vy = qvel[:, 0].copy(), qvel[:, 1].copy()
+            qvel[:, 0], qvel[:, 1] = c * vx + s * vy, -s * vx + c * vy
+        return np.concatenate([qpos, qvel, local], axis=1).astype(np.float32)
 
     def step(self, actions: np.ndarray) -> None:
         ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)
@@ -224,6 +240,14 @@ class BatchedSim:
             self.close()
         except Exception:  # interpreter shutdown
             pass
+
+
+def _without_yaw(quat: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """conj(q_yaw) * q for rows (w, x, y, z): the rotation left once the heading is removed, with w >= 0."""
+    w, x, y, z = quat.T
+    c, s = np.cos(yaw / 2), np.sin(yaw / 2)
+    out = np.stack([c * w + s * z, c * x + s * y, c * y - s * x, c * z - s * w], axis=1)
+    return np.where(out[:, :1] < 0, -out, out)  # q and -q are one rotation: one sign, or it jumps at yaw = pi
 
 
 # --- goal-conditioned reach task for training (open floor) -----------------------------------

@@ -80,6 +80,9 @@ class Config:
     flip_penalty: float | None = knob(None, "reward -= this on flipping (default: the agent's task)")
     lateral_cost: float | None = knob(None, "reward -= this x metres moved across the line to the goal "
                                             "(default: the agent's task)")
+    observation_frame: str = knob("world", "the policy's observation: 'world' (torso quaternion and velocity as "
+                                           "MuJoCo holds them, as every shipped policy) or 'heading' (the heading "
+                                           "taken out: behaviour independent of the direction of travel)")
     switch_radius: tuple[float, float] | None = knob(None, "each goal counts as reached within a radius drawn "
                                                            "from [LO, HI] m (default: the task's success radius)")
 
@@ -109,7 +112,7 @@ def _radius_range(pair) -> tuple[float, float]:
 
 def config_arguments(parser: argparse.ArgumentParser) -> None:
     """One ``--field-name`` option per :class:`Config` field (except ``agent``), default None = the agent's."""
-    types = {"int": int, "float": float, "str | None": str, "float | None": float, "int | None": int}
+    types = {"int": int, "float": float, "str": str, "str | None": str, "float | None": float, "int | None": int}
     for f in fields(Config):
         if f.name == "agent":
             continue
@@ -156,8 +159,9 @@ class Trainer:
         if cfg.switch_radius is not None:
             optional["goal_radius"] = _radius_range(cfg.switch_radius)
         task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
-        self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task)
-        self.policy = GoalPolicy(cfg.agent)
+        self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
+                                frame=cfg.observation_frame)
+        self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.actor, self.critic = make_modules(self.policy, self.env)
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
                                 entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,

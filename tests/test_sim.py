@@ -195,3 +195,46 @@ def test_goal_radius_draws_each_goals_own_radius_and_success_uses_it():
     plain = GoalReachEnv("point", 64, seed=0, nthread=1)
     plain.reset()
     assert (plain.radius == AGENTS["point"].reach_task.success_radius).all()
+
+
+def _turned(state: np.ndarray, goals: np.ndarray, angle: np.ndarray, nq: int):
+    """The same Ant states and goals turned by ``angle`` about the vertical axis through the origin."""
+    import mujoco
+
+    s, g = state.copy(), goals.copy()
+    c, n = np.cos(angle), np.sin(angle)
+    for cols, arr in (((1, 2), s), ((1 + nq, 2 + nq), s)):  # position and linear velocity (world frame)
+        x, y = arr[:, cols[0]].copy(), arr[:, cols[1]].copy()
+        arr[:, cols[0]], arr[:, cols[1]] = c * x - n * y, n * x + c * y
+    g[:, 0], g[:, 1] = c * goals[:, 0] - n * goals[:, 1], n * goals[:, 0] + c * goals[:, 1]
+    for i, a in enumerate(angle):  # the torso's orientation; the body-frame angular velocity is unchanged
+        mujoco.mju_mulQuat(s[i, 4:8], np.array([np.cos(a / 2), 0, 0, np.sin(a / 2)]), state[i, 4:8].copy())
+    return s, g
+
+
+def test_heading_frame_observation_does_not_depend_on_the_direction_of_travel():
+    rng = np.random.default_rng(0)
+    a, b = BatchedSim("ant", None, 8, nthread=1), BatchedSim("ant", None, 8, nthread=1)
+    a.reset(xy=np.zeros((8, 2)), rng=rng)
+    for _ in range(20):  # moving, tilted, turned: a state that is not the default pose
+        a.step(rng.uniform(-1, 1, (8, 8)))
+    goals = a.xy + rng.uniform(-5, 5, (8, 2))
+    turned, turned_goals = _turned(a.get_state(), goals, rng.uniform(-np.pi, np.pi, 8), a.model.nq)
+    b.reset(states=turned)
+    assert np.abs(a.observe(goals, "world") - b.observe(turned_goals, "world")).max() > 0.1  # world: it differs
+    actions = rng.uniform(-1, 1, (8, 8))
+    for _ in range(10):  # the physics agrees too: the same actions keep the observations equal
+        np.testing.assert_allclose(a.observe(goals, "heading"), b.observe(turned_goals, "heading"), atol=1e-4)
+        a.step(actions)
+        b.step(actions)
+
+
+def test_heading_and_world_frames_agree_at_heading_zero_and_for_the_point():
+    ant = BatchedSim("ant", None, 4, nthread=1)
+    ant.reset(xy=np.zeros((4, 2)))  # default pose: heading 0
+    goals = np.array([[3.0, 1.0], [-2.0, 0.5], [0.0, -4.0], [1.0, 1.0]])
+    np.testing.assert_array_equal(ant.observe(goals, "heading"), ant.observe(goals, "world"))
+    point = BatchedSim("point", None, 4, nthread=1)
+    np.testing.assert_array_equal(point.observe(goals, "heading"), point.observe(goals, "world"))
+    with pytest.raises(SpecrefineError, match="observation frame"):
+        ant.observe(goals, "compass")

@@ -181,3 +181,16 @@ def test_init_from_a_policy_file_trains_the_fresh_critic_alone_first(tiny_run, t
 def test_a_bad_switch_radius_is_one_line(capsys, tmp_path):
     assert main(["--agent", "point", "--out", str(tmp_path / "r"), "--switch-radius", "1.0", "0.5"]) == 2
     assert "needs 0 < LO <= HI" in capsys.readouterr().err
+
+
+def test_a_policy_file_records_its_observation_frame(tmp_path):
+    from specrefine.policy import GoalPolicy, load_policy, save_policy
+
+    world = load_policy("ant")
+    heading = GoalPolicy("ant", observation_frame="heading")
+    heading.load_state_dict(world.state_dict())
+    save_policy(heading, tmp_path / "h.pt")
+    back = load_policy(tmp_path / "h.pt")
+    assert (world.observation_frame, back.observation_frame) == ("world", "heading")
+    assert back.fingerprint != world.fingerprint  # the same weights fed another observation: another policy
+    assert load_policy("ant").fingerprint == world.fingerprint  # files without the header stay "world"
