@@ -29,8 +29,15 @@ MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's r
 #: every method: whether it asks a proposer, and what it is (the paper's Sec. 5.1, plus controls)
 METHODS = {
     "ours": (True, "Alg. 3: Dijkstra-order search with proposer edge splits and vertex subsets"),
-    "ours-novertex": (True, "control: ours without vertex refinement (edge splits only)"),
-    "ours-d1": (True, "control: ours with d = 1 (no feedback round in an edge split)"),
+    "ours-novertex": (True, "control: ours without vertex refinement anywhere (neither the search's vertex subsets "
+                            "nor Algorithm 2 inside an edge split)"),
+    "ours-nosearchvertex": (True, "control: ours without the search's own vertex subsets (an edge split still "
+                                  "tunes its later candidates with Algorithm 2)"),
+    "ours-notune": (True, "control: ours with an edge split's later candidates evaluated as proposed (no "
+                          "Algorithm 2 inside the split, Alg. 1 line 10)"),
+    "ours-nofeedback": (True, "control: ours with an edge split's later round asked afresh, without the earlier "
+                              "candidates' results"),
+    "ours-d1": (True, "the paper's d = 1: no later round in an edge split (its samples, feedback and tuning)"),
     "ours-repair": (True, "beyond the paper: ours, and when no split candidate succeeds end to end, its failing "
                           "legs are split once more before it is judged (refine/repair.py)"),
     "vlm-oneshot": (True, "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w"),
@@ -38,6 +45,16 @@ METHODS = {
                                   "subtask evaluations) on the same task and seed"),
     "symbolic": (False, "baseline: the search with vertex subsets only"),
     "dirl": (False, "baseline: no refinement, Dijkstra on the input graph"),
+}
+#: what each variant of ``ours`` changes in its SearchConfig (every control removes one thing from ``ours``)
+OURS_VARIANTS = {
+    "ours": {},
+    "ours-novertex": dict(vertex_refinement=False, split_tuning=False),
+    "ours-nosearchvertex": dict(vertex_refinement=False),
+    "ours-notune": dict(split_tuning=False),
+    "ours-nofeedback": dict(split_feedback=False),
+    "ours-d1": dict(d=1),
+    "ours-repair": dict(repair=True),
 }
 PROPOSER_METHODS = tuple(m for m, (asks, _) in METHODS.items() if asks)
 
@@ -131,10 +148,9 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
     if method == "symbolic":
         cfg = SearchConfig(k=k, edge_refinement=False, seed=seed, evaluation=evaluation)
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
-    if method.startswith("ours"):
-        cfg = SearchConfig(w=w, d=1 if method == "ours-d1" else d, k=k, seed=seed,
-                           vertex_refinement=method != "ours-novertex", evaluation=evaluation,
-                           repair=method == "ours-repair")
+    if method in OURS_VARIANTS:
+        cfg = SearchConfig(**{"w": w, "d": d, "k": k, "seed": seed, "evaluation": evaluation,
+                              **OURS_VARIANTS[method]})
         images = getattr(proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(maze, agent, evaluator.facts(), images=images)
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,

@@ -20,7 +20,8 @@ def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2"):
 
 
 def test_every_method_is_listed_once_with_what_it_is():
-    asking = {"ours", "ours-novertex", "ours-d1", "ours-repair", "vlm-oneshot", "vlm-oneshot-matched"}
+    asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
+              "ours-repair", "vlm-oneshot", "vlm-oneshot-matched"}
     assert set(METHODS) == asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) == asking
 
 
@@ -34,6 +35,49 @@ def test_controls_of_ours(tmp_path):
     assert {c["round"] for s in full_steps if s["event"] == "split-generated" for c in s["candidates"]} >= {0, 1}
     for data in (full, novertex, d1):
         assert data["proposer_calls"] >= 1 and data["vlm_calls"] == 0 and data["proposer_is_vlm"] is False
+
+
+def _search_steps(tmp_path, method):
+    """The issue's reproduction: u_chain_2, imperfect:mild, seed 1, 16 rollouts (later rounds tuned there)."""
+    refine_maze("u_chain_2", agent="point", method=method, proposer="imperfect:mild", seed=1, rollouts=16,
+                episodes=20, out=tmp_path / method)
+    steps = [json.loads(line) for line in (tmp_path / method / "steps.jsonl").read_text().splitlines()]
+    candidates = [c for s in steps if s["event"] == "split-generated" for c in s["candidates"]]
+    return {"vertex": sum(s["event"] == "vertex-generated" for s in steps),
+            "tuned": sum(c["tuned"] for c in candidates), "later": sum(c["round"] > 0 for c in candidates)}
+
+
+def test_each_control_removes_exactly_what_it_names(tmp_path):
+    seen = {m: _search_steps(tmp_path, m) for m in ("ours", "ours-novertex", "ours-nosearchvertex", "ours-notune")}
+    assert seen["ours"]["vertex"] > 0 and seen["ours"]["tuned"] > 0  # ours does both here
+    assert seen["ours-novertex"]["vertex"] == seen["ours-novertex"]["tuned"] == 0  # no vertex refinement anywhere
+    assert seen["ours-nosearchvertex"]["vertex"] == 0 and seen["ours-nosearchvertex"]["tuned"] > 0
+    assert seen["ours-notune"]["tuned"] == 0 and seen["ours-notune"]["later"] > 0 and seen["ours-notune"]["vertex"] > 0
+
+
+class _Feedback:
+    """A proposer (imperfect:mild, seed 1) recording how many earlier candidates each edge-split query shows it."""
+
+    def __init__(self):
+        from specrefine.proposers import make_proposer
+
+        self.inner, self.shown = make_proposer("imperfect:mild", seed=1), []
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+    def propose_split(self, q, w, feedback=()):
+        self.shown.append(len(feedback))
+        return self.inner.propose_split(q, w, feedback)
+
+
+@pytest.mark.parametrize("method, feedback_seen", [("ours", True), ("ours-nofeedback", False)])
+def test_the_no_feedback_control_asks_its_later_round_afresh(method, feedback_seen):
+    exp = setup("u_chain_2", agent="point", rollouts=16, seed=1)
+    proposer = _Feedback()
+    _search(method, exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze, "point", 1, 3, 2, 5, None)
+    assert len(proposer.shown) >= 2  # a later round was asked
+    assert any(n > 0 for n in proposer.shown) is feedback_seen
 
 
 def test_repair_keeps_a_split_that_ours_never_keeps(tmp_path):

@@ -7,6 +7,9 @@ rollouts, and the new candidates are tuned by the chain vertex refinement (Algor
 line 10 of Algorithm 1).  The best of the d x w candidates by product of success
 probabilities is returned.  Rounds stop early once a candidate succeeded in every rollout:
 no later candidate could be selected over it.
+
+Controls (each removes one thing): ``feedback=False`` asks the later rounds afresh, without the earlier
+candidates' results; ``tune=False`` evaluates the later rounds' candidates as proposed, without Algorithm 2.
 """
 
 from __future__ import annotations
@@ -54,7 +57,8 @@ def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
 
 
 def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = 3, d: int = 2,
-               k: int = 5, rng: np.random.Generator, picture: Callable | None = None, racing=None) -> SplitOutcome:
+               k: int = 5, rng: np.random.Generator, picture: Callable | None = None, racing=None,
+               feedback: bool = True, tune: bool = True) -> SplitOutcome:
     """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
     from ..proposers import CandidateFeedback
 
@@ -63,13 +67,16 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
     for round_ in range(d):
         if outcome.candidates and max(c.p for c in outcome.candidates) >= 1.0:
             break  # nothing can beat a candidate that never failed (max keeps the first of ties anyway)
-        feedback = [CandidateFeedback(waypoints=c.waypoints, subtask_success=c.probabilities,
+        if round_ and feedback:
+            seen = [CandidateFeedback(waypoints=c.waypoints, subtask_success=c.probabilities,
                                       image_png=picture(c) if picture else None) for c in outcome.candidates]
-        proposals = proposer.propose_split(query, w, feedback) if round_ else proposer.propose_split(query, w)
+            proposals = proposer.propose_split(query, w, seen)
+        else:
+            proposals = proposer.propose_split(query, w)
         if not proposals:
             log.info("edge split round %d: the proposer returned no valid candidate", round_ + 1)
         for waypoints in (p for p in proposals if p):
-            if round_ == 0:
+            if round_ == 0 or not tune:
                 legs = split_legs(waypoints, goal, avoid, goal_point)
                 path = estimate_legs(evaluator, start, legs)
                 outcome.evaluations += len(legs)

@@ -44,7 +44,9 @@ class SearchConfig:
     d: int = 2  # proposer rounds per edge split
     k: int = 5  # subsets sampled per vertex refinement
     edge_refinement: bool = True
-    vertex_refinement: bool = True
+    vertex_refinement: bool = True  # the search's own vertex refinements (Algorithm 3)
+    split_tuning: bool = True  # Algorithm 2 on an edge split's later-round candidates (Algorithm 1, line 10)
+    split_feedback: bool = True  # later rounds of an edge split see the earlier candidates' results
     tau0: float = 0.02
     tau_step: float = 0.02
     tau_max: float = 0.1
@@ -216,7 +218,7 @@ class RefinementSearch:
         query = self.query_for(g, u, v, self.results[(u, v)])
         outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
                              w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
-                             racing=self.racing)
+                             racing=self.racing, feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
         self._log("split-generated", edge=[u, v], candidates=[
             {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
              "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
@@ -233,7 +235,8 @@ class RefinementSearch:
             self.splits_generated += 1
             return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
                               goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=self.cfg.d, k=self.cfg.k,
-                              rng=self.rng, picture=self.picture, racing=self.racing)
+                              rng=self.rng, picture=self.picture, racing=self.racing,
+                              feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
 
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,
                           split_leg=split_leg, may_split=lambda: self.splits_generated < self.cfg.max_edge_splits)
