@@ -24,7 +24,7 @@ METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6
                   # controls of the offline comparison: a shade near the method each one varies
                   "ours-novertex": "#64b5f6", "ours-nosearchvertex": "#90caf9", "ours-notune": "#4db6ac",
                   "ours-nofeedback": "#80cbc4", "ours-d1": "#00897b", "vlm-oneshot-matched": "#ffb74d",
-                  "ours-repair": "#6a1b9a"}  # beyond the paper (refine/repair.py)
+                  "ours-repair": "#6a1b9a", "ours-shortcut": "#283593"}  # beyond the paper (refine/repair.py)
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
 EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
 _UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")

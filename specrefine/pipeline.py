@@ -40,6 +40,8 @@ METHODS = {
     "ours-d1": (True, "the paper's d = 1: no later round in an edge split (its samples, feedback and tuning)"),
     "ours-repair": (True, "beyond the paper: ours, and when no split candidate succeeds end to end, its failing "
                           "legs are split once more before it is judged (refine/repair.py)"),
+    "ours-shortcut": (True, "beyond the paper: ours, then shortcut edges over the found path's waypoints (one "
+                            "long leg where it beats several short ones; refine/shortcut.py)"),
     "vlm-oneshot": (True, "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w"),
     "vlm-oneshot-matched": (True, "control: one-shot best-of-N, spending what ours spent (proposer calls, "
                                   "subtask evaluations) on the same task and seed"),
@@ -55,6 +57,7 @@ OURS_VARIANTS = {
     "ours-nofeedback": dict(split_feedback=False),
     "ours-d1": dict(d=1),
     "ours-repair": dict(repair=True),
+    "ours-shortcut": dict(shortcut_reach="policy"),  # "policy": the agent's training goal range (below)
 }
 PROPOSER_METHODS = tuple(m for m, (asks, _) in METHODS.items() if asks)
 
@@ -149,8 +152,10 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
         cfg = SearchConfig(k=k, edge_refinement=False, seed=seed, evaluation=evaluation)
         return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
     if method in OURS_VARIANTS:
-        cfg = SearchConfig(**{"w": w, "d": d, "k": k, "seed": seed, "evaluation": evaluation,
-                              **OURS_VARIANTS[method]})
+        variant = dict(OURS_VARIANTS[method])
+        if variant.get("shortcut_reach") == "policy":  # as far as the policy was trained to reach a goal
+            variant["shortcut_reach"] = get_agent(agent).reach_task.goal_max
+        cfg = SearchConfig(**{"w": w, "d": d, "k": k, "seed": seed, "evaluation": evaluation, **variant})
         images = getattr(proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(maze, agent, evaluator.facts(), images=images)
         return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,

@@ -29,10 +29,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..graph import TaskGraph, assert_refines
-from .common import Leg, SubtaskEvaluator, estimate_legs, start_of, weight
+from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .racing import Racing
 from .repair import cheapest, repair
+from .shortcut import add_shortcuts, shortcuts
 from .vertex import refine_chain
 
 EVALUATIONS = ("fixed", "adaptive")
@@ -54,6 +55,7 @@ class SearchConfig:
     seed: int = 0
     evaluation: str = "fixed"  # "fixed": every estimate on n rollouts (the paper); "adaptive": racing.py
     repair: bool = False  # beyond the paper: split a candidate's failing legs before it is judged (repair.py)
+    shortcut_reach: float | None = None  # beyond the paper: shortcut edges up to this long on the path (shortcut.py)
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -136,6 +138,8 @@ class RefinementSearch:
                 self._relax(u, v)
             self._refine()
         path = self._trace(final)
+        if path and self.cfg.shortcut_reach:
+            path = self._shortcut(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0)
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
@@ -289,6 +293,37 @@ class RefinementSearch:
             for v in self.graph.successors(u):
                 if v not in f.closed:
                     self._relax(u, v)
+
+    # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
+    def _shortcut(self, path: list[str]) -> list[str]:
+        g, n = self.graph, self.evaluator.n
+        found = shortcuts(g, path, self.cfg.shortcut_reach, getattr(self.evaluator, "clearance", 0.0))
+        if not found:
+            return path
+        add_shortcuts(g, path, found)
+        assert_refines(g, self.original)
+        into = {j: [j - 1] + [s.i for s in found if s.j == j] for j in range(1, len(path))}
+        cost, arrivals, best = [0.0], [g.region(path[0])], {}
+        for j in range(1, len(path)):
+            options = []
+            for i in into[j]:
+                start = arrivals[i]
+                result = UNREACHED if start is None else self._evaluate(start, path[j], (path[i], path[j]))
+                options.append((cost[i] + weight(result.p, n), -i, result))
+            c, minus_i, result = min(options, key=lambda o: o[:2])  # a tie goes to the longer leg
+            cost.append(c)
+            arrivals.append(start_of(result))
+            best[j] = (-minus_i, result)
+        chosen, j = [len(path) - 1], len(path) - 1
+        while j:
+            i, result = best[j]
+            self.results[(path[i], path[j])] = result
+            chosen.append(i)
+            j = i
+        new = [path[k] for k in reversed(chosen)]
+        self._log("shortcut", added=[[path[s.i], path[s.j]] for s in found], path_before=path, path=new,
+                  probabilities=[self.results[(a, b)].p for a, b in zip(new, new[1:])])
+        return new
 
     def _trace(self, final) -> list[str] | None:
         if final is None:

@@ -1,0 +1,102 @@
+"""Shortcut edges over a found path's waypoints (beyond the paper: ours-shortcut), on hand-made graphs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from specrefine.graph import TaskGraph, check_refines
+from specrefine.refine import RefinementSearch, SearchConfig
+from specrefine.refine.shortcut import add_shortcuts, shortcuts
+from specrefine.regions import Box, Disc
+
+WALL = Box(3.5, 0.1, 4.5, 5.0)  # a wall just north of the line y = 0, around x = 4
+
+
+def split_line(points, parent_avoid=WALL):
+    """S -> x0 -> ... -> G: one split of the input edge S -> G through discs at ``points``."""
+    original = TaskGraph("S")
+    original.add_vertex("S", Disc(points[0][0], points[0][1], 0.5))
+    original.add_vertex("G", Disc(points[-1][0], points[-1][1], 0.5))
+    original.add_edge("S", "G", parent_avoid)
+    original.finals = {"G"}
+    refined = original.copy()
+    names = refined.split_edge("S", "G", [Disc(x, y, 0.3) for x, y in points[1:-1]])
+    return original, refined, ["S", *names, "G"]
+
+
+def test_shortcuts_skip_only_straight_clear_waypoints_within_reach():
+    # S (0,0) -> (2,0) -> (4,-2) -> (6,0) -> G (8,0): the wall stands above (4, 0.5..5)
+    original, refined, path = split_line([(0, 0), (2, 0), (4, -2), (6, 0), (8, 0)])
+    found = {(path[s.i], path[s.j]) for s in shortcuts(refined, path, reach=5.0, clearance=0.2)}
+    assert ("S", path[2]) in found  # (0,0) -> (4,-2): clear, 4.5 m
+    assert (path[1], path[3]) not in found  # (2,0) -> (6,0) passes 0.1 m under the wall: closer than 0.2
+    assert ("S", "G") not in found  # 8 m: beyond the reach
+    add_shortcuts(refined, path, shortcuts(refined, path, reach=5.0, clearance=0.2))
+    assert check_refines(refined, original) == []  # a shortcut is a split of the same edge with fewer waypoints
+
+
+def test_no_shortcut_over_an_original_vertex():
+    g = TaskGraph("S")
+    for name, x in (("S", 0), ("A", 2), ("G", 4)):
+        g.add_vertex(name, Disc(x, 0, 0.5))
+    g.add_edge("S", "A", WALL)
+    g.add_edge("A", "G", WALL)
+    g.finals = {"G"}
+    assert shortcuts(g, ["S", "A", "G"], reach=10.0) == []  # A is a vertex of the task, not a waypoint
+
+
+@dataclass
+class _Result:
+    p: float
+    n: int = 32
+
+    @property
+    def successes(self):
+        return round(self.p * self.n)
+
+    @property
+    def end_states(self):
+        return ("arrived", self.p)
+
+    @property
+    def ci(self):
+        return (self.p, self.p)
+
+
+class _LegsEvaluator:
+    """A leg out of S's box (the unsplit edge) fails; any other leg succeeds with 0.9: fewer legs is better."""
+
+    n, clearance = 32, 0.1
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
+        return _Result(0.9 if isinstance(start, tuple) or goal.centre()[0] < 7 else 0.0)
+
+
+class _Proposer:
+    name, is_vlm, calls = "stub", False, 0
+
+    def propose_split(self, query, w, feedback=()):
+        return [[Disc(x, y, 0.3) for x, y in ((2, 0), (4, -2), (6, -2))]]
+
+
+def _search(reach):
+    g = TaskGraph("S")
+    g.add_vertex("S", Box(-0.5, -0.5, 0.5, 0.5))
+    g.add_vertex("G", Disc(8, -2, 0.5))
+    g.add_edge("S", "G", WALL)
+    g.finals = {"G"}
+    cfg = SearchConfig(w=1, d=1, vertex_refinement=False, shortcut_reach=reach)
+    query = lambda graph, u, v, r: type("Q", (), {"goal": graph.region(v), "avoid": graph.avoid(u, v)})()
+    return g, RefinementSearch(g, _LegsEvaluator(), proposer=_Proposer(), config=cfg, query_for=query).run()
+
+
+def test_the_search_takes_a_shortcut_when_its_estimate_is_better():
+    g, plain = _search(None)
+    assert len(plain.path) == 5  # S, three waypoints, G: four legs
+    g, short = _search(5.0)
+    assert short.path[0] == "S" and short.path[-1] == "G" and len(short.path) < len(plain.path)
+    assert np.isclose(short.predicted_success, 0.9 ** (len(short.path) - 1))
+    assert check_refines(short.graph, g) == []
+    assert any(s["event"] == "shortcut" for s in short.steps)
