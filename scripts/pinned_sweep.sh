@@ -8,8 +8,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 code=${CODE:?CODE=COMMIT: the code the grid runs}
-out=${OUT:?OUT=folder of the sweep}
-shipped=${SHIPPED:?SHIPPED=the table in data/results}
+out=$(realpath -m "${OUT:?OUT=folder of the sweep}")  # absolute: the sweep runs from the worktree
+shipped=$(realpath -m "${SHIPPED:?SHIPPED=the table in data/results}")
 py=${PYTHON:-$root/.venv/bin/python}
 tree=${TREE:-$root/runs/code_$code}
 [ -d "$tree" ] || git -C "$root" worktree add -q --detach "$tree" "$code"
