@@ -30,7 +30,7 @@ import numpy as np
 
 from .figures import METHOD_COLOURS, figure4, figure5, plt, proposer_label  # plt: with the figures' backend
 from .render import PngFigure
-from .sweep import is_done
+from .sweep import is_done, mean_std
 
 COMPARISON_METHODS = ["ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"]
 ERROR_LEVELS = ["imperfect:mild", "imperfect:moderate", "imperfect:severe"]  # alpha = 0: the x axis, in order
@@ -257,15 +257,14 @@ T_975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 
 
 def mean_ci(values) -> tuple[float, float, float]:
     """Mean with a 95 % Student-t interval over seeds, clipped to [0, 1]; no interval from one seed."""
-    v = np.asarray(values, float)
-    if len(v) == 0:
+    if len(values) == 0:
         return (math.nan, math.nan, math.nan)
-    mean = float(v.mean())
-    if len(v) < 2:
+    mean, std = mean_std(values, ddof=1)  # order-free, as summary.md's means
+    if len(values) < 2:
         return (mean, mean, mean)
-    df = len(v) - 1
+    df = len(values) - 1
     t = T_975[df - 1] if df <= len(T_975) else 1.96 + (1.96**3 + 1.96) / (4 * df)  # Cornish-Fisher beyond the table
-    half = t * v.std(ddof=1) / math.sqrt(len(v))
+    half = t * std / math.sqrt(len(values))
     return (mean, max(0.0, mean - half), min(1.0, mean + half))
 
 
