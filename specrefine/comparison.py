@@ -146,7 +146,9 @@ def ratio_claim(cells, failed, proposer, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) ->
     idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(pairs), (BOOTSTRAP_RESAMPLES, len(pairs)))
     boot = _ratio(ours[idx].mean(axis=1), oneshot[idx].mean(axis=1))
     ci = _percentile_ci(boot)
-    note = "ratio undefined (0/0) in some resamples" if np.isnan(ci[0]) else ""
+    undefined = int(np.isnan(boot).sum())  # both means 0: no interval, whatever the other resamples say
+    note = f"ratio undefined (0/0: both methods at 0) in {undefined} of {BOOTSTRAP_RESAMPLES} resamples" \
+        if undefined else ""
     return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", _ratio(ours.mean(), oneshot.mean()), ci,
                   threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note)
 
