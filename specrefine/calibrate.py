@@ -134,28 +134,76 @@ def predict_run(run, maze_dir=None) -> dict:
     return {"success_rate": data["success_rate"], **prediction.to_dict()}
 
 
-def table_coverage(table) -> tuple[int, int]:
-    """``coverage`` of a predictions table (any CSV with success_rate and predicted_ci_low/high)."""
+#: What makes two rows the same run, and what a table without the column ran with: tables older than a column ran
+#: the maze's own task, the paper's fixed protocol (the only one before ``evaluation`` existed), 32 rollouts,
+#: 200 episodes and the shipped policy (the defaults of ``specrefine.sweep`` and ``specrefine.bench``). The policy is
+#: named by its fingerprint where the row has one, else by the ``policy`` column.
+RUN_IDENTITY = {"maze": None, "agent": None, "method": None, "proposer": None, "seed": None, "spec": "",
+                "evaluation": "fixed", "rollouts_per_evaluation": "32", "episodes": "200", "policy": "shipped"}
+
+
+def run_identity(row: dict, table="") -> tuple:
+    """The run a table row reports (``RUN_IDENTITY``); a row without a ``maze`` (a predictions table naming its run
+    only by ``cell``) is its own run, by table and cell."""
+    if not row.get("maze"):
+        return ("cell", str(table), row.get("cell"))
+    ident = [_canonical(row.get(k)) or default for k, default in RUN_IDENTITY.items() if k != "policy"]
+    return (*ident, row.get("policy_fingerprint") or row.get("policy") or "shipped")
+
+
+def _canonical(value) -> str:
+    """'32', '32.0' and 32 alike (csv text or typed)."""
+    text = "" if value is None else str(value)
+    try:
+        number = float(text)
+    except ValueError:
+        return text
+    return str(int(number)) if number.is_integer() else text
+
+
+def table_rows(table) -> list[dict]:
+    """The rows of a predictions table (any CSV with success_rate and predicted_ci_low/high) that have an interval."""
     import csv
 
     with open(table, newline="") as fh:
-        return coverage(list(csv.DictReader(fh)))
+        return [r for r in csv.DictReader(fh) if r.get("predicted_ci_low") not in (None, "")
+                and r.get("predicted_ci_high") not in (None, "")]
+
+
+def table_coverage(table) -> tuple[int, int]:
+    """``coverage`` of a predictions table."""
+    return coverage(table_rows(table))
+
+
+def _above_zero(rows) -> list[dict]:
+    return [r for r in rows if float(r["success_rate"]) > 0]
 
 
 def coverage_report(tables) -> str:
-    """One line per predictions table and the total."""
-    lines, inside_all, total_all = [], 0, 0
+    """One line per predictions table (its rows, and those measured above 0: success 0 predicted near 0 is covered
+    trivially), then, over all tables, the distinct runs (``run_identity``; a run in two rows or tables counts once,
+    its first row) and how many rows that dropped."""
+    lines, distinct, by_cell = [], {}, 0
     for table in tables:
-        inside, total = table_coverage(table)
-        inside_all, total_all = inside_all + inside, total_all + total
-        lines.append(f"{table}: {_covered(inside, total)}")
+        rows = table_rows(table)
+        lines.append(f"{table}: {_covered(*coverage(rows))}; above 0: {_covered(*coverage(_above_zero(rows)), False)}")
+        for r in rows:
+            ident = run_identity(r, table)
+            by_cell += ident[0] == "cell"
+            distinct.setdefault(ident, r)
     if len(lines) > 1:
-        lines.append(f"all: {_covered(inside_all, total_all)}")
+        runs = list(distinct.values())
+        dropped = sum(len(table_rows(t)) for t in tables) - len(runs)
+        lines.append(f"all, distinct runs: {_covered(*coverage(runs))}; above 0: "
+                     f"{_covered(*coverage(_above_zero(runs)), False)}; {dropped} duplicate rows dropped (same "
+                     f"{', '.join(RUN_IDENTITY)}); {by_cell} rows name their run by cell only (each counted as a run)")
     return "\n".join(lines)
 
 
-def _covered(inside: int, total: int) -> str:
-    return f"{inside}/{total} measured success rates inside predicted_ci ({inside / max(total, 1):.1%})"
+def _covered(inside: int, total: int, words: bool = True) -> str:
+    share = f"{inside}/{total}"
+    return f"{share} measured success rates inside predicted_ci ({inside / max(total, 1):.1%})" if words else \
+        f"{share} ({inside / max(total, 1):.1%})"
 
 
 def _predict_into(table, runs, maze_dir=None) -> int:

@@ -30,7 +30,7 @@ import numpy as np
 
 from .figures import METHOD_COLOURS, figure4, figure5, plt, proposer_label  # plt: with the figures' backend
 from .render import PngFigure
-from .sweep import is_done
+from .sweep import is_done, mean_std
 
 COMPARISON_METHODS = ["ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"]
 ERROR_LEVELS = ["imperfect:mild", "imperfect:moderate", "imperfect:severe"]  # alpha = 0: the x axis, in order
@@ -65,11 +65,13 @@ class Grid:
     proposers: tuple
     seeds: tuple
     levels: tuple = ()
+    contrasts: tuple = ()  # (first, second) method pairs: paired differences on the multi-room cells (descriptive)
 
 
 #: The offline comparison of docs/proposers.md (point mass, five methods, four presets, four seeds).
 POINT_GRID = Grid("point", tuple(COMPARISON_METHODS), tuple(COMPARISON_METHODS), tuple(PRESETS), SEEDS,
-                  tuple(ERROR_LEVELS))
+                  tuple(ERROR_LEVELS), (("vlm-oneshot-matched", "vlm-oneshot"), ("ours", "ours-novertex"),
+                                        ("ours", "ours-d1")))
 #: The Ant comparison of docs/ant_experiments.md section 3: the paper's methods, claims on ours and one-shot.
 ANT_GRID = Grid("ant", ("dirl", "symbolic", "vlm-oneshot", "ours"), ("ours", "vlm-oneshot"),
                 ("geometric", "imperfect:moderate"), (0, 1, 2))
@@ -144,9 +146,38 @@ def ratio_claim(cells, failed, proposer, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) ->
     idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(pairs), (BOOTSTRAP_RESAMPLES, len(pairs)))
     boot = _ratio(ours[idx].mean(axis=1), oneshot[idx].mean(axis=1))
     ci = _percentile_ci(boot)
-    note = "ratio undefined (0/0) in some resamples" if np.isnan(ci[0]) else ""
+    undefined = int(np.isnan(boot).sum())  # both means 0: no interval, whatever the other resamples say
+    note = f"ratio undefined (0/0: both methods at 0) in {undefined} of {BOOTSTRAP_RESAMPLES} resamples" \
+        if undefined else ""
     return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", _ratio(ours.mean(), oneshot.mean()), ci,
                   threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note)
+
+
+def paired_difference(cells, failed, proposer, first, second, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) -> dict:
+    """Mean of the paired success difference ``first`` - ``second`` over the (maze, seed) cells where both ran, with
+    its 95 % bootstrap interval (cells resampled); verdict ``higher`` if the interval lies above 0, ``lower`` if
+    below, else ``undecided``."""
+    diffs, missing, used_seeds = [], [], set()
+    for maze in mazes:
+        for seed in seeds:
+            pair = [cells.get((maze, m, proposer, seed)) for m in (first, second)]
+            if None in pair:
+                lacking = [m for m, v in zip((first, second), pair) if v is None]
+                missing.append(_missing_text(maze, seed, lacking, failed, proposer))
+            else:
+                diffs.append(pair[0] - pair[1])
+                used_seeds.add(seed)
+    entry = {"claim": f"{first} - {second}", "kind": "paired", "proposer": proposer, "method": first, "paper": "",
+             "n_expected": len(mazes) * len(seeds), "n_cells": len(diffs), "seeds": sorted(used_seeds),
+             "missing": missing, "complete": not missing, "note": ""}
+    if not diffs:
+        return entry | {"estimate": math.nan, "ci_low": math.nan, "ci_high": math.nan, "verdict": "undecided",
+                        "note": "no cell with both methods"}
+    d = np.array(diffs)
+    idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(d), (BOOTSTRAP_RESAMPLES, len(d)))
+    lo, hi = _percentile_ci(d[idx].mean(axis=1))
+    verdict = "higher" if lo > 0 else "lower" if hi < 0 else "undecided"
+    return entry | {"estimate": float(d.mean()), "ci_low": lo, "ci_high": hi, "verdict": verdict}
 
 
 def threshold_verdict(ci, threshold) -> str:
@@ -217,6 +248,28 @@ def claims(rows, grid: Grid = POINT_GRID) -> list[dict]:
     return out
 
 
+def contrasts(rows, grid: Grid = POINT_GRID) -> list[dict]:
+    """The grid's control contrasts (``paired_difference`` on the multi-room cells), per proposer: descriptive, not
+    claims the grid fixed."""
+    cells, failed = table_cells(rows, grid.agent)
+    return [paired_difference(cells, failed, proposer, first, second, grid.seeds)
+            for proposer in grid.proposers for first, second in grid.contrasts]
+
+
+def contrasts_markdown(entries) -> str:
+    lines = ["Control contrasts (descriptive, not claims the grid fixed): mean paired difference of success on the "
+             "multi-room (maze, seed) cells, 95 % bootstrap percentile interval (the claims' resamples and seed).", "",
+             "| proposer | difference | estimate [95 % CI] | verdict | cells (seeds) | missing |",
+             "|---|---|---|---|---|---|"]
+    for e in entries:
+        seeds = ",".join(map(str, e["seeds"])) or "none"
+        estimate = "—" if math.isnan(e["estimate"]) else \
+            f"{e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}]"
+        lines.append(f"| {e['proposer']} | {e['claim']} | {estimate} | {e['verdict']} | {e['n_cells']}/"
+                     f"{e['n_expected']} ({seeds}) | {_missing_summary(e['missing'])} |")
+    return "\n".join(lines)
+
+
 def _interval_text(entry) -> str:
     e, lo, hi = entry["estimate"], entry["ci_low"], entry["ci_high"]
     if math.isnan(e):
@@ -257,15 +310,14 @@ T_975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 
 
 def mean_ci(values) -> tuple[float, float, float]:
     """Mean with a 95 % Student-t interval over seeds, clipped to [0, 1]; no interval from one seed."""
-    v = np.asarray(values, float)
-    if len(v) == 0:
+    if len(values) == 0:
         return (math.nan, math.nan, math.nan)
-    mean = float(v.mean())
-    if len(v) < 2:
+    mean, std = mean_std(values, ddof=1)  # order-free, as summary.md's means
+    if len(values) < 2:
         return (mean, mean, mean)
-    df = len(v) - 1
+    df = len(values) - 1
     t = T_975[df - 1] if df <= len(T_975) else 1.96 + (1.96**3 + 1.96) / (4 * df)  # Cornish-Fisher beyond the table
-    half = t * v.std(ddof=1) / math.sqrt(len(v))
+    half = t * std / math.sqrt(len(values))
     return (mean, max(0.0, mean - half), min(1.0, mean + half))
 
 
@@ -421,13 +473,15 @@ def _jsonable(value):
     return value
 
 
-def write_claims(entries, out: Path, table, grid: Grid = POINT_GRID) -> None:
+def write_claims(entries, out: Path, table, grid: Grid = POINT_GRID, contrast_entries=()) -> None:
     about = {"table": str(table), "note": OFFLINE_NOTE, "agent": grid.agent,
              "multi_room_mazes": list(MULTI_ROOM_MAZES),
              "ratio_threshold": RATIO_CLAIM, "flat_tolerance": FLAT_TOLERANCE, "seeds": list(grid.seeds),
              "bootstrap_resamples": BOOTSTRAP_RESAMPLES, "bootstrap_seed": BOOTSTRAP_SEED}
-    (out / "claims.json").write_text(json.dumps(_jsonable({"about": about, "claims": entries}), indent=1) + "\n")
-    (out / "claims.md").write_text(markdown(entries) + "\n")
+    record = {"about": about, "claims": entries} | ({"contrasts": list(contrast_entries)} if contrast_entries else {})
+    (out / "claims.json").write_text(json.dumps(_jsonable(record), indent=1) + "\n")
+    extra = f"\n{contrasts_markdown(contrast_entries)}\n" if contrast_entries else ""
+    (out / "claims.md").write_text(markdown(entries) + "\n" + extra)
 
 
 def main(argv=None) -> int:
@@ -452,7 +506,7 @@ def main(argv=None) -> int:
         fig.savefig(out / f"{name}.png", dpi=110)
         plt.close(fig)
     entries = claims(rows, grid)
-    write_claims(entries, out, args.table, grid)
+    write_claims(entries, out, args.table, grid, contrasts(rows, grid))
     for seed in grid.seeds:
         table, shown, expected = seed_table(rows, grid, seed)
         contrast = "\n".join(seed_contrast(rows, grid, seed))

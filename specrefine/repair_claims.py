@@ -34,27 +34,9 @@ REPAIR_CLAIM = "ours-repair - ours"
 def paired_claim(cells: dict, failed: set, proposer: str, mazes, scope: str) -> dict:
     """Mean of the paired success difference ours-repair - ours over (maze, seed) cells; helps if its interval
     lies above 0, hurts if below."""
-    diffs, missing, seeds = [], [], set()
-    for maze in mazes:
-        for seed in SEEDS:
-            pair = [cells.get((maze, m, proposer, seed)) for m in ("ours-repair", "ours")]
-            if None in pair:
-                lacking = [m for m, v in zip(("ours-repair", "ours"), pair) if v is None]
-                missing.append(cmp._missing_text(maze, seed, lacking, failed, proposer))
-            else:
-                diffs.append(pair[0] - pair[1])
-                seeds.add(seed)
-    entry = {"claim": f"{REPAIR_CLAIM}, {scope}", "kind": "paired", "proposer": proposer, "method": "ours-repair",
-             "paper": "", "n_expected": len(mazes) * len(SEEDS), "n_cells": len(diffs), "seeds": sorted(seeds),
-             "missing": missing, "complete": not missing, "note": ""}
-    if not diffs:
-        return entry | {"estimate": float("nan"), "ci_low": float("nan"), "ci_high": float("nan"),
-                        "verdict": "undecided", "note": "no cell with both methods"}
-    d = np.array(diffs)
-    idx = np.random.default_rng(cmp.BOOTSTRAP_SEED).integers(0, len(d), (cmp.BOOTSTRAP_RESAMPLES, len(d)))
-    lo, hi = cmp._percentile_ci(d[idx].mean(axis=1))
-    verdict = "helps" if lo > 0 else "hurts" if hi < 0 else "undecided"
-    return entry | {"estimate": float(d.mean()), "ci_low": lo, "ci_high": hi, "verdict": verdict}
+    entry = cmp.paired_difference(cells, failed, proposer, "ours-repair", "ours", SEEDS, mazes)
+    verdict = {"higher": "helps", "lower": "hurts"}.get(entry["verdict"], "undecided")
+    return entry | {"claim": f"{REPAIR_CLAIM}, {scope}", "verdict": verdict}
 
 
 def as_ours(cells: dict) -> dict:

@@ -83,8 +83,9 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
     assert "/2 measured success rates inside" in out and "skipped 1 run(s) without a result.json" in out
     inside = sum(float(r["predicted_ci_low"]) <= float(r["success_rate"]) <= float(r["predicted_ci_high"])
                  for r in csv.DictReader(table.open()))
-    assert main(["--coverage", str(table), str(table)]) == 0
-    assert capsys.readouterr().out.splitlines()[-1].startswith(f"all: {2 * inside}/4 measured")
+    assert main(["--coverage", str(table), str(table)]) == 0  # the same runs twice count once
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith(f"all, distinct runs: {inside}/2 measured") and "; 2 duplicate rows dropped" in last
     elsewhere = tmp_path / "mazes"  # a result naming a maze outside data/mazes/ by its stem
     elsewhere.mkdir()
     (elsewhere / "my_maze.maze").write_bytes((MAZE_DIR / "u_chain_1.maze").read_bytes())
@@ -97,3 +98,28 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["--coverage", str(tmp_path / "nope.csv")])
     assert exit_.value.code == 2 and "no such table" in capsys.readouterr().err
+
+
+def test_coverage_counts_each_run_once_and_reports_the_runs_above_zero(tmp_path, capsys):
+    """A run shipped in two tables (an older one without the evaluation and policy columns) counts once; the runs
+    measured above 0 are reported apart (a run at 0 predicted near 0 is covered trivially)."""
+    from specrefine.calibrate import main
+
+    run = dict(maze="u_maze", agent="point", method="ours", proposer="geometric", rollouts_per_evaluation="32",
+               episodes="200", predicted_ci_low="0.9", predicted_ci_high="1.0")
+    older = [run | dict(seed="0", success_rate="0.95"), run | dict(seed="1", success_rate="0.0")]
+    newer = [run | dict(seed="0", success_rate="0.95", evaluation="fixed", policy="shipped",
+                        rollouts_per_evaluation="32.0"),
+             run | dict(seed="0", success_rate="0.5", evaluation="adaptive", policy="shipped")]
+    tables = []
+    for name, rows in (("older.csv", older), ("newer.csv", newer)):
+        tables.append(tmp_path / name)
+        with tables[-1].open("w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=sorted({k for r in rows for k in r}))
+            writer.writeheader()
+            writer.writerows(rows)
+    assert main(["--coverage", *map(str, tables)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("1/2 measured success rates inside predicted_ci (50.0%); above 0: 1/1 (100.0%)")
+    assert lines[-1].startswith("all, distinct runs: 1/3 measured") and "above 0: 1/2 (50.0%)" in lines[-1]
+    assert "1 duplicate rows dropped" in lines[-1] and "0 rows name their run by cell only" in lines[-1]

@@ -1,12 +1,12 @@
-"""README's result tables are their files' numbers: each row recomputed from the shipped table it names.
+"""README's result tables and claims are their tables' numbers: each recomputed here from the shipped CSV it names
+with the package's own functions (not read from claims.json / claims.md, which could be stale).
 
 A hand-typed or stale figure (a rounding of a rounding, a count from before a table grew) fails here naming the
-row. Only tables whose files are complete are checked; the growing Ant comparison is reported, not pinned.
+row; floats are compared as README prints them, verdicts exactly.
 """
 from __future__ import annotations
 
 import importlib.util
-import json
 import math
 import re
 from pathlib import Path
@@ -52,6 +52,16 @@ def test_point_table_is_results_csv():
         assert cells[1:] == want, maze
 
 
+def test_geometric_one_shot_matches_ours_on_every_maze_but_two_doors():
+    rows = read_table(ROOT / "data/results/results.csv")
+    means = {(s["maze"], s["method"]): s["success_mean"] for s in summarise(rows) if s["proposer"] == "geometric"}
+    gaps = {maze: abs(means[maze, "ours"] - means[maze, "vlm-oneshot"]) for maze, m in means if m == "ours"}
+    assert max(g for maze, g in gaps.items() if maze != "two_doors") <= 0.004 < gaps["two_doors"]
+    text = " ".join(README.split())
+    assert "every maze but two_doors (4-seed means within 0.004 of each other on the other 16" in text
+    assert f"{means['two_doors', 'vlm-oneshot']:.3f} against {means['two_doors', 'ours']:.3f}" in text
+
+
 def test_ant_uchain_table_is_per_maze_report():
     rows = [r for r in read_table(ROOT / "data/results/ant/comparison.csv")
             if r["method"] == "ours" and r["proposer"] == "geometric"]
@@ -67,9 +77,22 @@ def test_ant_uchain_table_is_per_maze_report():
         assert cells == report, cells[0]
 
 
-def test_offline_claims_table_is_claims_json():
-    claims = json.loads((ROOT / "data/results/imperfect/claims.json").read_text())["claims"]
-    by = {(c["proposer"], c["method"]): c for c in claims}
+def _offline():
+    """The offline comparison's claims, contrasts and multi-room means, recomputed from its table (not claims.json)."""
+    from specrefine import comparison as cmp
+    from specrefine.sweep import mean_std
+
+    rows = read_table(ROOT / "data/results/imperfect/results.csv")
+    cells, _ = cmp.table_cells(rows)
+    means = {(p, m): mean_std([cells[maze, m, p, s] for maze in cmp.MULTI_ROOM_MAZES for s in cmp.SEEDS])[0]
+             for p in cmp.PRESETS for m in cmp.COMPARISON_METHODS}
+    by = {(c["proposer"], c["method"]): c for c in cmp.claims(rows)}
+    contrasts = {(c["proposer"], c["claim"]): c for c in cmp.contrasts(rows)}
+    return by, contrasts, means
+
+
+def test_offline_claims_table_is_recomputed_from_its_table():
+    by, _, means = _offline()
     fmt = lambda c: f"{c['estimate']:.2f} [{c['ci_low']:.2f}, {c['ci_high']:.2f}]"  # noqa: E731
     table = _table_after("| preset | ours / one-shot, multi-room |")
     presets = {"mild": "imperfect:mild", "moderate": "imperfect:moderate", "severe": "imperfect:severe",
@@ -78,11 +101,60 @@ def test_offline_claims_table_is_claims_json():
     for cells in table:
         p = presets[cells[0]]
         ratio, ours, oneshot = by[p, "ours / vlm-oneshot"], by[p, "ours"], by[p, "vlm-oneshot"]
-        if all(isinstance(x, float) and math.isfinite(x) for x in (ratio["ci_low"], ratio["ci_high"])):
-            assert cells[1] == fmt(ratio) and cells[2] == ratio["verdict"], p
+        assert all(c["complete"] for c in (ratio, ours, oneshot)), p
+        if math.isfinite(ratio["estimate"]) and not math.isnan(ratio["ci_low"]):
+            assert cells[1] == fmt(ratio), p
+        elif math.isinf(ratio["estimate"]):  # the one-shot at 0 on every cell
+            assert cells[1] == "∞ (one-shot 0.000 on every multi-room cell)", p
+            assert means[p, "vlm-oneshot"] == 0
+        else:  # an interval undefined: both methods at 0 in some resamples (0/0)
+            undefined = re.search(r"in (\d+) of (\d+) resamples", ratio["note"]).groups()
+            assert cells[1] == f"{ratio['estimate']:.0f} (both methods at 0 in {int(undefined[0])} of " \
+                               f"{int(undefined[1]):,} resamples, 0/0: no interval)", p
+        assert cells[2] == ratio["verdict"], p
         assert cells[3] == fmt(ours) and cells[4] == ours["verdict"], p
         assert cells[5] == f"{fmt(oneshot)}, {oneshot['verdict']}", p
 
+
+def test_offline_means_and_contrasts_are_recomputed_from_its_table():
+    from specrefine.comparison import COMPARISON_METHODS
+
+    by, contrasts, means = _offline()
+    for preset, label in (("mild", "mild"), ("moderate", "moderate"), ("severe", "severe"),
+                          ("moderate,alpha=0.1", "moderate with alpha 0.1")):
+        line = " / ".join(f"{means['imperfect:' + preset, m]:.3f}" for m in COMPARISON_METHODS)
+        assert f"{label} {line}" in " ".join(README.split()), preset
+    matched = {p: contrasts["imperfect:" + p, "vlm-oneshot-matched - vlm-oneshot"] for p in ("mild", "moderate")}
+    text = " ".join(README.split())
+    m = matched["mild"]
+    matched_mean, oneshot_mean = means["imperfect:mild", "vlm-oneshot-matched"], means["imperfect:mild", "vlm-oneshot"]
+    assert (f"{matched_mean:.3f} against {oneshot_mean:.3f}, paired difference "
+            f"{m['estimate']:+.3f} [{m['ci_low']:+.3f}, {m['ci_high']:+.3f}]") in text
+    assert m["verdict"] == "higher" and matched["moderate"]["verdict"] == "lower"
+    m = matched["moderate"]
+    assert f"below it at moderate, {m['estimate']:.3f} [{m['ci_low']:.3f}, {m['ci_high']:.3f}]" in text
+    for p in ("severe", "moderate,alpha=0.1"):  # "level at severe and alpha 0.1"
+        assert contrasts["imperfect:" + p, "vlm-oneshot-matched - vlm-oneshot"]["verdict"] == "undecided", p
+    mild, severe = by["imperfect:mild", "ours / vlm-oneshot"], by["imperfect:severe", "ours / vlm-oneshot"]
+    assert f"at mild ({mild['estimate']:.2f}x, interval above 1 but not clear of 2" in text
+    assert mild["ci_low"] > 1 and mild["verdict"] == "undecided"
+    assert (f"at severe both are near 0 ({means['imperfect:severe', 'ours']:.3f} against "
+            f"{means['imperfect:severe', 'vlm-oneshot']:.4f}; each is above 0 in one of the 32 cells) and the verdict "
+            f"is {severe['verdict']}") in text
+
+
+def test_calibration_headline_is_the_coverage_command():
+    from specrefine.calibrate import coverage_report
+
+    command = re.search(r"python -m specrefine.calibrate --coverage\s+([^`]+)`\) the measured success", README)
+    tables = [t for pattern in command.group(1).split() for t in sorted(ROOT.glob(pattern))]
+    last = coverage_report(tables).splitlines()[-1]
+    pattern = r"all, distinct runs: (\d+/\d+) .*?\(([\d.]+)%\); above 0: (\d+/\d+) \(([\d.]+)%\); (\d+) duplicate"
+    runs, share, above, above_share, dropped = re.match(pattern, last).groups()
+    text = " ".join(README.split())
+    assert f"in **{runs.replace('/', ' of ')} distinct runs ({share} %)**" in text
+    assert f"**{above.replace('/', ' of the ')} measured above 0 ({above_share} %)**" in text
+    assert f"drops those {dropped} rows" in text
 
 
 def test_adaptive_table_is_the_bench_markdown():
@@ -109,18 +181,19 @@ def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
         assert f"<!-- ant comparison seed {seed} -->\n{table}\n\n{contrast}\n" in README, f"seed {seed}"
 
 
-def test_ant_comparison_claims_are_claims_md_of_the_complete_grid():
-    """README's Ant claims are the table of the shipped claims.md, drawn from every run of the fixed grid."""
-    from specrefine.comparison import ANT_GRID, expected_cells, grid_cells, table_cells
+def test_ant_comparison_claims_are_recomputed_from_the_complete_grid():
+    """README's Ant claims are specrefine.comparison's claims of the table, every run of the fixed grid, and the
+    shipped claims.md says the same."""
+    from specrefine.comparison import ANT_GRID, claims, expected_cells, grid_cells, markdown, table_cells
 
     rows = read_table(ROOT / "data/results/ant/comparison.csv")
     assert grid_cells(ANT_GRID) <= set(table_cells(rows, "ant")[0]), "the Ant grid is not complete"
     assert expected_cells(ANT_GRID) == 306
-    claims = json.loads((ROOT / "data/results/ant/comparison/claims.json").read_text())["claims"]
-    assert claims and all(c["complete"] for c in claims)
-    table = "\n".join(line for line in (ROOT / "data/results/ant/comparison/claims.md").read_text().splitlines()
-                      if line.startswith("|"))
+    entries = claims(rows, ANT_GRID)
+    assert entries and all(c["complete"] for c in entries)
+    table = "\n".join(line for line in markdown(entries).splitlines() if line.startswith("|"))
     assert f"<!-- ant comparison claims -->\n{table}\n" in README
+    assert table in (ROOT / "data/results/ant/comparison/claims.md").read_text()
 
 
 def test_repair_summary_is_the_repair_grid():

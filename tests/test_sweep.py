@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import os
 import shutil
 import signal
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from specrefine.policy import load_policy
 from specrefine.sweep import COLUMNS, cell_log, grid, read_table, run_sweep, summarise
 
 TINY = dict(agent="point", rollouts=8, episodes=16)
@@ -40,8 +42,18 @@ def test_table_schema_is_stable(tmp_path):
     assert row["status"] == "ok", row["error"]
     assert 0.0 <= row["success_ci_low"] <= row["success_rate"] <= row["success_ci_high"] <= 1.0
     assert row["episodes"] == 16 and row["proposer"] == "none" and row["proposer_is_vlm"] is False
+    result = json.loads((tmp_path / "cells" / row["cell"] / "result.json").read_text())
+    assert row["policy_fingerprint"] == result["policy_fingerprint"] == load_policy("point").fingerprint
     assert (tmp_path / "cells" / row["cell"] / "result.json").exists()
     assert (tmp_path / "cells" / row["cell"] / "log.txt").exists()
+
+
+def test_policy_fingerprint_is_read_as_text_and_older_tables_lack_it(tmp_path):
+    newer, older = tmp_path / "newer.csv", tmp_path / "older.csv"
+    newer.write_text("cell,seed,policy_fingerprint\r\nc,0,123e45678901\r\n")  # hex digits that parse as a float
+    older.write_text("cell,seed\r\nc,0\r\n")
+    assert read_table(newer)[0]["policy_fingerprint"] == "123e45678901"
+    assert read_table(older)[0].get("policy_fingerprint") is None
 
 
 def test_a_cells_warnings_and_log_records_go_to_its_log_file(tmp_path, capfd, caplog):
