@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -41,6 +42,7 @@ LIMITS = {
     "w": (1, 20), "d": (1, 10), "k": (1, 100), "rollouts": (1, 4096), "episodes": (1, 100_000),
     "seed": (0, MAX_SEED), "workers": (1, 256), "batch": (1, 65_536), "rounds": (1, 1000), "horizon": (1, 100_000),
     "torch_threads": (1, 256), "nthread": (1, 256), "gym_steps": (1, 10_000_000), "batches": (1, 10_000),
+    "chain": (1, 1000),
 }
 
 
@@ -70,3 +72,10 @@ def positive_float(text: str) -> float:
     if not 0 < value < float("inf"):
         raise argparse.ArgumentTypeError(f"{text} must be a finite number > 0")
     return value
+
+
+def out_path(text: str) -> Path:
+    """An argparse type for an output path: not empty (``--out ''`` would write into the current directory)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: name a folder (e.g. runs/mine)")
+    return Path(text)

@@ -8,6 +8,7 @@ weight is finite, and turns any problem into a one-line :class:`PolicyError`.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -102,14 +103,22 @@ def _resolve(path_or_agent) -> Path:
     return Path(path_or_agent)
 
 
+def safe_load(path):
+    """``torch.load`` of tensors and plain containers only (``weights_only=True``: a pickle that would run code is
+    refused, not run); torch's warnings about the file's pickle protocol are not shown."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return torch.load(path, map_location="cpu", weights_only=True)
+
+
 def load_policy(path_or_agent) -> GoalPolicy:
     """``'point'`` / ``'ant'`` (the shipped files) or a path -> :class:`GoalPolicy` in eval mode."""
     path = _resolve(path_or_agent)
     if not path.is_file():
         raise PolicyError(f"{path}: policy file not found")
     try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # truncated zip, pickle garbage, ...
+        blob = safe_load(path)
+    except Exception as e:  # noqa: BLE001 - truncated zip, pickle garbage, a pickle that needs code to load, ...
         raise PolicyError(f"{path}: not a readable policy file ({type(e).__name__})") from None
     if not isinstance(blob, dict) or blob.get("format") != FORMAT:
         raise PolicyError(f"{path}: not a specrefine policy file")
