@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, silence_stdout
+from .argtypes import OneLineParser, bounded_int, out_path, silence_stdout
 from .errors import SpecrefineError
 from .pipeline import METHODS
 
@@ -65,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
     r.add_argument("--seed", type=bounded_int("seed"), default=0,
                    help="random seed for rollouts and proposers (default: 0)")
-    r.add_argument("--out", type=Path, default=Path("runs/latest"),
+    r.add_argument("--out", type=out_path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
     r.add_argument("--rollouts", type=bounded_int("rollouts"), default=32,
                    help="rollouts per subtask evaluation (paper: 32)")

@@ -250,20 +250,22 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
             copy.metadata["specrefine"] = {"executed_copy_of": f"notebooks/{nb.name}", "commit": commit,
                                            "uncommitted_changes": dirty, "tier": tier, "parameters": params,
                                            "ok": code == 0, "wall_s": round(wall)}
-            out.write_text(nbformat.writes(copy) + "\n")
+            from .runfolder import write_atomic
+
+            write_atomic(out, nbformat.writes(copy) + "\n")
             out.with_suffix(".params.json").unlink(missing_ok=True)
     return 1 if failed else 0
 
 
 def main(argv=None) -> int:
-    import argparse
+    from .argtypes import OneLineParser, out_path
 
-    p = argparse.ArgumentParser(prog="python -m specrefine.notebook",
+    p = OneLineParser(prog="python -m specrefine.notebook",
                                 description="Executed copies of the numbered notebooks (make executed).")
     sub = p.add_subparsers(dest="command", required=True)
     ex = sub.add_parser("executed", help="run the notebooks with a tier's parameters and keep the outputs")
     ex.add_argument("--tier", choices=sorted(TIERS), default="full")
-    ex.add_argument("--out", type=Path, default=NB_DIR / "executed")
+    ex.add_argument("--out", type=out_path, default=NB_DIR / "executed")
     ex.add_argument("notebooks", nargs="*", help="stems or number prefixes (e.g. 05); default all")
     args = p.parse_args(argv)
     return write_executed(args.notebooks, args.tier, args.out)

@@ -92,9 +92,12 @@ class GoalPolicy(nn.Module):
 def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    from .runfolder import replacing
+
     state = {k: v.detach().cpu().float().clone() for k, v in policy.state_dict().items()}
-    torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
-                "act_dim": policy.act_dim, "state_dict": state, "meta": dict(meta or {})}, path)
+    with replacing(path, "wb") as fh:
+        torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
+                    "act_dim": policy.act_dim, "state_dict": state, "meta": dict(meta or {})}, fh)
 
 
 def _resolve(path_or_agent) -> Path:
@@ -131,17 +134,37 @@ def load_policy(path_or_agent) -> GoalPolicy:
     if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS and agent != path_or_agent:
         raise PolicyError(f"{path}: holds a {agent} policy, expected {path_or_agent}")
     policy = GoalPolicy(agent)
+    state = blob.get("state_dict")
+    if not isinstance(state, dict):
+        raise PolicyError(f"{path}: no weights (state_dict) in the policy file")
+    expected = policy.state_dict()
+    missing, extra = sorted(set(expected) - set(state)), sorted(set(state) - set(expected))
+    if missing or extra:
+        raise PolicyError(f"{path}: weights do not fit a {agent} policy (" + "; ".join(
+            f"{what} {', '.join(map(str, keys[:4]))}{', ...' if len(keys) > 4 else ''}"
+            for what, keys in (("missing", missing), ("unexpected", extra)) if keys) + ")")
     try:
-        policy.load_state_dict(blob["state_dict"])
+        policy.load_state_dict(state)
     except (RuntimeError, KeyError, TypeError) as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
+        first = " ".join(str(e).split()) or type(e).__name__  # torch names the tensors on its second line
+        raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:200]})") from None
     broken = [name for name, t in policy.state_dict().items() if not torch.isfinite(t).all()]
     if broken:  # it would run, driving the simulator with NaN actions (tens of thousands of MuJoCo warnings)
         raise PolicyError(f"{path}: weights hold NaN or infinite values ({', '.join(broken[:3])}"
                           f"{', ...' if len(broken) > 3 else ''}); retrain or restore the checkpoint")
+    _check_normaliser(policy.norm, path)
     policy.meta = blob.get("meta", {})
     return policy.eval()
+
+
+def _check_normaliser(norm: Normalizer, path) -> None:
+    """Finite is not enough: a negative variance (NaN square root) or a count <= 0 makes every action NaN."""
+    if (norm.var < 0).any():
+        raise PolicyError(f"{path}: the observation normaliser's variance is negative (norm.var); the policy would "
+                          "act with NaN: retrain or restore the checkpoint")
+    if not float(norm.count) > 0:
+        raise PolicyError(f"{path}: the observation normaliser's count is {float(norm.count):g} (norm.count), not > 0: "
+                          "retrain or restore the checkpoint")
 
 
 class PointController:

@@ -3,16 +3,27 @@ bad input in one line (exit 2) before any long work."""
 
 from __future__ import annotations
 
+import json
 import os
 import pickle
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 
+from specrefine import sweep
+from specrefine.cli import main as cli_main
+from specrefine.comparison import main as comparison_main
+from specrefine.errors import RunFolderError
+from specrefine.failures import main as failures_main
+from specrefine.runfolder import claim
+
 ROOT = Path(__file__).resolve().parent.parent
 TINY = ["--rollouts", "2", "--episodes", "2"]
+SWEEP = ["--methods", "dirl", "--seeds", "0", "--rollouts", "2", "--episodes", "2", "--workers", "1"]
+ROOM = "; the user's own maze\n#######\n#S.a.G#\n#######\n"
 
 
 def run_module(module: str, *args, cwd=None, env=None, timeout=120) -> subprocess.CompletedProcess:
@@ -27,6 +38,17 @@ def assert_one_line_2(proc: subprocess.CompletedProcess, needle: str = "") -> st
     err = proc.stderr.strip()
     assert proc.returncode == 2, (proc.returncode, err[-2000:])
     assert len(err.splitlines()) == 1 and "Traceback" not in err and needle in err, err[-2000:]
+    return err
+
+
+def one_line_2(main, argv, capsys) -> str:
+    """The one line on stderr of ``main(argv)`` (in-process), which must exit 2."""
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err, (code, err[-2000:])
     return err
 
 
@@ -60,3 +82,173 @@ def test_resume_from_a_foreign_checkpoint_is_one_line(tmp_path):
     torch.save({"weights": torch.zeros(3)}, tmp_path / "checkpoint.pt")  # safe to load, but not ours
     proc = run_module("specrefine.train", *TRAIN_TINY, "--out", tmp_path, "--resume")
     assert "KeyError" not in assert_one_line_2(proc, "not a trainer checkpoint")
+
+
+# --- the run folder's lock holds under a race -------------------------------------------------------------
+RACERS = 4
+
+
+def _race(out, barrier, tried, held, outcomes):
+    """Released together with the other racers: try to claim ``out``; a holder keeps the lock until every racer
+    has tried, so that a second holder could not hide behind the first one's release."""
+    barrier.wait()
+    try:
+        with claim(out, {"race": 1}):
+            with held.get_lock():
+                held.value += 1
+            with tried.get_lock():
+                tried.value += 1
+            deadline = time.time() + 20
+            while tried.value < RACERS and time.time() < deadline:
+                time.sleep(0.005)
+        outcomes.put("held")
+    except RunFolderError:
+        with tried.get_lock():
+            tried.value += 1
+        outcomes.put("refused")
+
+
+@pytest.mark.parametrize("stale", [False, True], ids=["fresh", "stale-lock"])
+def test_the_run_folder_lock_has_one_holder_under_a_barrier_race(tmp_path, stale):
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    for attempt in range(20):
+        out = tmp_path / f"run{attempt}"
+        out.mkdir()
+        if stale:  # left by a killed run: its pid is gone
+            (out / ".lock").write_text(f"{dead.pid}\n")
+        barrier, tried, held, outcomes = ctx.Barrier(RACERS), ctx.Value("i", 0), ctx.Value("i", 0), ctx.Queue()
+        procs = [ctx.Process(target=_race, args=(out, barrier, tried, held, outcomes)) for _ in range(RACERS)]
+        for proc in procs:
+            proc.start()
+        for proc in procs:
+            proc.join(60)
+        results = sorted(outcomes.get(timeout=5) for _ in procs)
+        assert held.value == 1 and results == ["held"] + ["refused"] * (RACERS - 1), (attempt, results)
+        assert not (out / ".lock").exists()
+
+
+# --- lost or wrong data ---------------------------------------------------------------------------------
+def refine_args(out, *args, maze="u_maze"):
+    return ["refine", maze, "--method", "dirl", "--out", str(out), *TINY, *args]
+
+
+def test_a_rerun_stopped_midway_keeps_the_finished_runs_record(tmp_path, monkeypatch):
+    import specrefine.pipeline as pipeline
+
+    assert cli_main(refine_args(tmp_path, maze="u_chain_1")) == 0
+    before = {name: (tmp_path / name).read_bytes() for name in ("steps.jsonl", "result.json", "run.json")}
+    real = pipeline._search
+
+    def stopped(*args, **kw):  # the rerun logs a step, then is stopped (as by a kill) before it finishes
+        args[10]({"step": 0, "event": "expand"})
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pipeline, "_search", stopped)
+    assert cli_main(refine_args(tmp_path, maze="u_chain_1")) == 130
+    monkeypatch.setattr(pipeline, "_search", real)
+    assert {name: (tmp_path / name).read_bytes() for name in before} == before
+    assert not [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]  # no temporary file left behind
+
+
+def test_a_malformed_row_in_a_sweep_table_is_named_and_nothing_is_run(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert sweep.main(["--mazes", "u_maze", "--out", str(out), *SWEEP, "--seeds", "0", "1"]) == 0
+    table = out / "results.csv"
+    lines = table.read_text().splitlines(keepends=True)
+    lines.insert(1, lines[1].replace(",ok,", ',"ok,', 1))  # an unterminated quote before the finished rows
+    table.write_text("".join(lines))
+    broken = table.read_bytes()
+    capsys.readouterr()
+    err = one_line_2(sweep.main, ["--mazes", "u_maze", "--out", str(out), *SWEEP, "--seeds", "0", "1"], capsys)
+    assert f"{table}:2: a malformed row" in err
+    assert table.read_bytes() == broken  # nothing appended, dropped or rerun
+
+
+@pytest.mark.parametrize("command", ["refine", "sweep", "failures", "comparison"])
+def test_an_empty_out_is_refused(tmp_path, monkeypatch, capsys, command):
+    monkeypatch.chdir(tmp_path)
+    argv = {"refine": (cli_main, refine_args("")), "sweep": (sweep.main, ["--mazes", "u_maze", "--out", "", *SWEEP]),
+            "failures": (failures_main, ["result.json", "--out", ""]),
+            "comparison": (comparison_main, ["results.csv", "--out", ""])}[command]
+    assert "an empty path" in one_line_2(*argv, capsys)
+    assert list(tmp_path.iterdir()) == []  # nothing written where the user stands
+
+
+@pytest.mark.parametrize("tensor,value,needle", [("norm.var", -1.0, "variance is negative"),
+                                                 ("norm.count", 0.0, "count is 0")])
+def test_a_policy_with_an_unusable_normaliser_is_refused_at_load(tmp_path, monkeypatch, capsys, tensor, value,
+                                                                  needle):
+    import torch
+
+    from specrefine.policy import GoalPolicy, save_policy
+
+    policy = GoalPolicy("point")
+    with torch.no_grad():
+        policy.get_buffer(tensor).fill_(value)
+    save_policy(policy, tmp_path / "broken.pt")
+    monkeypatch.chdir(tmp_path)
+    assert needle in one_line_2(cli_main, refine_args(tmp_path / "o", "--policy", str(tmp_path / "broken.pt")), capsys)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists() and not (tmp_path / "o" / "run.json").exists()
+
+
+def test_a_policy_missing_weights_is_refused_naming_them(tmp_path, capsys):
+    import torch
+
+    from specrefine.policy import GoalPolicy, save_policy
+
+    save_policy(GoalPolicy("point"), tmp_path / "p.pt")
+    blob = torch.load(tmp_path / "p.pt", weights_only=True)
+    del blob["state_dict"]["net.2.weight"], blob["state_dict"]["norm.mean"]
+    torch.save(blob, tmp_path / "p.pt")
+    err = one_line_2(cli_main, refine_args(tmp_path / "o", "--policy", str(tmp_path / "p.pt")), capsys)
+    assert "missing net.2.weight, norm.mean" in err
+
+
+def test_a_policy_acting_with_nan_stops_the_run_without_a_mujoco_log(tmp_path, monkeypatch):
+    import numpy as np
+
+    from specrefine.errors import PolicyError
+    from specrefine.evaluate import Evaluator
+    from specrefine.mazes import load_maze
+
+    monkeypatch.chdir(tmp_path)
+    maze = load_maze("u_maze")
+    ev = Evaluator(maze, "point", lambda obs: np.full((len(obs), 2), np.nan), n=4)
+    with pytest.raises(PolicyError, match="NaN"):
+        ev.evaluate(maze.start, maze.goal, maze.walls)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sim_steps_mean_the_same_in_a_run_a_resumed_run_and_a_sweep_cell(tmp_path):
+    assert cli_main(refine_args(tmp_path / "run", maze="u_chain_1")) == 0
+    first = json.loads((tmp_path / "run" / "result.json").read_text())
+    (tmp_path / "run" / "result.json").unlink()  # as after a kill before the end: the cache is kept
+    assert cli_main(refine_args(tmp_path / "run", maze="u_chain_1")) == 0
+    resumed = json.loads((tmp_path / "run" / "result.json").read_text())
+    assert sweep.main(["--mazes", "u_chain_1", "--out", str(tmp_path / "s"), *SWEEP]) == 0
+    (cell,) = sweep.read_table(tmp_path / "s" / "results.csv")
+    assert first["sim_steps"] == first["sim_steps_simulated"] > 0
+    assert resumed["sim_steps"] == first["sim_steps"] == cell["sim_steps"]
+    assert resumed["sim_steps_simulated"] < resumed["sim_steps"]  # the search's evaluations came from the cache
+    assert resumed["success_rate"] == first["success_rate"]
+
+
+def test_failures_with_zero_episodes_is_refused(tmp_path, capsys):
+    assert "out of range" in one_line_2(failures_main, [str(tmp_path / "result.json"), "--episodes", "0"], capsys)
+
+
+def test_a_finished_run_of_the_users_own_maze_is_reopened_from_its_record(tmp_path, capsys):
+    from specrefine.calibrate import main as calibrate_main
+
+    maze = tmp_path / "mine.maze"
+    maze.write_text(ROOM)
+    assert cli_main(["refine", str(maze), "--method", "ours", "--out", str(tmp_path / "run"), *TINY]) == 0
+    maze.unlink()  # the record alone must do
+    capsys.readouterr()
+    assert failures_main([str(tmp_path / "run" / "result.json"), "--episodes", "4"]) == 0, capsys.readouterr().err
+    assert calibrate_main([str(tmp_path / "run"), "--table", str(tmp_path / "p.csv")]) == 0, capsys.readouterr().err
+    assert sweep.read_table(tmp_path / "p.csv")[0]["cell"] == "run"

@@ -7,7 +7,7 @@ import sys
 import warnings
 
 from ..agents import AGENTS
-from ..argtypes import OneLineParser, bounded_int, positive_float
+from ..argtypes import OneLineParser, bounded_int, out_path, positive_float
 from . import __doc__ as package_doc
 
 
@@ -40,7 +40,7 @@ def main(argv=None) -> int:
     r.add_argument("--method", default="ours")
     r.add_argument("--proposer", default="geometric")
     r.add_argument("--episodes", type=bounded_int("episodes"), default=200)
-    r.add_argument("--table", default=None, help="CSV the rows are appended to (and resumed from)")
+    r.add_argument("--table", type=out_path, default=None, help="CSV the rows are appended to (and resumed from)")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore")
     from . import bench_evaluator, bench_gymenv, bench_refinement, bench_train
