@@ -13,29 +13,11 @@ import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, out_path, silence_stdout
+from .argtypes import OneLineParser, bounded_int, out_path, proposer_arg, silence_stdout
 from .errors import SpecrefineError
 from .pipeline import METHODS
 
 AGENTS = tuple(_AGENT_REGISTRY)
-
-
-def proposer_arg(text: str) -> str:
-    kind, _, rest = text.partition(":")
-    if kind in ("geometric", "random") and not rest:
-        return text
-    if kind in ("replay", "litellm") and rest:
-        return text
-    if kind == "imperfect" and rest:
-        from .proposers.imperfect import parse_imperfect
-
-        try:
-            parse_imperfect(rest)
-        except SpecrefineError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-        return text
-    raise argparse.ArgumentTypeError(
-        f"invalid proposer {text!r}: use geometric, random, imperfect:PRESET, replay:PATH or litellm:MODEL")
 
 
 _OneLineParser = OneLineParser  # the name other modules and tests know

@@ -70,6 +70,64 @@ def record(name: str, value, *, tol: float | None = None, rel: float | None = No
     return value
 
 
+#: a notebook parameter -> the command-line rule it follows: a LIMITS name (argtypes), or "agent", "method",
+#: "proposer" (a list of them for the plural names)
+PARAMETER_RULES = {"ROLLOUTS": "rollouts", "EPISODES": "episodes", "EVAL_EPISODES": "episodes", "SEED": "seed",
+                   "SEEDS": ["seed"], "W": "w", "D": "d", "K": "k", "WORKERS": "workers", "CHAIN": "chain",
+                   "AGENT": "agent", "METHOD": "method", "METHODS": ["method"], "PROPOSER": "proposer",
+                   "PROPOSERS": ["proposer"]}
+
+
+def check_parameters(params: dict) -> None:
+    """A notebook's parameters (its ``globals()`` after the parameters cell) checked by the command line's rules
+    (``specrefine refine`` / ``python -m specrefine.sweep``): a bad value is a one-line
+    :class:`~specrefine.errors.SpecrefineError` naming the parameter, before the notebook does any work."""
+    for name, rule in PARAMETER_RULES.items():
+        if name not in params:
+            continue
+        value = params[name]
+        if isinstance(rule, list):
+            if not isinstance(value, (list, tuple)) or not value:
+                raise _bad(name, value, "a non-empty list")
+            for item in value:
+                _check_value(name, item, rule[0])
+        else:
+            _check_value(name, value, rule)
+
+
+def _check_value(name: str, value, rule: str) -> None:
+    import argparse
+
+    from .agents import AGENTS
+    from .argtypes import LIMITS, bounded_int, proposer_arg
+    from .pipeline import METHODS
+
+    if rule in LIMITS:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise _bad(name, value, "a whole number")
+        check = bounded_int(rule)
+    else:
+        names = {"agent": AGENTS, "method": METHODS}.get(rule)
+
+        def check(text):
+            if names is not None and text not in names:
+                raise argparse.ArgumentTypeError(f"use one of {', '.join(names)}")
+            return proposer_arg(text) if rule == "proposer" else text
+
+        if not isinstance(value, str):
+            raise _bad(name, value, "a string")
+    try:
+        check(str(value))
+    except argparse.ArgumentTypeError as exc:
+        raise _bad(name, value, str(exc)) from None
+
+
+def _bad(name: str, value, why: str):
+    from .errors import SpecrefineError
+
+    return SpecrefineError(f"notebook parameter {name} = {value!r}: {why}")
+
+
 def read_records(notebook) -> dict:
     """``{name: {"value", "tol", "rel", "package"}}`` from an executed notebook (a path or an nbformat node)."""
     import nbformat

@@ -52,7 +52,7 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from .agents import AGENTS
-from .argtypes import OneLineParser, bounded_int, out_path
+from .argtypes import OneLineParser, bounded_int, maze_problem, out_path, proposer_arg
 from .errors import SpecrefineError, SweepError
 from .paths import regular_file
 from .runfolder import replacing, write_atomic
@@ -523,6 +523,7 @@ def _check_policy(policy: str, agent: str) -> str | None:
 
 def main(argv=None) -> int:
     from .mazes import benchmark_mazes
+    from .pipeline import METHODS
 
     p = OneLineParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
     p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
@@ -530,8 +531,8 @@ def main(argv=None) -> int:
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
                    help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
                         "'' = the maze's own task; default: the maze's own task)")
-    p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
-    p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"])
+    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
     p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
@@ -552,7 +553,7 @@ def main(argv=None) -> int:
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                  episodes=args.episodes, specs=args.specs, evaluation=args.evaluation,
                  policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
-    bad = _check_specs(cells) or _check_policy(args.policy, args.agent)
+    bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
         return _fail(bad, 2)
     t0 = time.time()

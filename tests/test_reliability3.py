@@ -252,3 +252,122 @@ def test_a_finished_run_of_the_users_own_maze_is_reopened_from_its_record(tmp_pa
     assert failures_main([str(tmp_path / "run" / "result.json"), "--episodes", "4"]) == 0, capsys.readouterr().err
     assert calibrate_main([str(tmp_path / "run"), "--table", str(tmp_path / "p.csv")]) == 0, capsys.readouterr().err
     assert sweep.read_table(tmp_path / "p.csv")[0]["cell"] == "run"
+
+
+# --- hangs: a FIFO is no input file ------------------------------------------------------------------------
+def test_a_fifo_given_as_an_input_file_is_refused_without_opening_it(tmp_path):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    for module, args, needle in [
+            ("specrefine.cli", ["refine", fifo, "--out", tmp_path / "o1", *TINY], "a FIFO"),
+            ("specrefine.cli", ["refine", "u_maze", "--policy", fifo, "--out", tmp_path / "o2", *TINY], "policy"),
+            ("specrefine.cli", ["refine", "u_maze", "--proposer", f"replay:{fifo}", "--out", tmp_path / "o3", *TINY],
+             "a FIFO"),
+            ("specrefine.comparison", [fifo, "--out", tmp_path / "o4"], "a FIFO"),
+            ("specrefine.failures", [fifo], "a FIFO")]:
+        assert_one_line_2(run_module(module, *args, timeout=60), needle)  # a hang would time out
+
+
+# --- tracebacks and exit codes: one line, exit 2, before any long work ------------------------------------
+def test_a_spec_nested_too_deep_is_one_line(tmp_path, capsys):
+    deep = "(" * 330 + "G" + ")" * 330
+    assert "nested more than 100 deep" in one_line_2(cli_main, refine_args(tmp_path / "o", "--spec", deep), capsys)
+    maze = tmp_path / "deep.maze"
+    maze.write_text(f"; spec: {deep}\n#####\n#S.G#\n#####\n")
+    assert "nested more than 100 deep" in one_line_2(cli_main, ["refine", str(maze), "--out", str(tmp_path / "p")],
+                                                     capsys)
+
+
+def test_calibrate_bad_input_is_one_line_exit_2(tmp_path, capsys):
+    from specrefine.calibrate import main as calibrate_main
+
+    (tmp_path / "list").mkdir()
+    (tmp_path / "list" / "result.json").write_text("[]")
+    (tmp_path / "empty.json").write_text("")
+    (tmp_path / "binary.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff")
+    (tmp_path / "garbage.csv").write_text("a,b\n1,2\n")
+    (tmp_path / "none.csv").write_text("")
+    table = ["--table", str(tmp_path / "t.csv")]
+    assert "a JSON list" in one_line_2(calibrate_main, [str(tmp_path / "list"), *table], capsys)
+    assert "empty.json" in one_line_2(calibrate_main, [str(tmp_path / "empty.json"), *table], capsys)
+    for name, needle in [("binary.csv", "not UTF-8"), ("garbage.csv", "not a predictions table"),
+                         ("none.csv", "empty")]:
+        assert needle in one_line_2(calibrate_main, ["--coverage", str(tmp_path / name)], capsys)
+
+
+def test_failures_bad_input_is_one_line_exit_2_before_the_rerun(tmp_path, capsys):
+    result = tmp_path / "result.json"
+    result.write_text(json.dumps({"maze": "u_maze", "agent": "point", "path": ["S", "G"], "graph": {"nodes": 1}}))
+    assert "malformed" in one_line_2(failures_main, [str(result), "--episodes", "2"], capsys)
+    assert "out of range" in one_line_2(failures_main, [str(result), "--episodes", "-5"], capsys)
+    (tmp_path / "file").write_text("")
+    assert "not a directory" in one_line_2(failures_main, [str(result), "--out", str(tmp_path / "file" / "r.json")],
+                                           capsys)
+
+
+def test_comparison_bad_input_is_one_line_exit_2(tmp_path, capsys):
+    (tmp_path / "binary.csv").write_bytes(b"\x00\x01\xff" * 50)
+    (tmp_path / "file").write_text("")
+    row = {k: "1" for k in sweep.COLUMNS} | {"cell": "c", "status": "ok", "success_rate": "high"}
+    sweep._append(tmp_path / "words.csv", row)
+    sweep._append(tmp_path / "fine.csv", row | {"success_rate": "0.5"})
+    assert "not UTF-8" in one_line_2(comparison_main, [str(tmp_path / "binary.csv"), "--out", str(tmp_path / "o")],
+                                     capsys)
+    assert "not a directory" in one_line_2(comparison_main, [str(tmp_path / "fine.csv"), "--out",
+                                                             str(tmp_path / "file")], capsys)
+    assert "success_rate is 'high', not a number" in one_line_2(
+        comparison_main, [str(tmp_path / "words.csv"), "--out", str(tmp_path / "o")], capsys)
+
+
+@pytest.mark.parametrize("args,needle", [(["--method", "best"], "invalid choice"),
+                                         (["--proposer", "gpt"], "invalid proposer"),
+                                         (["--mazes", "no_such_maze"], "no_such_maze"),
+                                         (["--table", "{tmp}"], "is a folder")])
+def test_bench_refine_bad_input_is_one_line_before_any_setup(tmp_path, capsys, args, needle):
+    from specrefine.bench.__main__ import main as bench_main
+
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    assert needle in one_line_2(bench_main, ["refine", "--agent", "point", "--episodes", "2", *args], capsys)
+
+
+def test_a_bad_mplbackend_is_one_line_before_any_work(tmp_path):
+    proc = run_module("specrefine.cli", *refine_args(tmp_path / "o"), env={"MPLBACKEND": "nonsense"})
+    assert_one_line_2(proc, "MPLBACKEND='nonsense' is not a matplotlib backend")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("name,value", [("ROLLOUTS", -1), ("ROLLOUTS", 0), ("SEEDS", [0, -2]), ("AGENT", "walker"),
+                                        ("PROPOSER", "gpt"), ("EPISODES", 2.5)])
+def test_notebook_parameters_are_checked_by_the_cli_rules(name, value):
+    from specrefine.errors import SpecrefineError
+    from specrefine.notebook import check_parameters
+
+    with pytest.raises(SpecrefineError, match=f"notebook parameter {name} = "):
+        check_parameters({"ROLLOUTS": 8, "SEED": 0, name: value})
+    check_parameters({"ROLLOUTS": 8, "SEEDS": [0, 1], "AGENT": "ant", "PROPOSER": "imperfect:mild"})  # all fine
+
+
+def test_a_notebook_run_with_rollouts_0_names_the_parameter(tmp_path):
+    from specrefine.notebook import NB_DIR, execute, kernel_env
+
+    env = kernel_env(tmp_path / "k")
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
+    code, log = execute(NB_DIR / "02_task_graphs_and_evaluation.ipynb", tmp_path / "nb.ipynb", {"ROLLOUTS": 0},
+                        env=env, timeout=300)
+    assert code != 0 and "notebook parameter ROLLOUTS = 0" in log, log[-3000:]
+    assert "negative dimensions" not in log and "ZeroDivisionError" not in log
+
+
+def test_every_proposer_the_library_accepts_the_cli_accepts(tmp_path, capsys):
+    assert cli_main(refine_args(tmp_path / "o", "--method", "ours", "--proposer", "geometric:max_waypoints=48")) == 0
+    assert json.loads((tmp_path / "o" / "result.json").read_text())["proposer"] == "geometric:max_waypoints=48"
+
+
+@pytest.mark.parametrize("args,needle", [(["--methods", "nonsense"], "invalid choice"),
+                                         (["--proposers", "gpt"], "invalid proposer"),
+                                         (["--mazes", "no_such_maze"], "no_such_maze")])
+def test_a_sweep_with_a_bad_method_proposer_or_maze_is_refused_before_any_cell(tmp_path, capsys, args, needle):
+    base = ["--mazes", "u_maze", "--methods", "ours", "--seeds", "0", "--rollouts", "2", "--episodes", "2",
+            "--workers", "1", "--out", str(tmp_path / "s")]
+    assert needle in one_line_2(sweep.main, base + args, capsys)
+    assert not (tmp_path / "s").exists()
