@@ -371,3 +371,53 @@ def test_a_sweep_with_a_bad_method_proposer_or_maze_is_refused_before_any_cell(t
             "--workers", "1", "--out", str(tmp_path / "s")]
     assert needle in one_line_2(sweep.main, base + args, capsys)
     assert not (tmp_path / "s").exists()
+
+
+# --- kill anywhere: every folder complete and parseable, or resumable to the same result --------------------
+KILL_RUN = ["refine", "u_chain_1", "--method", "ours", "-w", "1", "-d", "1", "--rollouts", "4", "--episodes", "8"]
+KILLS = int(os.environ.get("KILL_N", "3"))  # per kind of run; KILL_N=50 searches longer
+
+
+def _record(folder: Path) -> dict | None:
+    """result.json's data (None where there is none), after checking that every record file in the folder parses:
+    no 0-byte file, no cut line, steps.jsonl beside every result.json."""
+    for name in ("run.json", "result.json", "steps.jsonl"):
+        path = folder / name
+        assert not path.exists() or path.stat().st_size > 0, f"{path} is empty"
+    if (folder / "run.json").exists():
+        json.loads((folder / "run.json").read_text())
+    if not (folder / "result.json").exists():
+        return None
+    steps = (folder / "steps.jsonl").read_text().splitlines()
+    assert all(isinstance(json.loads(line), dict) for line in steps)
+    return json.loads((folder / "result.json").read_text()) | {"_steps": len(steps)}
+
+
+def test_a_run_killed_anywhere_is_complete_or_resumes_to_the_same_result(tmp_path):
+    import random
+    import shutil
+    import signal
+
+    reference = tmp_path / "reference"
+    assert cli_main([*KILL_RUN, "--out", str(reference)]) == 0
+    want = _record(reference)
+    rng = random.Random(29)
+    for i in range(2 * KILLS):
+        folder = tmp_path / f"kill{i}"
+        rerun = i % 2 == 1  # every other one: a rerun into a finished folder
+        if rerun:
+            shutil.copytree(reference, folder)
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+        proc = subprocess.Popen([sys.executable, "-m", "specrefine.cli", *KILL_RUN, "--out", str(folder)], env=env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(rng.uniform(0.3, 5.0))  # from the interpreter's start to past the run's end
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=60)
+        got = _record(folder)
+        if rerun:
+            assert got is not None  # the finished run's record is never lost
+        if got is None:  # resumable: a rerun finishes with the same result
+            assert cli_main([*KILL_RUN, "--out", str(folder)]) == 0
+            got = _record(folder)
+        assert (got["success_rate"], got["_steps"], got["sim_steps"]) == \
+            (want["success_rate"], want["_steps"], want["sim_steps"]), (i, rerun)
