@@ -11,13 +11,34 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line (no usage block), still exit code 2."""
+    """argparse, but a usage error is one line (no usage block), still exit code 2; the environment the commands
+    depend on is checked with the arguments, before any work (``MPLBACKEND``, read when matplotlib is imported)."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+    def parse_args(self, args=None, namespace=None):
+        parsed = super().parse_args(args, namespace)
+        problem = environment_problem()
+        if problem:
+            self.exit(2, f"{self.prog}: error: {problem}\n")
+        return parsed
+
+
+def environment_problem() -> str | None:
+    """One line on what in the environment would make a command fail midway (None: nothing)."""
+    backend = os.environ.get("MPLBACKEND")
+    if backend is None:
+        return None
+    try:
+        import matplotlib  # noqa: F401 - importing it validates MPLBACKEND
+    except ValueError:
+        return f"MPLBACKEND={backend!r} is not a matplotlib backend: unset it or name one (e.g. Agg)"
+    return None
 
 
 def exit_code_quiet_on_broken_pipe(main, *args) -> int:
@@ -41,6 +62,7 @@ LIMITS = {
     "w": (1, 20), "d": (1, 10), "k": (1, 100), "rollouts": (1, 4096), "episodes": (1, 100_000),
     "seed": (0, MAX_SEED), "workers": (1, 256), "batch": (1, 65_536), "rounds": (1, 1000), "horizon": (1, 100_000),
     "torch_threads": (1, 256), "nthread": (1, 256), "gym_steps": (1, 10_000_000), "batches": (1, 10_000),
+    "chain": (1, 1000),
 }
 
 
@@ -70,3 +92,37 @@ def positive_float(text: str) -> float:
     if not 0 < value < float("inf"):
         raise argparse.ArgumentTypeError(f"{text} must be a finite number > 0")
     return value
+
+
+def out_path(text: str) -> Path:
+    """An argparse type for an output path: not empty (``--out ''`` would write into the current directory)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: name a folder (e.g. runs/mine)")
+    return Path(text)
+
+
+def proposer_arg(text: str) -> str:
+    """An argparse type: any proposer the library accepts (its one parser, ``proposers.factory.parse_proposer``)."""
+    from .errors import SpecrefineError
+    from .proposers.factory import parse_proposer
+
+    try:
+        parse_proposer(text)
+    except SpecrefineError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def maze_problem(mazes) -> str | None:
+    """The first maze argument (a name, a file, or ``MAZE=SPEC``) that does not load, as one line (None: all do)."""
+    from .errors import SpecrefineError
+    from .mazes import load_maze
+    from .spec import maze_task
+
+    for arg in mazes:
+        maze, _, spec = str(arg).partition("=")
+        try:
+            maze_task(load_maze(maze), spec.strip() or None)
+        except SpecrefineError as exc:
+            return str(exc)
+    return None

@@ -22,6 +22,7 @@ The held-out episodes run on a copy of the evaluator, so the run's own counters 
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -113,23 +114,12 @@ def predict_run(run, maze_dir=None) -> dict:
     ``maze_dir``: where to find a maze the result names by its stem when it is not in ``data/mazes/``
     (e.g. ``data/mazes/unseen``).
     """
-    import json
-
     from .experiment import setup
-    from .graph import TaskGraph
 
-    path = result_file(run)
-    data = json.loads(path.read_text())
-    run_json = path.with_name("run.json") if path.name == "result.json" else None
-    args = json.loads(run_json.read_text()) if run_json and run_json.exists() else {}
-    if args.get("policy", "shipped") != "shipped":
-        raise ValueError(f"{path}: made with policy {args['policy']!r}; only shipped-policy runs are redone")
-    maze = data["maze"]
-    if maze_dir is not None and (Path(maze_dir) / f"{maze}.maze").is_file():
-        maze = Path(maze_dir) / f"{maze}.maze"
+    path, data, args, maze = checked_run(run, maze_dir)
     exp = setup(maze, agent=data["agent"], seed=int(data["seed"]),
                 rollouts=int(data["rollouts_per_evaluation"]), spec=args.get("spec"))
-    graph, original = TaskGraph.from_dict(data["graph"]), TaskGraph.from_dict(data["input_graph"])
+    graph, original = data["graph"], data["input_graph"]
     prediction = predict(exp.evaluator, original, graph, data["path"], int(data["seed"]), int(data["episodes"]))
     return {"success_rate": data["success_rate"], **prediction.to_dict()}
 
@@ -161,22 +151,68 @@ def _canonical(value) -> str:
     return str(int(number)) if number.is_integer() else text
 
 
-def table_rows(table) -> list[dict]:
-    """The rows of a predictions table (any CSV with success_rate and predicted_ci_low/high) that have an interval."""
-    import csv
+def _above_zero(rows) -> list[dict]:
+    return [r for r in rows if float(r["success_rate"]) > 0]
 
-    with open(table, newline="") as fh:
-        return [r for r in csv.DictReader(fh) if r.get("predicted_ci_low") not in (None, "")
-                and r.get("predicted_ci_high") not in (None, "")]
+
+NEEDED = ("success_rate", "seed", "rollouts_per_evaluation", "episodes", "path", "graph", "input_graph")
+
+
+def checked_run(run, maze_dir=None):
+    """(result file, its data with the graphs built, run.json's arguments, the maze) of a finished run, checked
+    before any simulation: anything unusable is a one-line :class:`~specrefine.errors.SpecrefineError`."""
+    import json
+
+    from .errors import SpecrefineError
+    from .failures import read_result
+    from .graph import TaskGraph
+    from .mazes import load_maze
+    from .runfolder import recorded_maze
+
+    path = result_file(run)
+    data = read_result(path)
+    missing = [key for key in NEEDED if key not in data]
+    if missing:
+        raise SpecrefineError(f"{path}: result.json lacks {', '.join(missing)}")
+    run_json = path.with_name("run.json") if path.name == "result.json" else None
+    try:
+        args = json.loads(run_json.read_text()) if run_json and run_json.is_file() else {}
+    except (OSError, ValueError):
+        raise SpecrefineError(f"{run_json}: unreadable run record") from None
+    if not isinstance(args, dict):
+        raise SpecrefineError(f"{run_json}: unreadable run record")
+    if args.get("policy", "shipped") != "shipped":
+        raise SpecrefineError(f"{path}: made with policy {args['policy']!r}; only shipped-policy runs are redone")
+    maze = recorded_maze(path, data["maze"], maze_dir)
+    try:
+        data = {**data, "graph": TaskGraph.from_dict(data["graph"]),
+                "input_graph": TaskGraph.from_dict(data["input_graph"])}
+        int(data["seed"]), int(data["rollouts_per_evaluation"]), int(data["episodes"]), float(data["success_rate"])
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SpecrefineError(f"{path}: a malformed result.json ({type(exc).__name__}: {exc})") from None
+    return path, data, args, maze if not isinstance(maze, (str, Path)) else load_maze(maze)
+
+
+def table_rows(table) -> list[dict]:
+    """The rows of a predictions table (any CSV with success_rate and predicted_ci_low/high) that have an interval;
+    a table that does not parse, or holds no such row, is a one-line :class:`~specrefine.errors.SpecrefineError`."""
+    from .errors import SpecrefineError
+    from .sweep import read_checked_table
+
+    rows = [r for r in read_checked_table(table) if r.get("predicted_ci_low") not in (None, "")
+            and r.get("predicted_ci_high") not in (None, "")]
+    if not rows:
+        raise SpecrefineError(f"{table}: no row with success_rate and predicted_ci_low/high: not a predictions table")
+    try:
+        coverage(rows)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SpecrefineError(f"{table}: a row without a numeric success_rate or predicted_ci ({exc})") from None
+    return rows
 
 
 def table_coverage(table) -> tuple[int, int]:
-    """``coverage`` of a predictions table."""
+    """``coverage`` of a predictions table (``table_rows``)."""
     return coverage(table_rows(table))
-
-
-def _above_zero(rows) -> list[dict]:
-    return [r for r in rows if float(r["success_rate"]) > 0]
 
 
 def coverage_report(tables) -> str:
@@ -225,6 +261,11 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     if missing:  # e.g. the folders of failed sweep cells in a glob
         print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
     todo = [r for r in runs if r not in missing and run_name(r) not in done]
+    for run in todo:  # every run checked before any is simulated: a bad one is one line, exit 2
+        try:
+            checked_run(run, maze_dir)
+        except SpecrefineError as exc:
+            raise SpecrefineError(f"{run}: {exc}" if not str(exc).startswith(str(run)) else str(exc)) from None
     new = not table.exists()
     with table.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
@@ -234,9 +275,9 @@ def _predict_into(table, runs, maze_dir=None) -> int:
         for run in tqdm(todo, desc="predictions"):
             try:
                 d = predict_run(run, maze_dir)
-            except (SpecrefineError, ValueError, KeyError, OSError) as exc:
+            except (SpecrefineError, OSError) as exc:
                 failed += 1
-                print(f"{run}: {exc}" if not isinstance(exc, KeyError) else f"{run}: result.json lacks {exc}")
+                print(f"{run}: {exc}", file=sys.stderr)
                 continue
             writer.writerow({"cell": run_name(run), **d, "predicted_ci_low": d["predicted_ci"][0],
                              "predicted_ci_high": d["predicted_ci"][1]})
@@ -247,25 +288,33 @@ def _predict_into(table, runs, maze_dir=None) -> int:
 def main(argv=None) -> int:
     """``python -m specrefine.calibrate RUN... --table OUT.csv``: predictions made again, and coverage;
     ``python -m specrefine.calibrate --coverage TABLE...``: the coverage of existing tables."""
-    from .argtypes import OneLineParser
+    from .argtypes import OneLineParser, out_path
+    from .errors import SpecrefineError
+    from .runfolder import writable_parent
 
     ap = OneLineParser(prog="python -m specrefine.calibrate", description=main.__doc__.split(":")[0])
     ap.add_argument("runs", nargs="+", type=Path,
                     help="run folders (each with result.json) or result.json files; with --coverage, tables")
-    ap.add_argument("--table", type=Path, help="CSV: one row per run (resumed if it exists)")
+    ap.add_argument("--table", type=out_path, help="CSV: one row per run (resumed if it exists)")
     ap.add_argument("--coverage", action="store_true", help="only report the coverage of the given tables")
-    ap.add_argument("--maze-dir", type=Path, help="where mazes named by stem live when not in data/mazes/")
+    ap.add_argument("--maze-dir", type=Path, help="where mazes named by stem live when not in data/mazes/ and the "
+                                                   "run has no run.json (a bare result file)")
     args = ap.parse_args(argv)
-    if args.coverage:
-        absent = [t for t in args.runs if not t.is_file()]
-        if absent:
-            ap.error(f"no such table: {absent[0]}")
-        print(coverage_report(args.runs))
-        return 0
-    if args.table is None:
-        ap.error("--table is required (or --coverage to read tables)")
-    failed = _predict_into(args.table, args.runs, args.maze_dir)
-    inside, total = table_coverage(args.table)
+    try:
+        if args.coverage:
+            absent = [t for t in args.runs if not t.is_file()]
+            if absent:
+                ap.error(f"no such table: {absent[0]}")
+            print(coverage_report(args.runs))
+            return 0
+        if args.table is None:
+            ap.error("--table is required (or --coverage to read tables)")
+        writable_parent(args.table)
+        failed = _predict_into(args.table, args.runs, args.maze_dir)
+        inside, total = table_coverage(args.table)
+    except SpecrefineError as exc:
+        print(f"{ap.prog}: error: {exc}", file=sys.stderr)
+        return 2
     print(f"{args.table}: {_covered(inside, total)}")
     return 0 if total and not failed else 1
 

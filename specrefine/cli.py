@@ -13,29 +13,11 @@ import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, silence_stdout
+from .argtypes import OneLineParser, bounded_int, out_path, proposer_arg, silence_stdout
 from .errors import SpecrefineError
 from .pipeline import METHODS
 
 AGENTS = tuple(_AGENT_REGISTRY)
-
-
-def proposer_arg(text: str) -> str:
-    kind, _, rest = text.partition(":")
-    if kind in ("geometric", "random") and not rest:
-        return text
-    if kind in ("replay", "litellm") and rest:
-        return text
-    if kind == "imperfect" and rest:
-        from .proposers.imperfect import parse_imperfect
-
-        try:
-            parse_imperfect(rest)
-        except SpecrefineError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-        return text
-    raise argparse.ArgumentTypeError(
-        f"invalid proposer {text!r}: use geometric, random, imperfect:PRESET, replay:PATH or litellm:MODEL")
 
 
 _OneLineParser = OneLineParser  # the name other modules and tests know
@@ -65,7 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
     r.add_argument("--seed", type=bounded_int("seed"), default=0,
                    help="random seed for rollouts and proposers (default: 0)")
-    r.add_argument("--out", type=Path, default=Path("runs/latest"),
+    r.add_argument("--out", type=out_path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
     r.add_argument("--rollouts", type=bounded_int("rollouts"), default=32,
                    help="rollouts per subtask evaluation (paper: 32)")

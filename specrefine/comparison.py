@@ -30,6 +30,7 @@ import numpy as np
 
 from .figures import METHOD_COLOURS, figure4, figure5, plt, proposer_label  # plt: with the figures' backend
 from .render import PngFigure
+from .runfolder import save_figure, write_atomic
 from .sweep import is_done, mean_std
 
 COMPARISON_METHODS = ["ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"]
@@ -479,39 +480,41 @@ def write_claims(entries, out: Path, table, grid: Grid = POINT_GRID, contrast_en
              "ratio_threshold": RATIO_CLAIM, "flat_tolerance": FLAT_TOLERANCE, "seeds": list(grid.seeds),
              "bootstrap_resamples": BOOTSTRAP_RESAMPLES, "bootstrap_seed": BOOTSTRAP_SEED}
     record = {"about": about, "claims": entries} | ({"contrasts": list(contrast_entries)} if contrast_entries else {})
-    (out / "claims.json").write_text(json.dumps(_jsonable(record), indent=1) + "\n")
+    write_atomic(out / "claims.json", json.dumps(_jsonable(record), indent=1) + "\n")
     extra = f"\n{contrasts_markdown(contrast_entries)}\n" if contrast_entries else ""
-    (out / "claims.md").write_text(markdown(entries) + "\n" + extra)
+    write_atomic(out / "claims.md", markdown(entries) + "\n" + extra)
 
 
 def main(argv=None) -> int:
-    from .argtypes import OneLineParser
-    from .sweep import read_table
+    from .argtypes import OneLineParser, out_path
+    from .errors import SpecrefineError
+    from .runfolder import ensure_dir
+    from .sweep import read_checked_table
 
     p = OneLineParser(prog="python -m specrefine.comparison", description=__doc__.split("\n")[0])
     p.add_argument("table", help="results.csv of the comparison sweep (specrefine.sweep)")
-    p.add_argument("--out", required=True,
+    p.add_argument("--out", required=True, type=out_path,
                    help="folder for figure4.png, figure5.png, error_levels.png, claims.md, claims.json and "
                         "seedS.md (one table per seed)")
     p.add_argument("--grid", choices=sorted(GRIDS), default="point",
                    help="point: docs/proposers.md's comparison (default); ant: docs/ant_experiments.md section 3")
     args = p.parse_args(argv)
     grid = GRIDS[args.grid]
-    if not Path(args.table).is_file():
-        p.exit(2, f"{p.prog}: error: no table at {args.table}\n")
-    rows = read_table(args.table)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        rows = read_checked_table(args.table)
+        out = ensure_dir(args.out)
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
     for name, fig in comparison_figures(rows, grid).items():
-        fig.savefig(out / f"{name}.png", dpi=110)
+        save_figure(fig, out / f"{name}.png", dpi=110)
         plt.close(fig)
     entries = claims(rows, grid)
     write_claims(entries, out, args.table, grid, contrasts(rows, grid))
     for seed in grid.seeds:
         table, shown, expected = seed_table(rows, grid, seed)
         contrast = "\n".join(seed_contrast(rows, grid, seed))
-        (out / f"seed{seed}.md").write_text(f"Seed {seed}: {shown} of {expected} cells ({OFFLINE_NOTE}; success "
-                                            f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n\n{contrast}\n")
+        write_atomic(out / f"seed{seed}.md", f"Seed {seed}: {shown} of {expected} cells ({OFFLINE_NOTE}; success "
+                                             f"over fresh episodes, 95 % Wilson CI).\n\n{table}\n\n{contrast}\n")
     partial = sum(not e["complete"] for e in entries)
     print(table_note(args.table, rows, grid))  # after the files: a closed stdout (`| head`) loses none of them
     print(f"{len(rows)} rows -> {out}: figures, claims.md, claims.json ({partial} of {len(entries)} entries partial)")

@@ -49,7 +49,9 @@ def plot_curve(log_path, png_path=None, window: int = 10):
         ax.grid(alpha=0.3)
     fig.tight_layout()
     if png_path is not None:
-        fig.savefig(png_path, dpi=90)
+        from .runfolder import save_figure
+
+        save_figure(fig, png_path, dpi=90)
     return fig
 
 

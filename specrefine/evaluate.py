@@ -36,8 +36,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
-import warnings
 from collections import OrderedDict
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from .agents import get_agent
-from .errors import SpecrefineError
+from .errors import PolicyError, SpecrefineError
 from .mazes import Maze
 from .regions import CompiledRegion, Region
 from .results import (
@@ -61,6 +61,8 @@ from .results import (
     unreached,
     wilson_ci,
 )
+
+log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
 CACHE_VERSION = 1
 
@@ -136,6 +138,12 @@ class Evaluator:
         self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
         self.cache_hits = 0
         self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
+        #: environment steps of the evaluations read from cache_dir that this process never simulated (an earlier
+        #: run of the same folder did): each counted once, so sim_steps + cached_steps is the same for a run done
+        #: in one go and one resumed after a kill
+        self.cached_steps = 0
+        self._simulated: set[str] = set()
+        self._steps_counted: set[str] = set()
         self._act = policy.act if hasattr(policy, "act") else policy
         self.observation_frame = getattr(policy, "observation_frame", "world")
         self._sims: dict[int, object] = {}
@@ -198,8 +206,7 @@ class Evaluator:
             got += len(chunks[-1])
             if got >= k:
                 return np.concatenate(chunks)
-        warnings.warn(f"region {region.to_dict()} has almost no room for the agent's body; sampling it plainly",
-                      stacklevel=2)
+        log.warning("region %s has almost no room for the agent's body; sampling it plainly", region.to_dict())
         return np.concatenate(chunks + [region.sample(k - got, rng)])
 
     def spawn_points(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
@@ -251,7 +258,7 @@ class Evaluator:
                     raise ValueError("inconsistent arrays")
                 return res
         except Exception as e:  # corrupt, truncated, foreign: never crash, recompute
-            warnings.warn(f"ignoring unreadable cache entry {path}: {type(e).__name__}: {e}", stacklevel=3)
+            log.warning("ignoring unreadable cache entry %s: %s: %s", path, type(e).__name__, e)
             return None
 
     def _store(self, key: str, text: str, res: EdgeResult) -> None:
@@ -267,7 +274,7 @@ class Evaluator:
                                     steps=np.array(res.steps), outcome=res.outcome)
             os.replace(tmp, path)
         except OSError as e:
-            warnings.warn(f"could not write cache entry {path}: {e}", stacklevel=3)
+            log.warning("could not write cache entry %s: %s", path, e)
 
     # --- public API ----------------------------------------------------------------------------
     MAX_EPISODES = 2048  # evaluate_many simulates at most this many episodes side by side
@@ -313,6 +320,7 @@ class Evaluator:
             for (key, (text, _, positions)), out in zip(chunk, self._rollout_many([t for _, (_, t, _) in chunk])):
                 res = _edge_result(out, n)
                 self.evaluations += 1
+                self._simulated.add(key)
                 self._remember(key, res)
                 if fp is not None:
                     self._store(key, text, res)
@@ -328,6 +336,9 @@ class Evaluator:
             self._memo.move_to_end(key)
         elif disk and (hit := self._load(key, text)) is not None:
             self.disk_hits += 1
+            if key not in self._simulated and key not in self._steps_counted:
+                self._steps_counted.add(key)
+                self.cached_steps += hit.steps
             self._remember(key, replace(hit, cached=False))
         if hit is None:
             return None
@@ -494,6 +505,9 @@ class Evaluator:
                 ep = np.where(live, episode, episode[0])
                 obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep], self.observation_frame)
                 act = np.asarray(self._act(obs), dtype=np.float64)
+                if not np.isfinite(act).all():  # MuJoCo would warn per step and write MUJOCO_LOG.TXT into the cwd
+                    raise PolicyError("the policy acts with NaN or infinite values on these observations: "
+                                      "retrain it or restore its checkpoint")
                 act[~(live & active[ep])] = 0.0  # finished rollouts stay still
                 sim.step(act)
                 steps += np.bincount(task_of[episode[live]], minlength=len(tasks))

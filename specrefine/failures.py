@@ -12,7 +12,6 @@ on a corner) from failures of the policy on open floor (a flip in a sharp turn):
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from collections import Counter
@@ -63,13 +62,16 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> d
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     agent = result["agent"]
     exp = setup(result["maze"], agent=agent, seed=seed, policy=policy)
-    graph = TaskGraph.from_dict(result["graph"])
-    path, legs = result["path"], path_legs(graph, result["path"])
+    try:
+        graph = TaskGraph.from_dict(result["graph"])
+        path, legs = result["path"], path_legs(graph, result["path"])
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
     start = graph.region(path[0])
     centres = [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
     turns = turn_angles(centres)
     lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
-    out = {"maze": result["maze"], "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
+    out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
            "legs": [{"leg": k, "from": path[k], "to": path[k + 1], "turn_deg": turns[k], "length_m": lengths[k]}
                     for k in range(len(legs))]}
     bare = open_floor(exp.maze)
@@ -99,24 +101,48 @@ def summary(report: dict) -> str:
     return "\n".join(lines)
 
 
+def read_result(path: Path) -> dict:
+    """A finished run's result.json, checked to hold what a re-run needs; anything else is a one-line error."""
+    from .paths import regular_file
+
+    try:
+        result = json.loads(regular_file(path, "result file").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise SpecrefineError(f"{path}: not a readable result.json ({type(exc).__name__})") from None
+    if not isinstance(result, dict):
+        raise SpecrefineError(f"{path}: not a run's result.json (a JSON {type(result).__name__})")
+    missing = [key for key in ("maze", "agent") if not isinstance(result.get(key), str)]
+    if missing:
+        raise SpecrefineError(f"{path}: not a run's result.json (no {' or '.join(missing)} named)")
+    if not isinstance(result.get("path", []), list) or not isinstance(result.get("graph", {}), dict):
+        raise SpecrefineError(f"{path}: a malformed result.json (its path or graph is of the wrong type)")
+    return result
+
+
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m specrefine.failures", description=__doc__.split("\n\n")[0])
-    p.add_argument("result", type=Path, help="a run's result.json")
-    p.add_argument("--episodes", type=int, default=300)
-    p.add_argument("--seed", type=int, default=77, help="seed of the fresh episodes (not the run's own)")
+    from .argtypes import OneLineParser, bounded_int, out_path
+    from .runfolder import recorded_maze, writable_parent, write_atomic
+
+    p = OneLineParser(prog="python -m specrefine.failures", description=__doc__.split("\n\n")[0])
+    p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
+    p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
+    p.add_argument("--seed", type=bounded_int("seed"), default=77,
+                   help="seed of the fresh episodes (not the run's own)")
     p.add_argument("--policy", default="shipped", help="'shipped' or a policy checkpoint")
-    p.add_argument("--out", type=Path, default=None, help="write the report here as JSON")
+    p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
     args = p.parse_args(argv)
     try:
-        result = json.loads(args.result.read_text())
-        report = path_failures(result, args.episodes, args.seed, args.policy)
-    except (OSError, json.JSONDecodeError, KeyError, SpecrefineError) as e:
-        print(f"error: {args.result}: {e}", file=sys.stderr)
-        return 1
+        if args.out is not None:
+            writable_parent(args.out)  # before the re-run, not after it
+        result = read_result(args.result)
+        maze = recorded_maze(args.result, result["maze"])
+        report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy)
+        if args.out is not None:
+            write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+    except SpecrefineError as e:
+        print(f"{p.prog}: error: {e}", file=sys.stderr)
+        return 2
     print(summary(report))
-    if args.out is not None:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(report, indent=1) + "\n")
     return 0
 
 

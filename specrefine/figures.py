@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from .pipeline import PROPOSER_METHODS  # noqa: E402
 from .render import PngFigure  # noqa: E402
+from .runfolder import save_figure, write_atomic  # noqa: E402
 from .sweep import summarise  # noqa: E402
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
@@ -184,23 +185,28 @@ def calibration_figure(tables: dict):
 
 
 def main(argv=None) -> int:
-    import argparse
     from pathlib import Path
 
-    from .sweep import read_table
+    from .argtypes import OneLineParser, out_path
+    from .errors import SpecrefineError
+    from .runfolder import ensure_dir
+    from .sweep import read_checked_table
 
-    p = argparse.ArgumentParser(prog="python -m specrefine.figures", description="Figures 4-6 from a sweep table")
+    p = OneLineParser(prog="python -m specrefine.figures", description="Figures 4-6 from a sweep table")
     p.add_argument("table", help="results.csv written by specrefine.sweep")
-    p.add_argument("--out", default=None, help="folder for figure4/5/6.png and summary.md (default: the table's)")
+    p.add_argument("--out", type=out_path, default=None,
+                   help="folder for figure4/5/6.png and summary.md (default: the table's)")
     args = p.parse_args(argv)
-    rows = read_table(args.table)
-    out = Path(args.out or Path(args.table).parent)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        rows = read_checked_table(args.table)
+        out = ensure_dir(args.out or Path(args.table).parent)
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
     for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
         fig = make(rows)
-        fig.savefig(out / f"{name}.png", dpi=110)
+        save_figure(fig, out / f"{name}.png", dpi=110)
         plt.close(fig)
-    (out / "summary.md").write_text(markdown_table(rows) + "\n")
+    write_atomic(out / "summary.md", markdown_table(rows) + "\n")
     print(f"{len(rows)} rows -> {out}/figure4.png, figure5.png, figure6.png, summary.md")
     return 0
 

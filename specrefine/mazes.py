@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from .agents import AGENTS, get_agent
-from .errors import MazeError
-from .paths import data_dir
+from .errors import MazeError, SpecrefineError
+from .paths import data_dir, regular_file
 from .regions import Box, Region, union
 
 MAZE_DIR = data_dir() / "mazes"
@@ -262,7 +262,9 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"
     try:
-        text = path.read_text(encoding="utf-8")
+        text = regular_file(path, "maze file").read_text(encoding="utf-8")
+    except SpecrefineError as exc:
+        raise MazeError(str(exc)) from None
     except OSError as exc:
         raise MazeError(f"{path}: cannot read maze file ({exc.strerror or exc})") from None
     except UnicodeDecodeError:

@@ -70,6 +70,64 @@ def record(name: str, value, *, tol: float | None = None, rel: float | None = No
     return value
 
 
+#: a notebook parameter -> the command-line rule it follows: a LIMITS name (argtypes), or "agent", "method",
+#: "proposer" (a list of them for the plural names)
+PARAMETER_RULES = {"ROLLOUTS": "rollouts", "EPISODES": "episodes", "EVAL_EPISODES": "episodes", "SEED": "seed",
+                   "SEEDS": ["seed"], "W": "w", "D": "d", "K": "k", "WORKERS": "workers", "CHAIN": "chain",
+                   "AGENT": "agent", "METHOD": "method", "METHODS": ["method"], "PROPOSER": "proposer",
+                   "PROPOSERS": ["proposer"]}
+
+
+def check_parameters(params: dict) -> None:
+    """A notebook's parameters (its ``globals()`` after the parameters cell) checked by the command line's rules
+    (``specrefine refine`` / ``python -m specrefine.sweep``): a bad value is a one-line
+    :class:`~specrefine.errors.SpecrefineError` naming the parameter, before the notebook does any work."""
+    for name, rule in PARAMETER_RULES.items():
+        if name not in params:
+            continue
+        value = params[name]
+        if isinstance(rule, list):
+            if not isinstance(value, (list, tuple)) or not value:
+                raise _bad(name, value, "a non-empty list")
+            for item in value:
+                _check_value(name, item, rule[0])
+        else:
+            _check_value(name, value, rule)
+
+
+def _check_value(name: str, value, rule: str) -> None:
+    import argparse
+
+    from .agents import AGENTS
+    from .argtypes import LIMITS, bounded_int, proposer_arg
+    from .pipeline import METHODS
+
+    if rule in LIMITS:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise _bad(name, value, "a whole number")
+        check = bounded_int(rule)
+    else:
+        names = {"agent": AGENTS, "method": METHODS}.get(rule)
+
+        def check(text):
+            if names is not None and text not in names:
+                raise argparse.ArgumentTypeError(f"use one of {', '.join(names)}")
+            return proposer_arg(text) if rule == "proposer" else text
+
+        if not isinstance(value, str):
+            raise _bad(name, value, "a string")
+    try:
+        check(str(value))
+    except argparse.ArgumentTypeError as exc:
+        raise _bad(name, value, str(exc)) from None
+
+
+def _bad(name: str, value, why: str):
+    from .errors import SpecrefineError
+
+    return SpecrefineError(f"notebook parameter {name} = {value!r}: {why}")
+
+
 def read_records(notebook) -> dict:
     """``{name: {"value", "tol", "rel", "package"}}`` from an executed notebook (a path or an nbformat node)."""
     import nbformat
@@ -250,20 +308,22 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
             copy.metadata["specrefine"] = {"executed_copy_of": f"notebooks/{nb.name}", "commit": commit,
                                            "uncommitted_changes": dirty, "tier": tier, "parameters": params,
                                            "ok": code == 0, "wall_s": round(wall)}
-            out.write_text(nbformat.writes(copy) + "\n")
+            from .runfolder import write_atomic
+
+            write_atomic(out, nbformat.writes(copy) + "\n")
             out.with_suffix(".params.json").unlink(missing_ok=True)
     return 1 if failed else 0
 
 
 def main(argv=None) -> int:
-    import argparse
+    from .argtypes import OneLineParser, out_path
 
-    p = argparse.ArgumentParser(prog="python -m specrefine.notebook",
+    p = OneLineParser(prog="python -m specrefine.notebook",
                                 description="Executed copies of the numbered notebooks (make executed).")
     sub = p.add_subparsers(dest="command", required=True)
     ex = sub.add_parser("executed", help="run the notebooks with a tier's parameters and keep the outputs")
     ex.add_argument("--tier", choices=sorted(TIERS), default="full")
-    ex.add_argument("--out", type=Path, default=NB_DIR / "executed")
+    ex.add_argument("--out", type=out_path, default=NB_DIR / "executed")
     ex.add_argument("notebooks", nargs="*", help="stems or number prefixes (e.g. 05); default all")
     args = p.parse_args(argv)
     return write_executed(args.notebooks, args.tier, args.out)

@@ -25,3 +25,23 @@ def prompt_dir() -> Path:
 
 def data_dir() -> Path:
     return _find("data")
+
+
+def regular_file(path, what: str = "file") -> Path:
+    """``path`` if it is a regular file (a symlink to one too), checked BEFORE anything opens it: a FIFO would block
+    the read forever, a device or a folder is no input file; otherwise a one-line
+    :class:`~specrefine.errors.SpecrefineError`."""
+    import os
+    import stat
+
+    from .errors import SpecrefineError
+
+    path = Path(path)
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        raise SpecrefineError(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(mode):
+        kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "not a regular file"
+        raise SpecrefineError(f"{path}: cannot read {what} ({kind}; give a regular file)")
+    return path

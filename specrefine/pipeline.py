@@ -22,6 +22,7 @@ from .errors import SpecrefineError
 from .graph import check_refines
 from .monitor import measure
 from .refine.search import EVALUATIONS
+from .runfolder import replacing, write_atomic
 from .spec import maze_spec_text
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
@@ -123,22 +124,24 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
 def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evaluation="fixed") -> RunResult:
     agent = exp.agent
     maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
-    with (out / "steps.jsonl").open("w") as steps_log:
+    # the step log goes to a temporary file that replaces steps.jsonl only once the run is measured: a rerun into
+    # a finished folder, killed at any moment, leaves the finished run's steps.jsonl beside its result.json
+    with replacing(out / "steps.jsonl") as steps_log:
 
         def on_step(step):
             steps_log.write(json.dumps(step, default=_jsonable) + "\n")
             steps_log.flush()
 
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step, evaluation)
-    measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
-    prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
+        measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
+        prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"] = evaluation
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
-    (out / "result.json").write_text(json.dumps(data, indent=2, default=_jsonable))
+    write_atomic(out / "result.json", json.dumps(data, indent=2, default=_jsonable))
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
 
@@ -256,7 +259,9 @@ def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, s
         # evaluations the result rests on: simulated now, or by an earlier run of the same --out (resume)
         "evaluations": evaluator.evaluations + getattr(evaluator, "disk_hits", 0),
         "evaluations_simulated": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
-        "sim_steps": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
+        # environment steps the result rests on (as evaluations: cached work included), and those simulated now
+        "sim_steps": int(evaluator.sim_steps + getattr(evaluator, "cached_steps", 0)),
+        "sim_steps_simulated": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
         "proposer_calls": int(getattr(proposer, "proposer_calls", 0) or 0),
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,
         "vlm_bad_replies": int(getattr(proposer, "bad_replies", 0) or 0),

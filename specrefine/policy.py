@@ -8,6 +8,7 @@ weight is finite, and turns any problem into a one-line :class:`PolicyError`.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -99,10 +100,13 @@ class GoalPolicy(nn.Module):
 def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    from .runfolder import replacing
+
     state = {k: v.detach().cpu().float().clone() for k, v in policy.state_dict().items()}
-    torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
-                "act_dim": policy.act_dim, "observation_frame": policy.observation_frame, "state_dict": state,
-                "meta": dict(meta or {})}, path)
+    with replacing(path, "wb") as fh:
+        torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
+                    "act_dim": policy.act_dim, "observation_frame": policy.observation_frame, "state_dict": state,
+                    "meta": dict(meta or {})}, fh)
 
 
 def _resolve(path_or_agent) -> Path:
@@ -111,14 +115,22 @@ def _resolve(path_or_agent) -> Path:
     return Path(path_or_agent)
 
 
+def safe_load(path):
+    """``torch.load`` of tensors and plain containers only (``weights_only=True``: a pickle that would run code is
+    refused, not run); torch's warnings about the file's pickle protocol are not shown."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return torch.load(path, map_location="cpu", weights_only=True)
+
+
 def load_policy(path_or_agent) -> GoalPolicy:
     """``'point'`` / ``'ant'`` (the shipped files) or a path -> :class:`GoalPolicy` in eval mode."""
     path = _resolve(path_or_agent)
     if not path.is_file():
         raise PolicyError(f"{path}: policy file not found")
     try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # truncated zip, pickle garbage, ...
+        blob = safe_load(path)
+    except Exception as e:  # noqa: BLE001 - truncated zip, pickle garbage, a pickle that needs code to load, ...
         raise PolicyError(f"{path}: not a readable policy file ({type(e).__name__})") from None
     if not isinstance(blob, dict) or blob.get("format") != FORMAT:
         raise PolicyError(f"{path}: not a specrefine policy file")
@@ -134,17 +146,37 @@ def load_policy(path_or_agent) -> GoalPolicy:
     if frame not in OBSERVATION_FRAMES:
         raise PolicyError(f"{path}: observation frame {frame!r} is not one of {', '.join(OBSERVATION_FRAMES)}")
     policy = GoalPolicy(agent, observation_frame=frame)
+    state = blob.get("state_dict")
+    if not isinstance(state, dict):
+        raise PolicyError(f"{path}: no weights (state_dict) in the policy file")
+    expected = policy.state_dict()
+    missing, extra = sorted(set(expected) - set(state)), sorted(set(state) - set(expected))
+    if missing or extra:
+        raise PolicyError(f"{path}: weights do not fit a {agent} policy (" + "; ".join(
+            f"{what} {', '.join(map(str, keys[:4]))}{', ...' if len(keys) > 4 else ''}"
+            for what, keys in (("missing", missing), ("unexpected", extra)) if keys) + ")")
     try:
-        policy.load_state_dict(blob["state_dict"])
+        policy.load_state_dict(state)
     except (RuntimeError, KeyError, TypeError) as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:120]})") from None
+        first = " ".join(str(e).split()) or type(e).__name__  # torch names the tensors on its second line
+        raise PolicyError(f"{path}: weights do not fit a {agent} policy ({first[:200]})") from None
     broken = [name for name, t in policy.state_dict().items() if not torch.isfinite(t).all()]
     if broken:  # it would run, driving the simulator with NaN actions (tens of thousands of MuJoCo warnings)
         raise PolicyError(f"{path}: weights hold NaN or infinite values ({', '.join(broken[:3])}"
                           f"{', ...' if len(broken) > 3 else ''}); retrain or restore the checkpoint")
+    _check_normaliser(policy.norm, path)
     policy.meta = blob.get("meta", {})
     return policy.eval()
+
+
+def _check_normaliser(norm: Normalizer, path) -> None:
+    """Finite is not enough: a negative variance (NaN square root) or a count <= 0 makes every action NaN."""
+    if (norm.var < 0).any():
+        raise PolicyError(f"{path}: the observation normaliser's variance is negative (norm.var); the policy would "
+                          "act with NaN: retrain or restore the checkpoint")
+    if not float(norm.count) > 0:
+        raise PolicyError(f"{path}: the observation normaliser's count is {float(norm.count):g} (norm.count), not > 0: "
+                          "retrain or restore the checkpoint")
 
 
 class PointController:

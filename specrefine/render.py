@@ -372,9 +372,11 @@ def to_png(fig) -> bytes:
 
 
 def save_png(fig, path) -> None:
+    from .runfolder import write_atomic
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(to_png(fig))
+    write_atomic(path, to_png(fig))
 
 
 def render_maze_pictures(out_dir=None, size_px=512) -> list[Path]:

@@ -15,14 +15,15 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from . import comparison as cmp
-from .argtypes import OneLineParser
+from .argtypes import OneLineParser, out_path
+from .errors import SpecrefineError
 from .mazes import benchmark_mazes
-from .sweep import read_table
+from .runfolder import ensure_dir, save_figure, write_atomic
+from .sweep import read_checked_table
 
 PRESETS = ("imperfect:moderate", "imperfect:severe", "imperfect:mild")  # the order they run in
 METHODS = ("ours", "ours-repair", "vlm-oneshot")
@@ -167,22 +168,23 @@ def study(rows: list[dict]) -> Study:
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.repair_claims", description=__doc__.splitlines()[0])
     ap.add_argument("table")
-    ap.add_argument("--out", required=True, type=Path)
+    ap.add_argument("--out", required=True, type=out_path)
     args = ap.parse_args(argv)
-    if not Path(args.table).is_file():
-        ap.error(f"no table at {args.table}")
-    rows = read_table(args.table)
+    try:
+        rows = read_checked_table(args.table)
+        ensure_dir(args.out)
+    except SpecrefineError as exc:
+        ap.exit(2, f"{ap.prog}: error: {exc}\n")
     result = study(rows)
-    args.out.mkdir(parents=True, exist_ok=True)
     about = {"table": str(args.table), "note": cmp.OFFLINE_NOTE, "presets": list(PRESETS), "seeds": list(SEEDS),
              "bootstrap_resamples": cmp.BOOTSTRAP_RESAMPLES, "bootstrap_seed": cmp.BOOTSTRAP_SEED}
-    (args.out / "claims.json").write_text(json.dumps(cmp._jsonable(
+    write_atomic(args.out / "claims.json", json.dumps(cmp._jsonable(
         {"about": about, "claims": result.entries, "costs": result.costs}), indent=1) + "\n")
-    (args.out / "claims.md").write_text(result.markdown + "\n")
-    (args.out / "mazes.md").write_text("\n\n".join(result.maze_tables) + "\n")
-    (args.out / "summary.md").write_text(result.summary() + "\n")
+    write_atomic(args.out / "claims.md", result.markdown + "\n")
+    write_atomic(args.out / "mazes.md", "\n\n".join(result.maze_tables) + "\n")
+    write_atomic(args.out / "summary.md", result.summary() + "\n")
     for name, fig in cmp.comparison_figures(rows, GRID).items():
-        fig.savefig(args.out / f"{name}.png", dpi=110)
+        save_figure(fig, args.out / f"{name}.png", dpi=110)
         cmp.plt.close(fig)
     partial = sum(not e["complete"] for e in result.entries)
     print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, summary.md, figures "

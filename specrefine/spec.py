@@ -157,6 +157,7 @@ def parse_spec(expr: str, maze) -> Spec:
     if not expr.strip():
         raise SpecSyntaxError(expr, 1, "empty specification (e.g. '(a | b) -> G')")
     toks = list(_tokens(expr))
+    _check_nesting(expr, toks)
     pos = 0
     letters = sorted(maze.subgoals)
     have = f"the maze has {', '.join(letters)} and G" if letters else "the maze has only G"
@@ -224,6 +225,17 @@ def parse_spec(expr: str, maze) -> Spec:
             raise SpecSyntaxError(expr, col, f"the spec must end in G (the goal), but a way through it ends at "
                                              f"{letter!r}: add '-> G'")
     return avoiding(_to_spec(tree, maze), maze.obstacles)
+
+
+MAX_NESTING = 100  #: parentheses inside parentheses (the recursive parser and compiler stay far from Python's limit)
+
+
+def _check_nesting(expr: str, toks) -> None:
+    depth = 0
+    for kind, _, col in toks:
+        depth += (kind == "(") - (kind == ")")
+        if depth > MAX_NESTING:
+            raise SpecSyntaxError(expr, col, f"parentheses nested more than {MAX_NESTING} deep")
 
 
 def _last_steps(tree):

@@ -33,6 +33,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import hashlib
+import io
 import json
 import logging
 import math
@@ -52,8 +53,10 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from .agents import AGENTS
-from .argtypes import OneLineParser, bounded_int
+from .argtypes import OneLineParser, bounded_int, maze_problem, out_path, proposer_arg
 from .errors import SpecrefineError, SweepError
+from .paths import regular_file
+from .runfolder import replacing, write_atomic
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -203,11 +206,73 @@ def result_row(data: dict, row: dict | None = None) -> dict:
 
 
 def read_table(path) -> list[dict]:
+    """The rows of a results table, typed (numbers as numbers); [] where there is no table yet.
+
+    A table that does not parse as the sweep writes it (a row with another number of fields than the header, an
+    unterminated quote, bytes that are not UTF-8 text, a number column holding text) is a one-line
+    :class:`SweepError` naming the file and line: no row is dropped, merged or duplicated behind the user's back.
+    Only the last row may be short, when the file ends without a newline: a row cut off by a kill (not done)."""
     path = Path(path)
     if not path.exists():
         return []
-    with path.open(newline="") as fh:
-        return [_typed(r) for r in csv.DictReader(fh)]
+    return [_typed(r) for r in _raw_rows(path)[1]]
+
+
+def read_checked_table(path) -> list[dict]:
+    """``read_table`` of a table that must exist, for the commands that only read one (comparison, figures)."""
+    if not os.path.lexists(path):
+        raise SweepError(f"no table at {path}")
+    if not _raw_rows(regular_file(path, "table"))[0]:
+        raise SweepError(f"{path}: an empty table (no header row)")
+    return read_table(path)
+
+
+def _raw_rows(path: Path) -> tuple[list[str], list[dict]]:
+    """(header, rows as text) of a table, checked as ``read_table`` says."""
+    try:
+        text = regular_file(path, "table").read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise SweepError(f"{path}: not a results table (not UTF-8 text)") from None
+    except OSError as exc:
+        raise SweepError(f"{path}: cannot read the table ({exc.strerror or exc})") from None
+    if "\0" in text:
+        raise SweepError(f"{path}: not a results table (it holds NUL bytes)")
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
+    header, rows, short, start = None, [], None, 1
+    try:
+        for fields in reader:
+            start, line = reader.line_num + 1, start  # where this record began; the next one begins after it
+            if not fields:
+                continue
+            if header is None:
+                header = fields
+                continue
+            if short is not None or len(fields) > len(header):
+                bad = short or (line, len(fields))
+                raise SweepError(f"{path}:{bad[0]}: a malformed row ({bad[1]} fields, the header has {len(header)}): "
+                                 "fix or remove that line")
+            if len(fields) < len(header):
+                short = (line, len(fields))
+            rows.append(dict(zip(header, fields + [""] * (len(header) - len(fields)))))
+    except csv.Error as exc:
+        raise SweepError(f"{path}:{start}: a malformed row ({exc}): fix or remove that line") from None
+    if short is not None and text.endswith("\n"):  # not cut off by a kill
+        raise SweepError(f"{path}:{short[0]}: a malformed row ({short[1]} fields, the header has {len(header)}): "
+                         "fix or remove that line")
+    for row in rows:
+        for key in _NUMBERS:
+            if row.get(key) not in (None, "") and not _is_number(row[key]):
+                raise SweepError(f"{path}: row of cell {row.get('cell', '?')!r}: {key} is {row[key][:40]!r}, "
+                                 "not a number")
+    return header or [], rows
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 _TEXT = ("policy_fingerprint",)  # hex digests: "123e45678901" must not become a float
@@ -239,10 +304,13 @@ def is_done(row: dict) -> bool:
         isinstance(row.get(k), (int, float)) and not isinstance(row.get(k), bool) for k in _NUMBERS)
 
 
-def _ends_cleanly(path: Path) -> bool:
-    with path.open("rb") as fh:
-        fh.seek(-1, os.SEEK_END)
-        return fh.read(1) == b"\n"
+def _drop_cut_row(path: Path) -> None:
+    """A last row cut off by a kill (no newline at its end) is removed: it was not done, and ending it instead
+    could leave an open quote that would swallow every row after it."""
+    with path.open("rb+") as fh:
+        data = fh.read()
+        if data and not data.endswith(b"\n"):
+            fh.truncate(data.rfind(b"\n") + 1)
 
 
 def _append(path: Path, row: dict) -> None:
@@ -257,13 +325,14 @@ def _append(path: Path, row: dict) -> None:
             raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
         if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
             raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
+    if not new:
+        _drop_cut_row(path)
     with path.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
-        elif not _ends_cleanly(path):  # a row cut short by a kill: end it, or this row would join it
-            fh.write("\r\n")
-        writer.writerow({k: row.get(k, "") for k in columns})
+        writer.writerow({k: " ".join(str(row.get(k, "")).split()) if k == "error" else row.get(k, "")
+                         for k in columns})  # one line per row: a cut row is then always the last line
         fh.flush()
         os.fsync(fh.fileno())
 
@@ -277,9 +346,7 @@ def compact(table: Path) -> None:
     """One row per cell: its last done row, else its last row; first-appearance order, the table's own header."""
     if not table.exists():
         return
-    with table.open(newline="") as fh:
-        reader = csv.DictReader(fh)
-        columns, raw = reader.fieldnames, list(reader)
+    columns, raw = _raw_rows(table)
     if not columns:
         return
     keep: dict[str, dict] = {}
@@ -289,13 +356,10 @@ def compact(table: Path) -> None:
             keep[row["cell"]] = row
     if len(keep) == len(raw):
         return
-    tmp = table.with_suffix(".csv.tmp")
-    with tmp.open("w", newline="") as fh:
+    with replacing(table, "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         writer.writeheader()
-        writer.writerows({k: v if v is not None else "" for k, v in r.items() if k is not None}
-                         for r in keep.values())
-    os.replace(tmp, table)
+        writer.writerows(keep.values())
 
 
 PARAMS = ("rollouts", "episodes", "policy")  # what a cell's rows depend on beyond its id
@@ -316,9 +380,7 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
             raise SweepError(f"{out_root} holds cell {cell.id} run with {' '.join(diff)}; rerun with those values "
                              f"or use another --out")
     known.update({c.id: {k: getattr(c, k) for k in PARAMS} for c in cells})
-    tmp = record.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"cells": known}, indent=1, sort_keys=True))
-    os.replace(tmp, record)
+    write_atomic(record, json.dumps({"cells": known}, indent=1, sort_keys=True))
 
 
 def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
@@ -480,6 +542,7 @@ def _check_policy(policy: str, agent: str) -> str | None:
 
 def main(argv=None) -> int:
     from .mazes import benchmark_mazes
+    from .pipeline import METHODS
 
     p = OneLineParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
     p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
@@ -487,8 +550,8 @@ def main(argv=None) -> int:
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
                    help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
                         "'' = the maze's own task; default: the maze's own task)")
-    p.add_argument("--methods", nargs="+", default=["dirl", "symbolic", "vlm-oneshot", "ours"])
-    p.add_argument("--proposers", nargs="+", default=["geometric", "random"])
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"])
+    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
     p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
     p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
@@ -499,7 +562,7 @@ def main(argv=None) -> int:
     p.add_argument("--policy", default="shipped",
                    help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
                         "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")
-    p.add_argument("--out", default="runs/sweep")
+    p.add_argument("--out", type=out_path, default="runs/sweep")
     p.add_argument("--backend", choices=["local", "ray"], default="local",
                    help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
                         "Ray) (default: local)")
@@ -509,7 +572,7 @@ def main(argv=None) -> int:
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                  episodes=args.episodes, specs=args.specs, evaluation=args.evaluation,
                  policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
-    bad = _check_specs(cells) or _check_policy(args.policy, args.agent)
+    bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
         return _fail(bad, 2)
     t0 = time.time()

@@ -32,9 +32,10 @@ from torch import nn
 from tqdm.auto import tqdm
 
 from .agents import AGENTS, get_agent
+from .argtypes import OneLineParser, bounded_int, out_path
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .errors import SpecrefineError
-from .policy import GoalPolicy, load_policy, mlp, save_policy
+from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
 from .reach_env import GoalReachEnv
 
@@ -145,6 +146,33 @@ def make_modules(policy: GoalPolicy, env: GoalReachEnv):
 
 
 # --- training ---------------------------------------------------------------------------------
+def read_checkpoint(path, option: str) -> dict:
+    """A trainer checkpoint's dict, loaded safely (tensors and plain containers only: no code runs); anything
+    else, or a file that needs more than that to load, is a one-line error naming ``option``."""
+    path = Path(path)
+    if not path.is_file():
+        raise SpecrefineError(f"{option} {path}: no such checkpoint file (or not a regular file)")
+    try:
+        ck = safe_load(path)
+    except Exception as e:  # noqa: BLE001 - a pickle that needs code, a truncated zip, garbage: all refused
+        raise SpecrefineError(f"{option} {path}: not a trainer checkpoint that loads safely (tensors and plain "
+                              f"containers only; {type(e).__name__})") from None
+    if not isinstance(ck, dict):
+        raise SpecrefineError(f"{option} {path}: not a trainer checkpoint (holds a {type(ck).__name__})")
+    missing = [key for key in CHECKPOINT_KEYS if key not in ck]
+    if missing:
+        raise SpecrefineError(f"{option} {path}: not a trainer checkpoint (no {', '.join(missing)})")
+    return ck
+
+
+CHECKPOINT_KEYS = ("loss", "optim", "frames", "iteration", "torch_rng")  # what save_checkpoint writes
+
+
+def _first_line(exc: Exception) -> str:
+    text = str(exc).strip()
+    return f"{type(exc).__name__}: {text.splitlines()[0][:160]}" if text else type(exc).__name__
+
+
 class Trainer:
     def __init__(self, cfg: Config, out: str | Path, resume: bool = False, progress: bool = True):
         from torchrl.collectors import Collector
@@ -179,18 +207,21 @@ class Trainer:
 
     # checkpointing
     def _load_checkpoint(self, path: Path) -> None:
-        ck = torch.load(path, map_location="cpu", weights_only=False)
-        self.loss.load_state_dict(ck["loss"])
-        self.optim.load_state_dict(ck["optim"])
-        self.frames, self.iteration, self.wall = ck["frames"], ck["iteration"], ck.get("wall", 0.0)
-        torch.set_rng_state(ck["torch_rng"])
+        ck = read_checkpoint(path, "--resume")
+        try:
+            self.loss.load_state_dict(ck["loss"])
+            self.optim.load_state_dict(ck["optim"])
+            self.frames, self.iteration = int(ck["frames"]), int(ck["iteration"])
+            self.wall = float(ck.get("wall", 0.0))
+            torch.set_rng_state(ck["torch_rng"])
+        except (KeyError, TypeError, ValueError, RuntimeError) as e:
+            raise SpecrefineError(f"--resume {path}: not a trainer checkpoint of this agent ({_first_line(e)})") \
+                from None
         self.env.rng = np.random.default_rng(self.cfg.seed + self.iteration)
 
     def _load_weights(self, init: str) -> None:
         """Start from another run's actor, critic and observation statistics (frames and optimiser start afresh),
         or from a policy file's actor and observation statistics (the critic starts afresh)."""
-        import pickle
-
         from .errors import PolicyError
 
         path = Path(init)
@@ -203,11 +234,12 @@ class Trainer:
                 raise SpecrefineError(f"--init {init}: a {shipped.agent} policy, not one for the {self.cfg.agent}")
             self.policy.load_state_dict(shipped.state_dict())
             return
+        ck = read_checkpoint(path, "--init")
         try:
-            ck = torch.load(path, map_location="cpu", weights_only=False)
             self.loss.load_state_dict(ck["loss"])
-        except (OSError, KeyError, TypeError, RuntimeError, EOFError, pickle.UnpicklingError) as e:
-            raise SpecrefineError(f"--init {path}: not a trainer checkpoint of this agent ({type(e).__name__})") from e
+        except (KeyError, TypeError, ValueError, RuntimeError) as e:
+            raise SpecrefineError(f"--init {path}: not a trainer checkpoint of this agent ({_first_line(e)})") \
+                from None
 
     def save_checkpoint(self) -> None:
         tmp = self.out / "checkpoint.pt.tmp"
@@ -302,16 +334,16 @@ def train(agent: str, frames: int, out, resume: bool = False, progress: bool = T
 
 # --- command line -----------------------------------------------------------------------------
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m specrefine.train", description=__doc__.splitlines()[0])
+    ap = OneLineParser(prog="python -m specrefine.train", description=__doc__.splitlines()[0])
     ap.add_argument("--agent", choices=list(AGENTS), required=True)
-    ap.add_argument("--out", default=None, help="run directory (checkpoint, log, curve)")
+    ap.add_argument("--out", type=out_path, default=None, help="run directory (checkpoint, log, curve)")
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
     ap.add_argument("--evaluate", metavar="POLICY", help="only evaluate POLICY ('point', 'ant' or a path)")
-    ap.add_argument("--episodes", type=int, default=500)
+    ap.add_argument("--episodes", type=bounded_int("episodes"), default=500)
     ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
     ap.add_argument("--plot", metavar="PNG", help="with --evaluate: save the success-vs-distance plot here")
     ap.add_argument("--no-progress", action="store_true")
-    ap.add_argument("--chain", type=int, default=None, metavar="K",
+    ap.add_argument("--chain", type=bounded_int("chain"), default=None, metavar="K",
                     help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain)")
     config_arguments(ap)
     args = ap.parse_args(argv)
@@ -334,7 +366,9 @@ def main(argv=None) -> int:
         overrides = {f.name: getattr(args, f.name) for f in fields(Config)
                      if f.name != "agent" and getattr(args, f.name) is not None}
         cfg = make_config(args.agent, **overrides)
-        path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()
+        from .runfolder import ensure_dir
+
+        path = Trainer(cfg, ensure_dir(args.out), args.resume, progress=not args.no_progress).train()
         print(f"policy written to {path}")
         return 0
     except SpecrefineError as e:

@@ -57,7 +57,7 @@ def test_a_finished_runs_path_is_rerun_with_and_without_inner_walls(tmp_path, ca
 def test_a_result_without_a_path_is_one_line(tmp_path, capsys):
     bad = tmp_path / "result.json"
     bad.write_text(json.dumps({"maze": "u_chain_1", "agent": "point", "path": []}))
-    assert main([str(bad)]) == 1
+    assert main([str(bad)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "no selected path" in err
 
@@ -66,5 +66,5 @@ def test_a_result_without_a_path_is_one_line(tmp_path, capsys):
 def test_an_unreadable_result_is_one_line(tmp_path, capsys, text):
     bad = tmp_path / "result.json"
     bad.write_text(text)
-    assert main([str(bad)]) == 1
+    assert main([str(bad)]) == 2
     assert capsys.readouterr().err.count("\n") == 1

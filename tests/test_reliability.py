@@ -109,8 +109,14 @@ def test_sweep_redoes_a_truncated_ok_row(tmp_path):
     assert row["cell"] == cell and sweep.is_done(row) and 0 <= row["success_rate"] <= 1
 
 
-def test_sweep_exits_1_when_every_cell_failed(tmp_path, capsys):
-    code = sweep.main(["--mazes", "no_such_maze", "--out", str(tmp_path / "s"), *SWEEP])
+def test_sweep_exits_1_when_every_cell_failed(tmp_path, capsys, monkeypatch):
+    import specrefine.pipeline
+
+    def fails(*args, **kw):  # a cell that fails while it runs (a bad maze is refused before any cell: exit 2)
+        raise RuntimeError("the simulator fell over")
+
+    monkeypatch.setattr(specrefine.pipeline, "refine_maze", fails)
+    code = sweep.main(["--mazes", "u_maze", "--out", str(tmp_path / "s"), *SWEEP])
     assert code == 1 and "1 failed" in capsys.readouterr().out
 
 

@@ -204,3 +204,132 @@ def test_edited_replay_lines_give_a_result_or_one_line(recording, tmp_path_facto
     path = tmp_path_factory.mktemp("replay") / "rec.jsonl"
     path.write_bytes(b"\n".join(edited(recording, edits)) + b"\n")
     assert_result_or_one_line(*refine(*REPLAY_RUN, f"replay:{path}"))
+
+
+# --- issue 29: every command, random argument vectors and random bytes as files -----------------------------
+# Each `python -m specrefine.*` command with a command line and `specrefine refine` (above), run in-process under a
+# time limit: exit 0, or exit 2 with exactly one line on stderr (log records go to their own stream and hold no
+# traceback).  Options that would start long work get tiny values; `python -m specrefine.render` takes no
+# arguments and rewrites the shipped maze pictures, so it is left out.  Three examples per command by default.
+from importlib import import_module  # noqa: E402
+
+CMD_FUZZ = settings(max_examples=int(FUZZ_N or 3), derandomize=FUZZ_N is None, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+JUNK = st.one_of(st.sampled_from(["--bogus", "-x", "", "--", "nan", "-1", "0", "1e9", "\u00e9", "--out"]),
+                 st.text(alphabet="ab-=:/._ 0\u00e9", max_size=8))
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished one-cell sweep: its table and its cell's run folder (result.json, run.json)."""
+    from specrefine import sweep
+
+    out = tmp_path_factory.mktemp("finished")
+    assert sweep.main(["--mazes", "u_chain_1", "--methods", "ours", "--proposers", "geometric", "--seeds", "0",
+                       "--rollouts", "2", "--episodes", "2", "--workers", "1", "--out", str(out)]) == 0
+    (cell,) = (out / "cells").iterdir()
+    return {"table": str(out / "results.csv"), "run": str(cell), "result": str(cell / "result.json")}
+
+
+def choice(valid, invalid):
+    return st.one_of(st.sampled_from(valid), st.sampled_from(invalid))
+
+
+def command_argv(name: str, files: dict):
+    """A strategy of argument vectors for command ``name``; ``files``: paths of good inputs and random-bytes ones."""
+    bad, out = files["random"], files["out"]
+    options = {
+        "sweep": (["--methods", "dirl", "--seeds", "0", "--rollouts", "2", "--episodes", "2", "--workers", "1",
+                   "--out", out], {"--mazes": choice(["u_maze", "u_maze=G"], [bad, "no_such", "u_maze=->"]),
+                                   "--proposers": choice(["geometric", "geometric:max_waypoints=4"], ["gpt", bad]),
+                                   "--methods": choice(["dirl"], ["nonsense"]), "--agent": choice(["point"], ["x"]),
+                                   "--specs": choice(["G"], ["(G", "z"]), "--policy": choice(["shipped"], [bad]),
+                                   "--evaluation": choice(["fixed"], ["slow"]), "--seeds": choice(["1"], ["-1"])}),
+        "calibrate": ([], {"--table": choice([out + ".csv"], ["", files["dir"]]), "--coverage": st.just(None),
+                           "--maze-dir": choice([files["dir"]], [bad])}),
+        "failures": (["--episodes", "2"], {"--episodes": choice(["1"], ["0", "-5", "x"]),
+                                           "--seed": choice(["3"], ["-1"]),
+                                           "--out": choice([out + ".json"], ["", files["dir"], bad + "/sub"]),
+                                           "--policy": choice(["shipped"], [bad])}),
+        "comparison": (["--out", out], {"--grid": choice(["point", "ant"], ["cat"]),
+                                        "--out": choice([out], ["", bad])}),
+        "figures": (["--out", out], {"--out": choice([out], ["", bad])}),
+        "repair_claims": (["--out", out], {"--out": choice([out], ["", bad])}),
+        "train": (["--agent", "point", "--frames", "64", "--num-envs", "2", "--steps-per-env", "4", "--no-progress",
+                   "--out", out], {"--init": choice(["point"], [bad, "ant"]), "--resume": st.just(None),
+                                   "--evaluate": choice(["point"], [bad]), "--episodes": choice(["2"], ["0"]),
+                                   "--agent": choice(["point"], ["walker"]), "--switch-radius": st.just("1 0.5")}),
+        "notebook": (["executed", "--out", out], {"--tier": choice(["smoke"], ["huge"]),
+                                                   "--out": choice([out], [""])}),
+        "bench": ([], {}),
+    }
+    fixed, opts = options[name]
+    positional = {"calibrate": choice([files["run"], files["result"]], [bad, files["dir"]]),
+                  "failures": choice([files["result"]], [bad, files["dir"]]),
+                  "comparison": choice([files["table"]], [bad]), "figures": choice([files["table"]], [bad]),
+                  "repair_claims": choice([files["table"]], [bad]),
+                  "notebook": st.sampled_from(["zz_no_such_notebook", "99"]),
+                  "bench": st.sampled_from([["evaluator", "--seconds", "0.05", "--rounds", "1", "--batch", "2"],
+                                            ["evaluator", "--scenario", bad], ["evaluator", "--batch", "0"],
+                                            ["refine", "--agent", "point", "--mazes", "u_maze", "--seeds", "0",
+                                             "--method", "dirl", "--episodes", "2"],
+                                            ["refine", "--method", "best"], ["refine", "--proposer", bad],
+                                            ["refine", "--mazes", bad], ["cook"]])}.get(name)
+
+    @st.composite
+    def build(draw):
+        argv = list(fixed)
+        if positional is not None:
+            first = draw(positional)
+            argv = (first if isinstance(first, list) else [first]) + argv
+        for flag in draw(st.lists(st.sampled_from(sorted(opts)), max_size=3, unique=True)) if opts else []:
+            value = draw(opts[flag])
+            argv += [flag] if value is None else [flag, *value.split(" ")] if flag == "--switch-radius" else \
+                [flag, value]
+        if draw(st.booleans()):
+            argv.insert(draw(st.integers(0, len(argv))), draw(JUNK))
+        return [str(a) for a in argv]
+
+    return build()
+
+
+COMMANDS = {"sweep": "specrefine.sweep", "calibrate": "specrefine.calibrate", "failures": "specrefine.failures",
+            "comparison": "specrefine.comparison", "figures": "specrefine.figures",
+            "repair_claims": "specrefine.repair_claims", "train": "specrefine.train",
+            "notebook": "specrefine.notebook", "bench": "specrefine.bench.__main__"}
+
+
+def run_command(module: str, argv: list[str]) -> tuple[int, str, str]:
+    main = import_module(module).main
+    err, logs = io.StringIO(), io.StringIO()
+    handler = logging.StreamHandler(logs)
+    logging.getLogger().addHandler(handler)
+    try:
+        with time_limit(LIMIT_S), contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            try:
+                code = main(argv)
+            except SystemExit as exc:  # argparse, p.exit
+                code = exc.code
+    finally:
+        logging.getLogger().removeHandler(handler)
+    return code, err.getvalue(), logs.getvalue()
+
+
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_every_command_gives_exit_0_or_one_line(name, finished, tmp_path_factory):
+    @CMD_FUZZ
+    @given(data=st.data(), blob=st.binary(max_size=300))
+    def check(data, blob):
+        where = tmp_path_factory.mktemp(name)
+        (where / "random.bin").write_bytes(blob)
+        (where / "dir").mkdir()
+        files = {**finished, "random": str(where / "random.bin"), "out": str(where / "out"), "dir": str(where / "dir")}
+        argv = data.draw(command_argv(name, files), label="argv")
+        code, err, logs = run_command(COMMANDS[name], argv)
+        event(f"exit {code}")
+        assert "Traceback" not in err + logs, (argv, err + logs)
+        if code != 0:
+            lines = err.strip().splitlines()
+            assert code == 2 and len(lines) == 1, (argv, code, err[-3000:])
+
+    check()

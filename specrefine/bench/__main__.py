@@ -5,9 +5,12 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from pathlib import Path
 
 from ..agents import AGENTS
-from ..argtypes import OneLineParser, bounded_int, positive_float
+from ..argtypes import OneLineParser, bounded_int, maze_problem, out_path, positive_float, proposer_arg
+from ..errors import SpecrefineError
+from ..pipeline import METHODS
 from . import __doc__ as package_doc
 
 
@@ -37,29 +40,38 @@ def main(argv=None) -> int:
     r.add_argument("--agent", choices=list(AGENTS), default="ant")
     r.add_argument("--mazes", nargs="+", default=["split_doorway", "u_maze", "u_chain_2"])
     r.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2])
-    r.add_argument("--method", default="ours")
-    r.add_argument("--proposer", default="geometric")
+    r.add_argument("--method", choices=list(METHODS), default="ours")
+    r.add_argument("--proposer", type=proposer_arg, default="geometric")
     r.add_argument("--episodes", type=bounded_int("episodes"), default=200)
-    r.add_argument("--table", default=None, help="CSV the rows are appended to (and resumed from)")
+    r.add_argument("--table", type=out_path, default=None, help="CSV the rows are appended to (and resumed from)")
     args = ap.parse_args(argv)
+    if args.what == "refine":  # before seconds of Ant setup
+        problem = maze_problem(args.mazes)
+        if problem is None and args.table is not None and Path(args.table).is_dir():
+            problem = f"--table {args.table}: is a folder: name a CSV file"
+        if problem:
+            ap.exit(2, f"{ap.prog}: error: {problem}\n")
     warnings.filterwarnings("ignore")
     from . import bench_evaluator, bench_gymenv, bench_refinement, bench_train
 
-    if args.what == "evaluator":
-        out = bench_evaluator(args.agent, args.batch, args.seconds, args.horizon, args.torch_threads, args.nthread,
-                              args.scenario, args.rounds)
-    elif args.what == "gymenv":
-        ev = bench_evaluator(args.agent, args.batch, args.seconds)
-        gym = bench_gymenv(args.agent, args.gym_steps)
-        out = {"evaluator": ev, "gymenv": gym}
-        if "env_steps_per_s" in gym:
-            out["evaluator_over_gymenv"] = round(ev["env_steps_per_s"] / gym["env_steps_per_s"], 2)
-        out["evaluator_over_raw_rollout"] = ev["ratio_vs_raw_rollout"]
-    elif args.what == "refine":
-        out = bench_refinement(args.mazes, args.seeds, args.agent, args.method, args.proposer, args.table,
-                               args.episodes)
-    else:
-        out = bench_train(args.agent, args.batches)
+    try:
+        if args.what == "evaluator":
+            out = bench_evaluator(args.agent, args.batch, args.seconds, args.horizon, args.torch_threads, args.nthread,
+                                  args.scenario, args.rounds)
+        elif args.what == "gymenv":
+            ev = bench_evaluator(args.agent, args.batch, args.seconds)
+            gym = bench_gymenv(args.agent, args.gym_steps)
+            out = {"evaluator": ev, "gymenv": gym}
+            if "env_steps_per_s" in gym:
+                out["evaluator_over_gymenv"] = round(ev["env_steps_per_s"] / gym["env_steps_per_s"], 2)
+            out["evaluator_over_raw_rollout"] = ev["ratio_vs_raw_rollout"]
+        elif args.what == "refine":
+            out = bench_refinement(args.mazes, args.seeds, args.agent, args.method, args.proposer, args.table,
+                                   args.episodes)
+        else:
+            out = bench_train(args.agent, args.batches)
+    except SpecrefineError as exc:
+        ap.exit(2, f"{ap.prog}: error: {exc}\n")
     print(json.dumps(out), flush=True)
     return 0
 

@@ -27,23 +27,37 @@ from .vlm import VLMProposer
 log = logging.getLogger(__name__)
 
 
-def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = None, **client_kw) -> Proposer:
-    """``geometric`` | ``random`` | ``replay:PATH`` | ``litellm:MODEL`` (extra keywords go to LiteLLMClient)."""
+def parse_proposer(spec: str) -> tuple[str, object]:
+    """``(kind, option)`` of a ``--proposer`` string, or a one-line :class:`SpecrefineError`: the one parser the
+    command lines validate with (before anything runs) and :func:`make_proposer` builds from.  Options: the
+    waypoint cap (geometric), the error model (imperfect), the path (replay) or the model (litellm)."""
     kind, _, rest = str(spec).partition(":")
     if kind == "geometric":
-        proposer: Proposer = GeometricProposer(seed=seed, max_waypoints=_max_waypoints(rest))
+        return kind, _max_waypoints(rest)
+    if kind == "random" and not rest:
+        return kind, None
+    if kind == "imperfect" and rest:
+        return kind, parse_imperfect(rest)
+    if kind in ("replay", "litellm") and rest:
+        return kind, rest
+    raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, geometric:max_waypoints=N, random, "
+                          "imperfect:PRESET, replay:PATH or litellm:MODEL")
+
+
+def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = None, **client_kw) -> Proposer:
+    """``geometric`` | ``random`` | ``replay:PATH`` | ``litellm:MODEL`` (extra keywords go to LiteLLMClient)."""
+    kind, option = parse_proposer(spec)
+    if kind == "geometric":
+        proposer: Proposer = GeometricProposer(seed=seed, max_waypoints=option)
         proposer.spec = spec
-    elif kind == "random" and not rest:
+    elif kind == "random":
         proposer = RandomProposer(seed=seed)
-    elif kind == "replay" and rest:
-        proposer = VLMProposer(ReplayClient(rest), spec=spec)
-    elif kind == "imperfect" and rest:
-        proposer = ImperfectProposer(parse_imperfect(rest), spec=spec, seed=seed)
-    elif kind == "litellm" and rest:
-        proposer = VLMProposer(LiteLLMClient(rest, record_path=record_path, **client_kw), spec=spec)
+    elif kind == "replay":
+        proposer = VLMProposer(ReplayClient(option), spec=spec)
+    elif kind == "imperfect":
+        proposer = ImperfectProposer(option, spec=spec, seed=seed)
     else:
-        raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, geometric:max_waypoints=N, random, "
-                              "imperfect:PRESET, replay:PATH or litellm:MODEL")
+        proposer = VLMProposer(LiteLLMClient(option, record_path=record_path, **client_kw), spec=spec)
     log.info("proposer: %s", proposer.name)
     return proposer
 

@@ -13,8 +13,8 @@ import logging
 import re
 from pathlib import Path
 
-from ..errors import ReplayMiss, VLMConfigError
-from ..paths import data_dir
+from ..errors import ReplayMiss, SpecrefineError, VLMConfigError
+from ..paths import data_dir, regular_file
 from .messages import (
     MAX_REPLY_CHARS,
     TOO_LONG,
@@ -121,7 +121,9 @@ class ReplayClient(VLMClient):
         self.path = Path(path)
         self.strict = strict
         try:
-            lines = self.path.read_bytes().splitlines()
+            lines = regular_file(self.path, "the recording").read_bytes().splitlines()
+        except SpecrefineError as exc:
+            raise VLMConfigError(f"replay:{exc}") from None
         except OSError as exc:
             raise VLMConfigError(f"replay:{path}: cannot read the recording ({exc.strerror or exc})") from None
         self.records: list[dict] = []
