@@ -47,7 +47,9 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("refine", help="refine a maze task's specification and measure the resulting policy",
                        description="Refine the task graph of MAZE_FILE (S -> a -> ... -> G, avoiding walls), "
                                    "then measure the compositional policy end to end on the ORIGINAL task.")
-    r.add_argument("maze", metavar="MAZE_FILE", help="a .maze file (or the name of one in data/mazes/)")
+    r.add_argument("maze", metavar="MAZE_FILE",
+                   help="a .maze file, the name of one in data/mazes/, or gr:NAME: a Gymnasium-Robotics map "
+                        "(gr:U_MAZE, gr:MEDIUM_MAZE, gr:LARGE_MAZE, gr:LARGE_MAZE_DIVERSE_G, ...)")
     r.add_argument("--agent", choices=AGENTS, default="point",
                    help="point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells (default: point)")
     r.add_argument("--method", choices=list(METHODS), default="ours",
