@@ -98,6 +98,20 @@ def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
     return spec.compile()
 
 
+def torso_up(quat: np.ndarray) -> np.ndarray:
+    """z-component of the body z axis of unit quaternions (w, x, y, z), one per row: < 0 is flipped."""
+    _, qx, qy, _ = np.asarray(quat, dtype=float).T
+    return 1.0 - 2.0 * (qx * qx + qy * qy)
+
+
+def in_heading_frame(rel: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    """Planar vectors ``rel`` (n, 2) in the heading (yaw) frame of the quaternions ``quat`` (n, 4)."""
+    w, x, y, z = np.asarray(quat, dtype=float).T
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
+
+
 class BatchedSim:
     """``n`` copies of one agent in one maze, stepped together.  See the module docstring."""
 
@@ -182,24 +196,18 @@ class BatchedSim:
         """z-component of the torso's z axis: 1 upright, 0 on its side, < 0 upside down (point: always 1)."""
         if self._spec.planar:
             return np.ones(self.n)
-        _, qx, qy, _ = self.qpos[:, 3:7].T
-        return 1.0 - 2.0 * (qx * qx + qy * qy)
+        return torso_up(self.qpos[:, 3:7])
 
     @property
     def flipped(self) -> np.ndarray:
         return self.up < 0.0
-
-    def _yaw(self) -> np.ndarray:
-        w, x, y, z = self.qpos[:, 3:7].T
-        return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
     # --- observe / step --------------------------------------------------------------------
     def observe(self, goals: np.ndarray) -> np.ndarray:
         rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
         if self._spec.planar:
             return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
-        c, s = np.cos(self._yaw()), np.sin(self._yaw())
-        local = np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
+        local = in_heading_frame(rel, self.qpos[:, 3:7])
         return np.concatenate([self.qpos[:, 2:], self.qvel, local], axis=1).astype(np.float32)
 
     def step(self, actions: np.ndarray) -> None:
