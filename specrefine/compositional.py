@@ -70,12 +70,17 @@ class CompositionalPolicy:
         spec = get_agent(agent)
         self.agent, self.maze, self.legs, self.goal_policy, self.horizon = agent, maze, list(legs), goal_policy, horizon
         self.control_period = spec.timestep * spec.frame_skip
-        self.hold = 1 if env_dt is None else max(1, round(self.control_period / float(env_dt)))
+        self.match_env_dt(env_dt)
         self._sampler = Evaluator(maze, agent, goal_policy, n=1)  # the evaluator's goal-point rule and clearance
         self.clearance = self._sampler.clearance
         self._goals = [CompiledRegion(leg.goal) for leg in self.legs]
         self._avoids = [CompiledRegion(leg.avoid) for leg in self.legs]
         self.reset()
+
+    def match_env_dt(self, env_dt: float | None) -> None:
+        """``act`` is called every ``env_dt`` seconds: decide every ``hold`` calls (None: every call)."""
+        self.env_dt = None if env_dt is None else float(env_dt)
+        self.hold = 1 if env_dt is None else max(1, round(self.control_period / self.env_dt))
 
     # --- the loop ------------------------------------------------------------------------------
     def reset(self, observation=None, *, seed=None) -> None:
@@ -86,12 +91,12 @@ class CompositionalPolicy:
                                      for leg in self.legs], dtype=float)
         self.leg, self.decisions_in_leg, self._calls, self._action = 0, 0, 0, None
         if observation is not None:
-            self._advance(agent_xy(observation))
+            self.update(observation)
 
     def act(self, observation) -> np.ndarray:
         """The control for this environment step (a new decision every ``hold`` calls)."""
         if self._calls % self.hold == 0 or self._action is None:
-            self._advance(agent_xy(observation))
+            self.update(observation)
             goal = self.goal_points[min(self.leg, len(self.legs) - 1)]
             obs = policy_observation(self.agent, observation, goal)
             self._action = self._control(np.asarray(self._act(obs[None]), dtype=np.float64)[0])
@@ -115,8 +120,9 @@ class CompositionalPolicy:
             return False
         return bool(self._avoids[self.leg].below(np.asarray(xy, dtype=float).reshape(1, 2), self.clearance)[0])
 
-    def _advance(self, xy) -> None:
-        point = np.asarray(xy, dtype=float).reshape(1, 2)
+    def update(self, observation) -> None:
+        """Move on past every leg whose goal region holds the agent now (``act`` does this at each decision)."""
+        point = agent_xy(observation).reshape(1, 2)
         while not self.done and self._goals[self.leg].contains(point)[0]:
             self.leg += 1
             self.decisions_in_leg = 0
