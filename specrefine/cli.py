@@ -2,6 +2,7 @@
 
     specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl}
         --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
+    specrefine official RUN_DIR [--episodes N] [--seed S]
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -29,7 +30,9 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("refine", help="refine a maze task's specification and measure the resulting policy",
                        description="Refine the task graph of MAZE_FILE (S -> a -> ... -> G, avoiding walls), "
                                    "then measure the compositional policy end to end on the ORIGINAL task.")
-    r.add_argument("maze", metavar="MAZE_FILE", help="a .maze file (or the name of one in data/mazes/)")
+    r.add_argument("maze", metavar="MAZE_FILE",
+                   help="a .maze file, the name of one in data/mazes/, or gr:NAME: a Gymnasium-Robotics map "
+                        "(gr:U_MAZE, gr:MEDIUM_MAZE, gr:LARGE_MAZE, gr:LARGE_MAZE_DIVERSE_G, ...)")
     r.add_argument("--agent", choices=AGENTS, default="point",
                    help="point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells (default: point)")
     r.add_argument("--method", choices=list(METHODS), default="ours",
@@ -66,11 +69,39 @@ def build_parser() -> argparse.ArgumentParser:
                         "refinement's candidates in stages, stopping those that cannot be chosen (same full "
                         "budget for what is chosen; far fewer simulator steps) (default: fixed for point, "
                         "adaptive for ant)")
+    o = sub.add_parser("official", help="run a finished run's compositional policy in the official "
+                                         "Gymnasium-Robotics environment (PointMaze-v3 / AntMaze-v5)",
+                       description="Run RUN_DIR's compositional policy (RUN_DIR/policy.json) in the official "
+                                   "Gymnasium-Robotics environment built from the run's maze, judge the ORIGINAL "
+                                   "task with this package's monitor, write RUN_DIR/official.json.")
+    o.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a finished 'specrefine refine' output folder")
+    o.add_argument("--episodes", type=bounded_int("episodes"), default=200, help="episodes (default: 200)")
+    o.add_argument("--seed", type=bounded_int("seed"), default=0, help="random seed of the episodes (default: 0)")
     return parser
+
+
+def official(args) -> int:
+    try:
+        from .official import run_official, summary
+
+        data = run_official(args.run_dir, episodes=args.episodes, seed=args.seed)
+    except SpecrefineError as exc:
+        print(f"specrefine: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("specrefine: interrupted; nothing written", file=sys.stderr)
+        return 130
+    try:
+        print(summary(data) + f"\n  -> {args.run_dir / 'official.json'}", flush=True)
+    except BrokenPipeError:
+        silence_stdout()
+    return 0
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
+    if args.command == "official":
+        return official(args)
     try:
         from .pipeline import refine_maze  # heavy imports only after argument parsing
 

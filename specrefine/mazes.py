@@ -57,6 +57,14 @@ class Maze:
     def for_agent(self, agent: str) -> Maze:
         return self.scaled(get_agent(agent).cell_size)
 
+    @classmethod
+    def from_gymnasium(cls, map_list, name: str = "gymnasium_map", cell_size: float = 1.0) -> Maze:
+        """A Gymnasium-Robotics map (rows of 1 / 0 / 'r' / 'g' / 'c'); start and goal as in
+        :mod:`specrefine.standard_maps`."""
+        from .standard_maps import from_gymnasium
+
+        return from_gymnasium(map_list, name=name, cell_size=cell_size)
+
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
     @property
     def width(self) -> float:
@@ -257,7 +265,12 @@ def reachable_cells(maze: Maze, sources, through=None) -> set[tuple[int, int]]:
 
 
 def load_maze(path, cell_size: float = 1.0) -> Maze:
-    """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/."""
+    """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/, and 'gr:NAME' is the
+    Gymnasium-Robotics map NAME (``specrefine.standard_maps``)."""
+    from .standard_maps import PREFIX, load_standard
+
+    if isinstance(path, str) and path.startswith(PREFIX):
+        return load_standard(path, cell_size)
     path = Path(path)
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"

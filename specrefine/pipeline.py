@@ -18,6 +18,7 @@ import numpy as np
 
 from .agents import get_agent
 from .calibrate import predict
+from .compositional import save_run_policy
 from .errors import SpecrefineError
 from .graph import check_refines
 from .monitor import measure
@@ -142,6 +143,7 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
     write_atomic(out / "result.json", json.dumps(data, indent=2, default=_jsonable))
+    save_run_policy(out, maze, agent, search.graph, search.path, evaluator)  # out/policy.json: the policy as an object
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
 

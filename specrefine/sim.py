@@ -98,6 +98,41 @@ def build_model(agent: str, maze: Maze | None) -> mujoco.MjModel:
     return spec.compile()
 
 
+def torso_up(quat: np.ndarray) -> np.ndarray:
+    """z-component of the body z axis of unit quaternions (w, x, y, z), one per row: < 0 is flipped."""
+    _, qx, qy, _ = np.asarray(quat, dtype=float).T
+    return 1.0 - 2.0 * (qx * qx + qy * qy)
+
+
+def heading(quat: np.ndarray) -> np.ndarray:
+    """The yaw (rad) of unit quaternions (w, x, y, z), one per row."""
+    w, x, y, z = np.asarray(quat, dtype=float).T
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def in_heading_frame(rel: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    """Planar vectors ``rel`` (n, 2) in the heading (yaw) frame of the quaternions ``quat`` (n, 4)."""
+    return _rotated(rel, heading(quat))
+
+
+def _rotated(vec: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.stack([c * vec[:, 0] + s * vec[:, 1], -s * vec[:, 0] + c * vec[:, 1]], axis=1)
+
+
+def free_body_observation(qpos: np.ndarray, qvel: np.ndarray, rel: np.ndarray, frame: str = "world") -> np.ndarray:
+    """A free-joint body's policy observation from its qpos without x, y (z, quaternion, joints), qvel and the goal
+    relative to it, rows alike (``BatchedSim.observe`` and the official environment's policy share it)."""
+    if frame not in OBSERVATION_FRAMES:
+        raise SpecrefineError(f"observation frame must be one of {', '.join(OBSERVATION_FRAMES)}, got {frame!r}")
+    qpos, qvel = np.array(qpos, dtype=float), np.array(qvel, dtype=float)
+    yaw = heading(qpos[:, 1:5])
+    if frame == "heading":
+        qpos[:, 1:5] = _without_yaw(qpos[:, 1:5], yaw)
+        qvel[:, 0:2] = _rotated(qvel[:, 0:2], yaw)
+    return np.concatenate([qpos, qvel, _rotated(np.asarray(rel, dtype=float), yaw)], axis=1).astype(np.float32)
+
+
 class BatchedSim:
     """``n`` copies of one agent in one maze, stepped together.  See the module docstring."""
 
@@ -182,16 +217,11 @@ class BatchedSim:
         """z-component of the torso's z axis: 1 upright, 0 on its side, < 0 upside down (point: always 1)."""
         if self._spec.planar:
             return np.ones(self.n)
-        _, qx, qy, _ = self.qpos[:, 3:7].T
-        return 1.0 - 2.0 * (qx * qx + qy * qy)
+        return torso_up(self.qpos[:, 3:7])
 
     @property
     def flipped(self) -> np.ndarray:
         return self.up < 0.0
-
-    def _yaw(self) -> np.ndarray:
-        w, x, y, z = self.qpos[:, 3:7].T
-        return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
     # --- observe / step --------------------------------------------------------------------
     def observe(self, goals: np.ndarray, frame: str = "world") -> np.ndarray:
@@ -208,15 +238,7 @@ class BatchedSim:
         rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
         if self._spec.planar:
             return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
-        yaw = self._yaw()
-        c, s = np.cos(yaw), np.sin(yaw)
-        local = np.stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]], axis=1)
-        qpos, qvel = self.qpos[:, 2:].copy(), self.qvel.copy()
-        if frame == "heading":
-            qpos[:, 1:5] = _without_yaw(qpos[:, 1:5], yaw)
-            vx, vy = qvel[:, 0].copy(), qvel[:, 1].copy()
-            qvel[:, 0], qvel[:, 1] = c * vx + s * vy, -s * vx + c * vy
-        return np.concatenate([qpos, qvel, local], axis=1).astype(np.float32)
+        return free_body_observation(self.qpos[:, 2:], self.qvel, rel, frame)
 
     def step(self, actions: np.ndarray) -> None:
         ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)

@@ -89,6 +89,7 @@ class Cell:
         name = self.maze
         if Path(name).is_absolute():  # a file outside data/mazes: unique by its path
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
+        name = name.replace(":", "-")  # a standard map 'gr:NAME' -> 'gr-NAME' (a folder name on every system)
         task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
         tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
@@ -515,10 +516,17 @@ def mean_std(values, ddof: int = 0) -> tuple[float, float]:
 
 
 def _check_specs(cells: list[Cell]) -> str | None:
-    """The first bad (maze, spec) pair's one-line message, before any cell runs (None: all fine)."""
+    """The first bad (maze, spec) pair's or unknown standard map's one-line message, before any cell runs
+    (None: all fine)."""
     from .mazes import load_maze
     from .spec import maze_task
+    from .standard_maps import PREFIX
 
+    for maze in sorted({c.maze for c in cells if c.maze.startswith(PREFIX)}):
+        try:
+            load_maze(maze)
+        except SpecrefineError as exc:
+            return str(exc)
     for maze, spec in sorted({(c.maze, c.spec) for c in cells if c.spec}):
         try:
             maze_task(load_maze(maze), spec)
@@ -546,7 +554,8 @@ def main(argv=None) -> int:
 
     p = OneLineParser(prog="python -m specrefine.sweep", description=__doc__.split("\n")[0])
     p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
-                   help="maze names or files; MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
+                   help="maze names or files, or gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE); MAZE=SPEC runs "
+                        "that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
                    help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
                         "'' = the maze's own task; default: the maze's own task)")

@@ -1,0 +1,67 @@
+"""The point mass in this package's simulator and in the official PointMaze-v3, on the same runs.
+
+    PYTHONPATH=$PWD python scripts/official_gap.py [--episodes 1000] [--out data/official/point_gap.json]
+
+For each maze: one ``specrefine refine --agent point --method ours --proposer geometric --seed 0`` run
+(seconds), then the run's compositional policy on ``--episodes`` fresh episodes in both simulators: this
+package's (``monitor.measure``, the run's own measurement with more episodes) and the official
+environment (``specrefine official``).  Writes one JSON record (see docs/official_env.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+from pathlib import Path
+
+MAZES = ["u_maze", "gr:MEDIUM_MAZE"]
+SIM_SEED = 777  # fresh episodes: neither the search's seed nor the run's measurement seed
+
+
+def sim_side(run: Path, episodes: int) -> dict:
+    import specrefine
+    from specrefine.graph import TaskGraph
+    from specrefine.monitor import measure
+    from specrefine.results import wilson_ci
+
+    result = json.loads((run / "result.json").read_text())
+    exp = specrefine.setup(json.loads((run / "run.json").read_text())["maze"], agent="point")
+    m = measure(exp.evaluator, exp.graph, TaskGraph.from_dict(result["graph"]), result["path"], episodes, SIM_SEED)
+    k = int(m.success.sum())
+    return {"success_rate": k / episodes, "success_ci": list(wilson_ci(k, episodes)), "episodes": episodes,
+            "outcomes": m.path_result.counts()}
+
+
+def main() -> None:
+    from specrefine.cli import main as cli
+    from specrefine.official import run_official
+
+    p = argparse.ArgumentParser()
+    p.add_argument("--episodes", type=int, default=1000)
+    p.add_argument("--out", default="data/official/point_gap.json")
+    args = p.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for maze in MAZES:
+            run = Path(tmp) / maze.replace(":", "-")
+            assert cli(["refine", maze, "--agent", "point", "--method", "ours", "--proposer", "geometric", "--seed",
+                        "0", "--out", str(run)]) == 0
+            official = run_official(run, episodes=args.episodes, seed=1)
+            rows.append({"maze": maze, "env_id": official["env_id"], "path": json.loads((run / "result.json")
+                                                                                       .read_text())["path"],
+                         "this_simulator": sim_side(run, args.episodes),
+                         "official": {k: official[k] for k in ("success_rate", "success_ci", "episodes", "outcomes")}})
+    record = {"command": f"PYTHONPATH=$PWD python scripts/official_gap.py --episodes {args.episodes}",
+              "agent": "point", "method": "ours", "proposer": "geometric", "seed": 0, "rows": rows}
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp_out = out.with_name(f".{out.name}.{os.getpid()}.tmp")
+    tmp_out.write_text(json.dumps(record, indent=1) + "\n")
+    os.replace(tmp_out, out)
+    print(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()
