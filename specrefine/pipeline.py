@@ -133,8 +133,11 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
             steps_log.write(json.dumps(step, default=_jsonable) + "\n")
             steps_log.flush()
 
+        phases = {"search_seconds": time.time()}
         search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step, evaluation)
+        phases["measure_seconds"] = time.time()
         measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
+        phases["calibrate_seconds"] = time.time()
         prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
     data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
@@ -142,6 +145,7 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
     data["evaluation"] = evaluation
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
+    data.update(_durations(phases, time.time()))  # where the wall time went: search, measurement, calibration
     write_atomic(out / "result.json", json.dumps(data, indent=2, default=_jsonable))
     save_run_policy(out, maze, agent, search.graph, search.path, evaluator)  # out/policy.json: the policy as an object
     _pictures(maze, search, measured, out, data)
@@ -173,6 +177,12 @@ def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, o
         return oneshot(original, evaluator, proposer, maze=maze, agent=agent, w=w, rounds=d, seed=seed,
                        on_step=on_step, budget=budget)
     raise SpecrefineError(f"unknown method {method!r}")
+
+
+def _durations(starts: dict, end: float) -> dict:
+    """{phase: seconds} from {phase: its start time}, phases in order, the last ending at ``end``."""
+    times = [*starts.values(), end]
+    return {name: round(b - a, 3) for name, a, b in zip(starts, times, times[1:])}
 
 
 def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, k, evaluation="fixed"

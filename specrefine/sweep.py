@@ -64,9 +64,10 @@ COLUMNS = [
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
     "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
-    "policy_fingerprint",
+    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds",
 ]
-#: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, ...): readers
+#: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
+#: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
 #: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header.
 
 

@@ -127,3 +127,9 @@ def test_pictures_are_drawn_only_for_a_proposer_that_looks_at_them(method):
     assert blind.pictures and all(p is None for p in blind.pictures)
     assert seeing.pictures[0][:8] == b"\x89PNG\r\n\x1a\n"  # the query's map
     assert [p is None for p in blind.pictures] == [True] * len(seeing.pictures)  # the same queries were asked
+
+
+def test_a_run_records_where_its_wall_time_went(tmp_path):
+    data, _ = run(tmp_path, "ours", proposer="geometric", maze="u_maze")
+    phases = [data[k] for k in ("search_seconds", "measure_seconds", "calibrate_seconds")]
+    assert all(p >= 0 for p in phases) and sum(phases) <= data["wall_seconds"] + 1e-6
