@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+from test_refine_search import FakeResult
 
 from specrefine.graph import TaskGraph, check_refines
 from specrefine.refine import RefinementSearch, SearchConfig
@@ -47,31 +46,13 @@ def test_no_shortcut_over_an_original_vertex():
     assert shortcuts(g, ["S", "A", "G"], reach=10.0) == []  # A is a vertex of the task, not a waypoint
 
 
-@dataclass
-class _Result:
-    p: float
-    n: int = 32
-
-    @property
-    def successes(self):
-        return round(self.p * self.n)
-
-    @property
-    def end_states(self):
-        return ("arrived", self.p)
-
-    @property
-    def ci(self):
-        return (self.p, self.p)
-
-
 class _LegsEvaluator:
     """A leg out of S's box (the unsplit edge) fails; any other leg succeeds with 0.9: fewer legs is better."""
 
     n, clearance = 32, 0.1
 
     def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
-        return _Result(0.9 if isinstance(start, tuple) or goal.centre()[0] < 7 else 0.0)
+        return FakeResult(0.9 if isinstance(start, tuple) or goal.centre()[0] < 7 else 0.0)
 
 
 class _Proposer:
