@@ -1,7 +1,9 @@
 """The ``specrefine`` command line.
 
-    specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl}
+    specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl,...}
         --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
+
+The options of ``refine`` are the fields of :class:`specrefine.runconfig.RunConfig` (defaults, help, bounds).
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -13,9 +15,9 @@ import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, silence_stdout
+from .argtypes import OneLineParser, silence_stdout
 from .errors import SpecrefineError
-from .pipeline import METHODS
+from .runconfig import RunConfig, add_run_options
 
 AGENTS = tuple(_AGENT_REGISTRY)
 
@@ -46,44 +48,12 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     r = sub.add_parser("refine", help="refine a maze task's specification and measure the resulting policy",
                        description="Refine the task graph of MAZE_FILE (S -> a -> ... -> G, avoiding walls), "
-                                   "then measure the compositional policy end to end on the ORIGINAL task.")
+                                   "then measure the compositional policy end to end on the ORIGINAL task. The "
+                                   "defaults are the paper's settings.")
     r.add_argument("maze", metavar="MAZE_FILE", help="a .maze file (or the name of one in data/mazes/)")
-    r.add_argument("--agent", choices=AGENTS, default="point",
-                   help="point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells (default: point)")
-    r.add_argument("--method", choices=list(METHODS), default="ours",
-                   help="; ".join(f"{m}: {what}" for m, (_, what) in METHODS.items()) + " (default: ours)")
-    r.add_argument("--proposer", type=proposer_arg, default="geometric",
-                   help="who proposes edge splits: geometric (offline shortest-path waypoints, NOT a VLM), "
-                        "random (random free-space waypoints, ablation), imperfect:PRESET or imperfect:key=value,... "
-                        "(VLM-like error model, offline, NOT a VLM; presets mild, moderate, severe), "
-                        "replay:PATH (recorded VLM replies), "
-                        "litellm:MODEL (any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; "
-                        "keys from the environment) (default: geometric)")
-    r.add_argument("--spec", metavar="EXPR", default=None,
-                   help="the task as an expression over the maze's letters: a..z its subgoal regions, G the goal, "
-                        "S implicit; '->' sequence, '|' choice (binds tighter), parentheses; must end in G; e.g. "
-                        "'(a | b) -> c -> G' (default: the maze's '; spec:' line, else its chain a -> b -> ... -> G)")
-    r.add_argument("--seed", type=bounded_int("seed"), default=0,
-                   help="random seed for rollouts and proposers (default: 0)")
+    add_run_options(r, types={"proposer": proposer_arg})
     r.add_argument("--out", type=Path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
-    r.add_argument("--rollouts", type=bounded_int("rollouts"), default=32,
-                   help="rollouts per subtask evaluation (paper: 32)")
-    r.add_argument("--episodes", type=bounded_int("episodes"), default=200,
-                   help="fresh end-to-end episodes to measure the final policy on the original task")
-    r.add_argument("--policy", type=Path, default=None,
-                   help="policy checkpoint (default: the shipped data/policies/AGENT.pt)")
-    r.add_argument("-w", type=bounded_int("w"), default=3,
-                   help="candidate edge splits per VLM query (paper: 3; at most 20)")
-    r.add_argument("-d", type=bounded_int("d"), default=2,
-                   help="VLM query rounds per edge split (paper: 2; at most 10)")
-    r.add_argument("-k", type=bounded_int("k"), default=5,
-                   help="subsets sampled per vertex refinement (paper: 5; at most 100)")
-    r.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
-                   help="fixed: every subtask estimate on --rollouts rollouts (the paper); adaptive: the vertex "
-                        "refinement's candidates in stages, stopping those that cannot be chosen (same full "
-                        "budget for what is chosen; far fewer simulator steps) (default: fixed for point, "
-                        "adaptive for ant)")
     return parser
 
 
@@ -92,10 +62,7 @@ def main(argv=None) -> int:
     try:
         from .pipeline import refine_maze  # heavy imports only after argument parsing
 
-        result = refine_maze(args.maze, agent=args.agent, method=args.method, proposer=args.proposer,
-                             seed=args.seed, out=args.out, rollouts=args.rollouts, episodes=args.episodes,
-                             policy_path=args.policy, w=args.w, d=args.d, k=args.k, spec=args.spec,
-                             evaluation=args.evaluation)
+        result = refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out)
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2
