@@ -54,6 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_run_options(r, types={"proposer": proposer_arg})
     r.add_argument("--out", type=Path, default=Path("runs/latest"),
                    help="output directory for result.json, pictures, the step log and the evaluation cache")
+    r.add_argument("--quiet", action="store_true",
+                   help="no live progress line on stderr (shown only when stderr is a terminal anyway)")
     return parser
 
 
@@ -62,7 +64,8 @@ def main(argv=None) -> int:
     try:
         from .pipeline import refine_maze  # heavy imports only after argument parsing
 
-        result = refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out)
+        result = refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out,
+                             progress=False if args.quiet else None)
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2

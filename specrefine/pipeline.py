@@ -21,6 +21,7 @@ from .errors import SpecrefineError
 from .graph import check_refines
 from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
 from .monitor import measure
+from .progress import RunProgress
 from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
 from .refine.search import EVALUATIONS
 from .runconfig import RunConfig
@@ -50,7 +51,7 @@ class RunResult:
 
 
 def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/latest"), evaluator=None,
-                policy_path=None, **fields) -> RunResult:
+                progress: bool | None = None, policy_path=None, **fields) -> RunResult:
     """Run ``config`` (default: the paper's :class:`~specrefine.runconfig.RunConfig`) on the maze ``maze_path``.
 
     Keywords named like RunConfig's fields change them (``refine_maze("u_maze", method="dirl", rollouts=8)``);
@@ -59,7 +60,8 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     ``; spec:`` line, else its chain).  ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts,
     the paper's protocol) or "adaptive" (the chain DP by branch and bound with staged rollouts:
     :mod:`specrefine.refine.racing`); None: the agent's ``default_evaluation`` (fixed for the point mass,
-    adaptive for the Ant).  ``evaluator``: use this one instead of building one.
+    adaptive for the Ant).  ``evaluator``: use this one instead of building one.  ``progress``: the live line on
+    stderr (:mod:`specrefine.progress`); None shows it when stderr is a terminal or in a notebook.
 
     ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
@@ -90,20 +92,24 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
                     policy=config.policy, out=out, evaluator=evaluator, record_path=out / "vlm_recording.jsonl",
                     spec=config.spec)
         write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
-        return _refine(exp, config, out, t0)
+        with RunProgress(exp.evaluator, exp.proposer, enabled=progress) as shown:
+            return _refine(exp, config, out, t0, shown)
 
 
-def _refine(exp, config: RunConfig, out: Path, t0: float) -> RunResult:
+def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) -> RunResult:
     maze, original, evaluator = exp.maze, exp.graph, exp.evaluator
     with (out / "steps.jsonl").open("w") as steps_log:
 
         def on_step(step):
             steps_log.write(json.dumps(step, default=_jsonable) + "\n")
             steps_log.flush()
+            shown.step(step)
 
         search = run_search(config, original, evaluator, exp.proposer, maze, on_step)
     seed, episodes = config.seed, config.episodes
+    shown.phase("measurement")
     measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
+    shown.phase("calibration")
     prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
     data = _result_dict(exp, config, search, measured, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)

@@ -187,7 +187,7 @@ def run_cell(cell: Cell, out_root: str) -> dict:
     out = Path(out_root) / "cells" / cell.id
     try:
         with cell_log(out / "log.txt"):
-            result = refine_maze(cell.maze, cell.config(), out=out)
+            result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}

@@ -55,7 +55,7 @@ def _run(maze, seed, evaluation, agent, method, proposer, episodes) -> dict:
     try:
         wall, cpu = time.perf_counter(), time.process_time()
         d = refine_maze(maze, agent=agent, method=method, proposer=proposer, seed=seed, out=out / "run",
-                        episodes=episodes, evaluation=evaluation).data
+                        episodes=episodes, evaluation=evaluation, progress=False).data
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     finally:
         shutil.rmtree(out, ignore_errors=True)
