@@ -10,8 +10,8 @@ records the configuration a run ran with under ``"config"``.
     refine_maze("u_maze", RunConfig(method="symbolic", k=10), out="runs/k10")
 
 Library defaults elsewhere (``setup``'s rollouts, ``SearchConfig``'s w, d and k, a sweep cell's rollouts and
-episodes, ...) read :data:`DEFAULTS`.  This module imports nothing else of the package at import time, so any
-layer may read it.
+episodes, ...) read :data:`DEFAULTS`.  At import time this module reads only :mod:`specrefine.argtypes` (the
+registries behind the choices and help are read when a parser is built), so any layer may import it.
 """
 
 from __future__ import annotations
