@@ -8,6 +8,7 @@ import warnings
 
 from ..agents import AGENTS
 from ..argtypes import OneLineParser, bounded_int, positive_float
+from ..runconfig import DEFAULTS
 from . import __doc__ as package_doc
 
 
@@ -39,7 +40,7 @@ def main(argv=None) -> int:
     r.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2])
     r.add_argument("--method", default="ours")
     r.add_argument("--proposer", default="geometric")
-    r.add_argument("--episodes", type=bounded_int("episodes"), default=200)
+    r.add_argument("--episodes", type=bounded_int("episodes"), default=DEFAULTS.episodes)
     r.add_argument("--table", default=None, help="CSV the rows are appended to (and resumed from)")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore")
