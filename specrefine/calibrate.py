@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .runconfig import DEFAULTS
+
 HOLDOUT_SEED_OFFSET = 2_000_029  # neither the search's seed nor the measurement's
 HOLDOUT_EPISODES = 64  # end-to-end episodes behind a prediction
 DRAWS = 20_000
@@ -64,7 +66,7 @@ def product_posterior(successes, rollouts, seed: int = 0, draws: int = DRAWS,
     return float(np.prod(a / (a + b))), (float(lo), float(hi))
 
 
-def predict(evaluator, original, graph, path, seed: int = 0, episodes: int = 200,
+def predict(evaluator, original, graph, path, seed: int = 0, episodes: int = DEFAULTS.episodes,
             holdout_episodes: int = HOLDOUT_EPISODES) -> Prediction:
     """Held-out end-to-end estimate of the compositional policy along ``path`` of ``graph``, judged as the
     measurement judges it (on the ``original`` task graph, from its initial set)."""

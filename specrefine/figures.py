@@ -15,17 +15,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .pipeline import PROPOSER_METHODS  # noqa: E402
+from .methods import METHOD_COLOURS, PROPOSER_METHODS  # noqa: E402  (colours: each method's registry entry)
 from .render import PngFigure  # noqa: E402
 from .runfolder import save_figure, write_atomic  # noqa: E402
 from .sweep import summarise  # noqa: E402
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
-METHOD_COLOURS = {"dirl": "#9e9e9e", "symbolic": "#8d6e63", "vlm-oneshot": "#ef6c00", "ours": "#1565c0",
-                  # controls of the offline comparison: a shade near the method each one varies
-                  "ours-novertex": "#64b5f6", "ours-nosearchvertex": "#90caf9", "ours-notune": "#4db6ac",
-                  "ours-nofeedback": "#80cbc4", "ours-d1": "#00897b", "vlm-oneshot-matched": "#ffb74d",
-                  "ours-repair": "#6a1b9a", "ours-shortcut": "#283593"}  # beyond the paper (refine/repair.py)
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
 EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
 _UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")

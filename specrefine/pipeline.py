@@ -11,57 +11,25 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from .agents import get_agent
 from .calibrate import predict
 from .compositional import save_run_policy
 from .errors import SpecrefineError
 from .graph import check_refines
+from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
 from .monitor import measure
+from .progress import RunProgress
+from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
 from .refine.search import EVALUATIONS
+from .runconfig import RunConfig
 from .runfolder import replacing, write_atomic
 from .spec import maze_spec_text
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
-
-#: every method: whether it asks a proposer, and what it is (the paper's Sec. 5.1, plus controls)
-METHODS = {
-    "ours": (True, "Alg. 3: Dijkstra-order search with proposer edge splits and vertex subsets"),
-    "ours-novertex": (True, "control: ours without vertex refinement anywhere (neither the search's vertex subsets "
-                            "nor Algorithm 2 inside an edge split)"),
-    "ours-nosearchvertex": (True, "control: ours without the search's own vertex subsets (an edge split still "
-                                  "tunes its later candidates with Algorithm 2)"),
-    "ours-notune": (True, "control: ours with an edge split's later candidates evaluated as proposed (no "
-                          "Algorithm 2 inside the split, Alg. 1 line 10)"),
-    "ours-nofeedback": (True, "control: ours with an edge split's later round asked afresh, without the earlier "
-                              "candidates' results"),
-    "ours-d1": (True, "the paper's d = 1: no later round in an edge split (its samples, feedback and tuning)"),
-    "ours-repair": (True, "beyond the paper: ours, and when no split candidate succeeds end to end, its failing "
-                          "legs are split once more before it is judged (refine/repair.py)"),
-    "ours-shortcut": (True, "beyond the paper: ours, then shortcut edges over the found path's waypoints (one "
-                            "long leg where it beats several short ones; refine/shortcut.py)"),
-    "vlm-oneshot": (True, "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w"),
-    "vlm-oneshot-matched": (True, "control: one-shot best-of-N, spending what ours spent (proposer calls, "
-                                  "subtask evaluations) on the same task and seed"),
-    "symbolic": (False, "baseline: the search with vertex subsets only"),
-    "dirl": (False, "baseline: no refinement, Dijkstra on the input graph"),
-}
-#: what each variant of ``ours`` changes in its SearchConfig (every control removes one thing from ``ours``)
-OURS_VARIANTS = {
-    "ours": {},
-    "ours-novertex": dict(vertex_refinement=False, split_tuning=False),
-    "ours-nosearchvertex": dict(vertex_refinement=False),
-    "ours-notune": dict(split_tuning=False),
-    "ours-nofeedback": dict(split_feedback=False),
-    "ours-d1": dict(d=1),
-    "ours-repair": dict(repair=True),
-    "ours-shortcut": dict(shortcut_reach="policy"),  # "policy": the agent's training goal range (below)
-}
-PROPOSER_METHODS = tuple(m for m, (asks, _) in METHODS.items() if asks)
 
 
 @dataclass
@@ -84,15 +52,18 @@ class RunResult:
                 f"{d['wall_seconds']:.1f} s\n  -> {self.out / 'result.json'}")
 
 
-def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric", seed=0, out=Path("runs/latest"),
-                rollouts=32, episodes=200, policy_path=None, w=3, d=2, k=5, evaluator=None,
-                spec: str | None = None, evaluation: str | None = None) -> RunResult:
-    """``spec``: the task as an expression over the maze's letters (``specrefine.spec.parse_spec``, e.g.
-    ``"(a | b) -> c -> G"``); None = the maze's own task (its ``; spec:`` line, else its chain).
+def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/latest"), evaluator=None,
+                progress: bool | None = None, policy_path=None, **fields) -> RunResult:
+    """Run ``config`` (default: the paper's :class:`~specrefine.runconfig.RunConfig`) on the maze ``maze_path``.
 
-    ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts, the paper's protocol) or
-    "adaptive" (the chain DP by branch and bound with staged rollouts: :mod:`specrefine.refine.racing`);
-    None: the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
+    Keywords named like RunConfig's fields change them (``refine_maze("u_maze", method="dirl", rollouts=8)``);
+    ``policy_path`` is the ``policy`` field under its older name.  ``spec``: the task as an expression over the
+    maze's letters (``specrefine.spec.parse_spec``, e.g. ``"(a | b) -> c -> G"``); None = the maze's own task (its
+    ``; spec:`` line, else its chain).  ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts,
+    the paper's protocol) or "adaptive" (the chain DP by branch and bound with staged rollouts:
+    :mod:`specrefine.refine.racing`); None: the agent's ``default_evaluation`` (fixed for the point mass,
+    adaptive for the Ant).  ``evaluator``: use this one instead of building one.  ``progress``: the live line on
+    stderr (:mod:`specrefine.progress`); None shows it when stderr is a terminal or in a notebook.
 
     ``out`` holds this run only (:mod:`specrefine.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
@@ -103,28 +74,33 @@ def refine_maze(maze_path, *, agent="point", method="ours", proposer="geometric"
     from .spec import maze_task
 
     t0 = time.time()
+    if policy_path is not None:
+        fields["policy"] = str(policy_path)
+    config = replace(config or RunConfig(), **fields)
     maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
-    maze_task(maze.for_agent(agent), spec)  # a bad agent or spec fails before the folder is touched
-    evaluation = evaluation or get_agent(agent).default_evaluation
-    args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": agent,
-            "method": method, "proposer": proposer if method in PROPOSER_METHODS else None, "seed": seed,
-            "rollouts": rollouts, "episodes": episodes, "policy": str(policy_path or "shipped"), "w": w, "d": d,
-            "k": k, "spec": spec}
-    if evaluation != "fixed":  # run folders of the fixed protocol keep the records they always had
-        args["evaluation"] = evaluation
-    if evaluation not in EVALUATIONS:
-        raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {evaluation!r}")
+    maze_task(maze.for_agent(config.agent), config.spec)  # a bad agent or spec fails before the folder is touched
+    proposer = config.proposer if get_method(config.method).asks_proposer else None
+    config = config.resolved()
+    args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": config.agent,
+            "method": config.method, "proposer": proposer, "seed": config.seed, "rollouts": config.rollouts,
+            "episodes": config.episodes, "policy": config.policy, "w": config.w, "d": config.d, "k": config.k,
+            "spec": config.spec}
+    if config.evaluation != "fixed":  # run folders of the fixed protocol keep the records they always had
+        args["evaluation"] = config.evaluation
+    if config.evaluation not in EVALUATIONS:
+        raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {config.evaluation!r}")
     with claim(out, args) as out:
-        exp = setup(maze, agent=agent, proposer=proposer if method in PROPOSER_METHODS else None, seed=seed,
-                    rollouts=rollouts, policy=policy_path or "shipped", out=out, evaluator=evaluator,
-                    record_path=out / "vlm_recording.jsonl", spec=spec)
+        exp = setup(maze, agent=config.agent, proposer=proposer, seed=config.seed, rollouts=config.rollouts,
+                    policy=config.policy, out=out, evaluator=evaluator, record_path=out / "vlm_recording.jsonl",
+                    spec=config.spec)
         write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
-        return _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evaluation)
+        with RunProgress(exp.evaluator, exp.proposer, enabled=progress) as shown:
+            return _refine(exp, config, out, t0, shown)
 
 
-def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evaluation="fixed") -> RunResult:
-    agent = exp.agent
-    maze, original, evaluator, prop = exp.maze, exp.graph, exp.evaluator, exp.proposer
+def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) -> RunResult:
+    maze, original, evaluator = exp.maze, exp.graph, exp.evaluator
+    seed, episodes = config.seed, config.episodes
     # the step log goes to a temporary file that replaces steps.jsonl only once the run is measured: a rerun into
     # a finished folder, killed at any moment, leaves the finished run's steps.jsonl beside its result.json
     with replacing(out / "steps.jsonl") as steps_log:
@@ -132,51 +108,28 @@ def _refine(exp, method, proposer, seed, out, episodes, w, d, k, spec, t0, evalu
         def on_step(step):
             steps_log.write(json.dumps(step, default=_jsonable) + "\n")
             steps_log.flush()
+            shown.step(step)
 
         phases = {"search_seconds": time.time()}
-        search = _search(method, original, evaluator, prop, maze, agent, seed, w, d, k, on_step, evaluation)
+        search = run_search(config, original, evaluator, exp.proposer, maze, on_step)
         phases["measure_seconds"] = time.time()
+        shown.phase("measurement")
         measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
         phases["calibrate_seconds"] = time.time()
+        shown.phase("calibration")
         prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
-    data = _result_dict(maze, agent, method, prop, proposer, seed, original, search, measured, evaluator, t0)
+    data = _result_dict(exp, config, search, measured, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
-    data["evaluation"] = evaluation
+    data["evaluation"] = config.evaluation
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
-    data["spec"] = maze_spec_text(maze, spec)  # the task's expression (the original graph is data["input_graph"])
+    data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])
+    data["config"] = config.to_dict()  # everything this run was asked to do (evaluation resolved)
     data.update(_durations(phases, time.time()))  # where the wall time went: search, measurement, calibration
     write_atomic(out / "result.json", json.dumps(data, indent=2, default=_jsonable))
-    save_run_policy(out, maze, agent, search.graph, search.path, evaluator)  # out/policy.json: the policy as an object
+    save_run_policy(out, maze, config.agent, search.graph, search.path, evaluator)  # out/policy.json: as an object
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
-
-
-def _search(method, original, evaluator, proposer, maze, agent, seed, w, d, k, on_step, evaluation="fixed"):
-    from .refine import RefinementSearch, SearchConfig, shortest_path
-
-    if method == "dirl":
-        return shortest_path(original, evaluator, seed=seed)
-    if method == "symbolic":
-        cfg = SearchConfig(k=k, edge_refinement=False, seed=seed, evaluation=evaluation)
-        return RefinementSearch(original, evaluator, config=cfg, on_step=on_step).run()
-    if method in OURS_VARIANTS:
-        variant = dict(OURS_VARIANTS[method])
-        if variant.get("shortcut_reach") == "policy":  # as far as the policy was trained to reach a goal
-            variant["shortcut_reach"] = get_agent(agent).reach_task.goal_max
-        cfg = SearchConfig(**{"w": w, "d": d, "k": k, "seed": seed, "evaluation": evaluation, **variant})
-        images = getattr(proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
-        query_for = edge_query_builder(maze, agent, evaluator.facts(), images=images)
-        return RefinementSearch(original, evaluator, proposer=proposer, config=cfg, on_step=on_step,
-                                query_for=query_for, picture=candidate_picture(maze) if images else None).run()
-    if method.startswith("vlm-oneshot"):
-        from .refine.oneshot import oneshot
-
-        budget = budget_of_ours(original, evaluator, proposer.spec, maze, agent, seed, w, d, k, evaluation) \
-            if method == "vlm-oneshot-matched" else None
-        return oneshot(original, evaluator, proposer, maze=maze, agent=agent, w=w, rounds=d, seed=seed,
-                       on_step=on_step, budget=budget)
-    raise SpecrefineError(f"unknown method {method!r}")
 
 
 def _durations(starts: dict, end: float) -> dict:
@@ -185,83 +138,16 @@ def _durations(starts: dict, end: float) -> dict:
     return {name: round(b - a, 3) for name, a, b in zip(starts, times, times[1:])}
 
 
-def budget_of_ours(original, evaluator, proposer_spec, maze, agent, seed, w, d, k, evaluation="fixed"
-                   ) -> tuple[int, int]:
-    """(proposer calls, subtask evaluations) that ``ours`` spends on this task and seed (run here, on its own cache)."""
-    from .proposers import make_proposer
-
-    cache = evaluator.cache_dir.parent / "budget_cache" if evaluator.cache_dir is not None else None
-    twin = evaluator.fresh_copy(cache_dir=cache)
-    proposer = make_proposer(proposer_spec, seed=seed)
-    _search("ours", original, twin, proposer, maze, agent, seed, w, d, k, on_step=None, evaluation=evaluation)
-    return proposer.proposer_calls, twin.evaluations + twin.disk_hits
-
-
-def edge_query_builder(maze, agent, facts=None, *, images: bool = True):
-    """(graph, u, v, EdgeResult) -> EdgeQuery with the picture of the edge's evaluated rollouts.
-
-    ``facts``: the evaluator's ``facts()``, what the prompt says about the evaluation (default: an
-    evaluator with default settings on ``maze``). ``images=False``: no picture (``image_png`` None).
-    """
-    from .proposers import EdgeQuery
-    from .render import render_task, to_png
-
-    def picture(graph, u, v, result):
-        if not images:
-            return None
-        fig = render_task(maze, _edge_graph(graph, u, v), trajectories=getattr(result, "trajectories", None),
-                          success=getattr(result, "success", None), lengths=getattr(result, "lengths", None),
-                          title=f"{u} -> {v}: {result.p:.0%} of {result.n} rollouts succeed")
-        return to_png(fig)
-
-    def build(graph, u, v, result):
-        return EdgeQuery(maze=maze, agent=agent, start=graph.region(u), goal=graph.region(v),
-                         avoid=graph.avoid(u, v), success=result.p, n=result.n,
-                         image_png=picture(graph, u, v, result), graph=graph, facts=facts)
-
-    return build
-
-
-def _edge_graph(graph, u, v):
-    from .graph import TaskGraph
-
-    sub = TaskGraph(u)
-    sub.add_vertex(u, graph.region(u), label=graph.label(u))
-    sub.add_vertex(v, graph.region(v), label=graph.label(v))
-    sub.add_edge(u, v, graph.avoid(u, v))
-    sub.finals = {v}
-    return sub
-
-
-def candidate_picture(maze):
-    """SplitCandidate -> PNG of its waypoints and the rollouts of each of its subtasks."""
-    from .render import render_task, to_png
-
-    def picture(candidate):
-        legs = [r for r in candidate.results if getattr(r, "trajectories", None) is not None and r.n]
-        if not legs:
-            return None
-        width = max(r.trajectories.shape[1] for r in legs)
-        from .results import pad_trajectories
-
-        traj = np.concatenate([pad_trajectories(r.trajectories, width) for r in legs])
-        fig = render_task(maze, trajectories=traj, success=np.concatenate([r.success for r in legs]),
-                          lengths=np.concatenate([r.lengths for r in legs]), waypoints=candidate.waypoints,
-                          title="subtask success: " + ", ".join(f"{p:.2f}" for p in candidate.probabilities))
-        return to_png(fig)
-
-    return picture
-
-
-def _result_dict(maze, agent, method, proposer, proposer_spec, seed, original, search, measured, evaluator, t0):
+def _result_dict(exp, config: RunConfig, search, measured, t0) -> dict:
     from .results import wilson_ci
 
+    maze, original, evaluator, proposer = exp.maze, exp.graph, exp.evaluator, exp.proposer
     n_ok, n = int(measured.success.sum()), len(measured.success)
     graph = search.graph
     path_edges = len(search.path) - 1 if search.path else 0
     return {
-        "maze": maze.name, "agent": agent, "method": method, "proposer": proposer_spec,
-        "proposer_is_vlm": bool(getattr(proposer, "is_vlm", False)), "seed": seed,
+        "maze": maze.name, "agent": config.agent, "method": config.method, "proposer": config.proposer,
+        "proposer_is_vlm": bool(getattr(proposer, "is_vlm", False)), "seed": config.seed,
         "success_rate": measured.rate, "success_ci": list(wilson_ci(n_ok, n)), "episodes": n,
         "path_success_rate": float(measured.path_result.p) if measured.path_result else 0.0,
         # where the measured episodes of the path end (success, avoid, flipped, timeout) and each leg's rate

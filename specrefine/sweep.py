@@ -13,6 +13,12 @@ A cell's ``spec`` (``--specs``, or ``MAZE=SPEC`` in ``--mazes``) is the task as 
 given, so the ids of default-task cells (and the rows of older tables, which lack the ``spec``
 column) stay valid; rows are appended in the columns of the table they go into.
 
+The search settings ``w``, ``d`` and ``k`` (``-w 3 5 -k 5 10``; defaults and bounds from
+:class:`specrefine.runconfig.RunConfig`) are grid axes too: a method gets one cell per combination of the
+settings it reads (``methods.Method.knobs``).  A cell with the paper's values keeps the id it always had; any
+other value is named in the id (``...__s0__w5``) and recorded in the ``w``, ``d``, ``k`` columns (a table from
+before them reads as the paper's values; cells with other values are refused into it).
+
 A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
 ``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
 ids and tables stay valid).  ``OUT/sweep.json`` records each cell's ``rollouts`` and ``episodes`` (not part
@@ -34,6 +40,7 @@ import contextlib
 import csv
 import hashlib
 import io
+import itertools
 import json
 import logging
 import math
@@ -55,8 +62,12 @@ from tqdm.auto import tqdm
 from .agents import AGENTS
 from .argtypes import OneLineParser, bounded_int, maze_problem, out_path, proposer_arg
 from .errors import SpecrefineError, SweepError
+from .methods import METHODS, PROPOSER_METHODS
 from .paths import regular_file
+from .runconfig import DEFAULTS, RunConfig, add_run_options
 from .runfolder import replacing, write_atomic
+
+KNOBS = ("w", "d", "k")  # the search settings a sweep can vary (a cell's id names those off the paper's defaults)
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -64,7 +75,7 @@ COLUMNS = [
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
     "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
-    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds",
+    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k",
 ]
 #: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
 #: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
@@ -78,11 +89,14 @@ class Cell:
     method: str
     proposer: str  # "none" for methods that use no proposer
     seed: int
-    rollouts: int = 32
-    episodes: int = 200
+    rollouts: int = DEFAULTS.rollouts
+    episodes: int = DEFAULTS.episodes
     spec: str = ""  # the task as a spec expression; "" = the maze's own task
     evaluation: str = "fixed"  # "fixed" (the paper's protocol) or "adaptive" (specrefine.refine.racing)
     policy: str = "shipped"  # the goal-conditioned policy: "shipped" (data/policies/AGENT.pt) or a checkpoint path
+    w: int = DEFAULTS.w
+    d: int = DEFAULTS.d
+    k: int = DEFAULTS.k
 
     @property
     def id(self) -> str:
@@ -93,7 +107,16 @@ class Cell:
         name = name.replace(":", "-")  # a standard map 'gr:NAME' -> 'gr-NAME' (a folder name on every system)
         task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
         tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
+        tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
+                        if getattr(self, knob) != getattr(DEFAULTS, knob))  # the paper's w, d, k: the id they had
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
+
+    def config(self) -> RunConfig:
+        """What ``refine_maze`` runs for this cell."""
+        return RunConfig(agent=self.agent, method=self.method, seed=self.seed, rollouts=self.rollouts,
+                         episodes=self.episodes, spec=self.spec or None, evaluation=self.evaluation,
+                         proposer="geometric" if self.proposer == "none" else self.proposer, policy=self.policy,
+                         w=self.w, d=self.d, k=self.k)
 
 
 def spec_slug(spec: str) -> str:
@@ -124,9 +147,14 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
-         agent: str = "point", rollouts: int = 32, episodes: int = 200,
-         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped") -> list[Cell]:
+         agent: str = "point", rollouts: int = DEFAULTS.rollouts, episodes: int = DEFAULTS.episodes,
+         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped",
+         w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,)
+         ) -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
+
+    ``w``, ``d``, ``k``: the values of each search setting; a method gets one cell per combination of the settings
+    it reads (``methods.Method.knobs``: dirl none, symbolic k only), the others at the paper's defaults.
 
     ``evaluation``: None = the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
 
@@ -134,9 +162,9 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
     ``MAZE=SPEC`` runs that spec only.
     """
     from .agents import get_agent
-    from .pipeline import PROPOSER_METHODS
 
     evaluation = evaluation or get_agent(agent).default_evaluation
+    axes = {"w": list(w), "d": list(d), "k": list(k)}
     cells = []
     for arg in mazes:
         maze, own = split_maze_arg(str(arg))
@@ -145,9 +173,18 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                 props = list(proposers) if method in PROPOSER_METHODS else ["none"]
                 for proposer in props:
                     for seed in seeds:
-                        cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
-                                          spec, evaluation, policy))
+                        for knobs in _knob_values(method, axes):
+                            cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
+                                              spec, evaluation, policy, **knobs))
     return cells
+
+
+def _knob_values(method: str, axes: dict[str, list[int]]) -> list[dict[str, int]]:
+    """Each combination of the values of the settings ``method`` reads (an unknown method: all of them); the
+    settings it does not read stay at the paper's defaults."""
+    reads = METHODS[method].knobs if method in METHODS else KNOBS
+    values = [axes[knob] if knob in reads else [getattr(DEFAULTS, knob)] for knob in KNOBS]
+    return [dict(zip(KNOBS, combo)) for combo in dict.fromkeys(itertools.product(*values))]
 
 
 def run_cell(cell: Cell, out_root: str) -> dict:
@@ -156,13 +193,9 @@ def run_cell(cell: Cell, out_root: str) -> dict:
 
     row = {**asdict(cell), "cell": cell.id}
     out = Path(out_root) / "cells" / cell.id
-    proposer = "geometric" if cell.proposer == "none" else cell.proposer
-    policy = None if cell.policy == "shipped" else cell.policy
     try:
         with cell_log(out / "log.txt"):
-            result = refine_maze(cell.maze, agent=cell.agent, method=cell.method, proposer=proposer, seed=cell.seed,
-                                 out=out, rollouts=cell.rollouts, episodes=cell.episodes, spec=cell.spec or None,
-                                 evaluation=cell.evaluation, policy_path=policy)
+            result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
@@ -217,7 +250,8 @@ def read_table(path) -> list[dict]:
     path = Path(path)
     if not path.exists():
         return []
-    return [_typed(r) for r in _raw_rows(path)[1]]
+    defaults = {knob: getattr(DEFAULTS, knob) for knob in KNOBS}  # tables from before w, d, k ran the paper's
+    return [{**defaults, **_typed(r)} for r in _raw_rows(path)[1]]
 
 
 def read_checked_table(path) -> list[dict]:
@@ -290,7 +324,7 @@ def _typed(row: dict) -> dict:
         else:
             try:
                 out[k] = int(v) if k in ("seed", "episodes", "evaluations", "sim_steps", "vlm_calls",
-                                                "proposer_calls") else float(v)
+                                                "proposer_calls", *KNOBS) else float(v)
             except (TypeError, ValueError):
                 out[k] = v
     return out
@@ -327,6 +361,9 @@ def _append(path: Path, row: dict) -> None:
             raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
         if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
             raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
+        if any(row.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob) for knob in KNOBS) \
+                and "w" not in columns:
+            raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
     if not new:
         _drop_cut_row(path)
     with path.open("a", newline="") as fh:
@@ -493,6 +530,10 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
         if r.get("status") == "ok":
             if r.get("spec") and "maze" in by:  # a task other than the maze's own is its own group
                 r = {**r, "maze": f"{r['maze']} [{r['spec']}]"}
+            tuned = [f"{knob}={r[knob]}" for knob in KNOBS
+                     if knob not in by and r.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob)]
+            if tuned and "method" in by:  # so is a method run with other w, d or k than the paper's
+                r = {**r, "method": f"{r['method']} [{', '.join(tuned)}]"}
             groups.setdefault(tuple(r[k] for k in by), []).append(r)
     out = []
     for key, rs in sorted(groups.items()):
@@ -564,8 +605,9 @@ def main(argv=None) -> int:
     p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
     p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
-    p.add_argument("--rollouts", type=bounded_int("rollouts"), default=32)
-    p.add_argument("--episodes", type=bounded_int("episodes"), default=200)
+    add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
+    add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
+                                               "of w, d, k it reads)")
     p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
                    help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
                         "when adaptive) (default: fixed for point, adaptive for ant)")
@@ -580,7 +622,7 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
     args = p.parse_args(argv)
     cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
-                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation,
+                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
                  policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
     bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:

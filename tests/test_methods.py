@@ -7,8 +7,10 @@ import json
 import pytest
 
 from specrefine.experiment import setup
-from specrefine.pipeline import METHODS, PROPOSER_METHODS, _search, refine_maze
+from specrefine.methods import run_search
+from specrefine.pipeline import METHODS, PROPOSER_METHODS, refine_maze
 from specrefine.proposers.geometric import GeometricProposer
+from specrefine.runconfig import RunConfig
 
 SMALL = dict(agent="point", rollouts=8, episodes=20, seed=0)
 
@@ -75,7 +77,7 @@ class _Feedback:
 def test_the_no_feedback_control_asks_its_later_round_afresh(method, feedback_seen):
     exp = setup("u_chain_2", agent="point", rollouts=16, seed=1)
     proposer = _Feedback()
-    _search(method, exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze, "point", 1, 3, 2, 5, None)
+    run_search(RunConfig(method=method, seed=1, rollouts=16), exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze)
     assert len(proposer.shown) >= 2  # a later round was asked
     assert any(n > 0 for n in proposer.shown) is feedback_seen
 
@@ -123,7 +125,7 @@ def test_pictures_are_drawn_only_for_a_proposer_that_looks_at_them(method):
     exp = setup("u_chain_2", agent="point", rollouts=8, seed=0)
     blind, seeing = _Seeing(False), _Seeing(True)
     for proposer in (blind, seeing):
-        _search(method, exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze, "point", 0, 3, 2, 5, None)
+        run_search(RunConfig(method=method, rollouts=8), exp.graph, exp.evaluator.fresh_copy(), proposer, exp.maze)
     assert blind.pictures and all(p is None for p in blind.pictures)
     assert seeing.pictures[0][:8] == b"\x89PNG\r\n\x1a\n"  # the query's map
     assert [p is None for p in blind.pictures] == [True] * len(seeing.pictures)  # the same queries were asked

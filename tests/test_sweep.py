@@ -179,3 +179,30 @@ def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path):
                                       text=True).stdout
     finally:
         subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tree)], capture_output=True)
+
+
+def test_w_d_k_are_grid_axes_and_the_paper_values_keep_their_ids(tmp_path):
+    from specrefine.sweep import Cell, _append, pending
+
+    cells = grid(["u_maze"], ["ours", "symbolic", "dirl"], ["geometric"], [0], w=[3, 5], k=[5, 10])
+    ids = sorted(c.id for c in cells)
+    assert ids == sorted(["u_maze__point__ours__geometric__s0", "u_maze__point__ours__geometric__s0__w5",
+                          "u_maze__point__ours__geometric__s0__k10", "u_maze__point__ours__geometric__s0__w5__k10",
+                          "u_maze__point__symbolic__none__s0", "u_maze__point__symbolic__none__s0__k10",
+                          "u_maze__point__dirl__none__s0"])  # symbolic reads k only, dirl none
+    assert {(c.w, c.k) for c in cells if c.method == "ours"} == {(3, 5), (5, 5), (3, 10), (5, 10)}
+    assert Cell("u_maze", "point", "ours", "geometric", 0, k=10).config().k == 10
+    # a table from before the w, d, k columns: its rows read as the paper's values, its cells stay done
+    old = [c for c in COLUMNS if c not in ("w", "d", "k")]
+    table = tmp_path / "results.csv"
+    with table.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=old)
+        writer.writeheader()
+        writer.writerow({c: "" for c in old} | {"cell": "u_maze__point__dirl__none__s0", "status": "ok",
+                                                 "success_rate": 1.0, "success_ci_low": 0.9, "success_ci_high": 1.0,
+                                                 "episodes": 16, "evaluations": 2, "graph_vertices": 3})
+    (row,) = read_table(table)
+    assert (row["w"], row["d"], row["k"]) == (3, 2, 5)
+    assert [c.id for c in pending(cells, table)] == [c.id for c in cells if c.method != "dirl"]
+    with pytest.raises(ValueError, match="no 'w', 'd', 'k' columns"):
+        _append(table, {"cell": "x", "w": 5, "d": 2, "k": 5})

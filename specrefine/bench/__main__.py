@@ -10,7 +10,8 @@ from pathlib import Path
 from ..agents import AGENTS
 from ..argtypes import OneLineParser, bounded_int, maze_problem, out_path, positive_float, proposer_arg
 from ..errors import SpecrefineError
-from ..pipeline import METHODS
+from ..methods import METHODS
+from ..runconfig import DEFAULTS
 from . import __doc__ as package_doc
 
 
@@ -42,7 +43,7 @@ def main(argv=None) -> int:
     r.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2])
     r.add_argument("--method", choices=list(METHODS), default="ours")
     r.add_argument("--proposer", type=proposer_arg, default="geometric")
-    r.add_argument("--episodes", type=bounded_int("episodes"), default=200)
+    r.add_argument("--episodes", type=bounded_int("episodes"), default=DEFAULTS.episodes)
     r.add_argument("--table", type=out_path, default=None, help="CSV the rows are appended to (and resumed from)")
     args = ap.parse_args(argv)
     if args.what == "refine":  # before seconds of Ant setup

@@ -19,6 +19,8 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from ..runconfig import DEFAULTS
+
 COLUMNS = ["maze", "agent", "method", "proposer", "seed", "evaluation", "success_rate", "success_ci_low",
            "success_ci_high", "predicted_success", "predicted_ci_low", "predicted_ci_high", "evaluations",
            "sim_steps", "wall_seconds", "cpu_seconds", "path_edges", "refinements"]
@@ -26,7 +28,7 @@ EVALUATIONS = ("fixed", "adaptive")
 
 
 def bench_refinement(mazes, seeds, agent: str = "ant", method: str = "ours", proposer: str = "geometric",
-                     table=None, episodes: int = 200) -> dict:
+                     table=None, episodes: int = DEFAULTS.episodes) -> dict:
     """Run the grid (resuming ``table``) and return totals and ratios per maze and overall."""
     rows = _read(table) if table else []
     done = {(r["maze"], int(r["seed"]), r["evaluation"]) for r in rows}
@@ -53,7 +55,7 @@ def _run(maze, seed, evaluation, agent, method, proposer, episodes) -> dict:
     try:
         wall, cpu = time.perf_counter(), time.process_time()
         d = refine_maze(maze, agent=agent, method=method, proposer=proposer, seed=seed, out=out / "run",
-                        episodes=episodes, evaluation=evaluation).data
+                        episodes=episodes, evaluation=evaluation, progress=False).data
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     finally:
         shutil.rmtree(out, ignore_errors=True)

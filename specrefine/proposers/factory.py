@@ -1,4 +1,6 @@
-"""``make_proposer(spec)``: the one place that turns a ``--proposer`` string into a proposer.
+"""``make_proposer(spec)``: the one place that turns a ``--proposer`` string into a proposer, through one registry.
+
+A proposer string is ``KIND`` or ``KIND:OPTIONS``; :data:`PROPOSERS` maps each kind to its entry:
 
 * ``litellm:MODEL`` — any model LiteLLM speaks (keys from the environment only); every call is
   recorded to ``data/vlm/`` (or ``record_path``);
@@ -9,12 +11,16 @@
 * ``random`` — random free-space waypoints (an ablation; also not a VLM);
 * ``imperfect:PRESET`` / ``imperfect:key=value,...`` — a VLM-like error model, offline (NOT a VLM).
 
-A new proposer is one more branch here.
+A new proposer is its module and one :func:`register_proposer` call: ``parse`` checks the options (the text
+after ``KIND:``) without side effects and returns what ``build`` needs; ``build(options, spec=..., seed=...,
+record_path=..., **client_kw)`` returns the :class:`Proposer`.  :func:`parse_proposer` checks a whole string.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SpecrefineError
@@ -27,39 +33,67 @@ from .vlm import VLMProposer
 log = logging.getLogger(__name__)
 
 
-def parse_proposer(spec: str) -> tuple[str, object]:
-    """``(kind, option)`` of a ``--proposer`` string, or a one-line :class:`SpecrefineError`: the one parser the
-    command lines validate with (before anything runs) and :func:`make_proposer` builds from.  Options: the
-    waypoint cap (geometric), the error model (imperfect), the path (replay) or the model (litellm)."""
-    kind, _, rest = str(spec).partition(":")
-    if kind == "geometric":
-        return kind, _max_waypoints(rest)
-    if kind == "random" and not rest:
-        return kind, None
-    if kind == "imperfect" and rest:
-        return kind, parse_imperfect(rest)
-    if kind in ("replay", "litellm") and rest:
-        return kind, rest
-    raise SpecrefineError(f"invalid proposer {spec!r}: use geometric, geometric:max_waypoints=N, random, "
-                          "imperfect:PRESET, replay:PATH or litellm:MODEL")
+@dataclass(frozen=True)
+class ProposerKind:
+    name: str  # the KIND before the colon
+    build: Callable[..., Proposer]  # (options, *, spec, seed, record_path, **client_kw) -> Proposer
+    parse: Callable[[str], object]  # options text -> options (SpecrefineError if bad; no side effects)
+    usage: str  # how it is written, for help and messages (e.g. "replay:PATH")
+    description: str  # what it is, for --help
+
+
+PROPOSERS: dict[str, ProposerKind] = {}
+
+
+def register_proposer(name: str, build: Callable[..., Proposer], parse: Callable[[str], object], *,
+                      usage: str | None = None, description: str = "") -> ProposerKind:
+    """Make ``NAME`` / ``NAME:OPTIONS`` a proposer string everywhere (``make_proposer``, the sweep, notebooks)."""
+    if ":" in name or not name:
+        raise ValueError(f"a proposer kind is a non-empty name without ':', got {name!r}")
+    kind = ProposerKind(name, build, parse, usage or name, description)
+    PROPOSERS[name] = kind
+    return kind
+
+
+def usage_text() -> str:
+    """'a, b, c or d': every registered proposer as it is written."""
+    usages = [p.usage.replace(" or ", ", ") for p in PROPOSERS.values()]
+    return ", ".join(usages[:-1]) + f" or {usages[-1]}" if len(usages) > 1 else "".join(usages)
+
+
+def parse_proposer(spec: str) -> tuple[ProposerKind, object]:
+    """``(kind, options)`` of a proposer string; SpecrefineError (one line) if it names no registered proposer or its
+    options are bad."""
+    name, _, rest = str(spec).partition(":")
+    kind = PROPOSERS.get(name)
+    if kind is None:
+        raise SpecrefineError(f"invalid proposer {spec!r}: use {usage_text()}")
+    return kind, kind.parse(rest)
 
 
 def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = None, **client_kw) -> Proposer:
-    """``geometric`` | ``random`` | ``replay:PATH`` | ``litellm:MODEL`` (extra keywords go to LiteLLMClient)."""
-    kind, option = parse_proposer(spec)
-    if kind == "geometric":
-        proposer: Proposer = GeometricProposer(seed=seed, max_waypoints=option)
-        proposer.spec = spec
-    elif kind == "random":
-        proposer = RandomProposer(seed=seed)
-    elif kind == "replay":
-        proposer = VLMProposer(ReplayClient(option), spec=spec)
-    elif kind == "imperfect":
-        proposer = ImperfectProposer(option, spec=spec, seed=seed)
-    else:
-        proposer = VLMProposer(LiteLLMClient(option, record_path=record_path, **client_kw), spec=spec)
+    """The proposer a ``--proposer`` string names (extra keywords go to LiteLLMClient)."""
+    kind, options = parse_proposer(spec)
+    proposer = kind.build(options, spec=spec, seed=seed, record_path=record_path, **client_kw)
     log.info("proposer: %s", proposer.name)
     return proposer
+
+
+def _no_options(name: str):
+    def parse(options: str) -> None:
+        if options:
+            raise SpecrefineError(f"invalid proposer {name + ':' + options!r}: use {usage_text()}")
+
+    return parse
+
+
+def _needs(name: str, what: str):
+    def parse(options: str) -> str:
+        if not options:
+            raise SpecrefineError(f"invalid proposer {name!r}: use {usage_text()} ({name} needs its {what})")
+        return options
+
+    return parse
 
 
 def _max_waypoints(options: str) -> int:
@@ -71,3 +105,39 @@ def _max_waypoints(options: str) -> int:
         raise SpecrefineError(f"invalid proposer 'geometric:{options}': the one option is max_waypoints=N "
                               "(a positive integer)")
     return int(value)
+
+
+def _geometric(max_waypoints, *, spec, seed, **_):
+    proposer = GeometricProposer(seed=seed, max_waypoints=max_waypoints)
+    proposer.spec = spec
+    return proposer
+
+
+def _random(_, *, seed, **__):
+    return RandomProposer(seed=seed)
+
+
+def _imperfect(config, *, spec, seed, **_):
+    return ImperfectProposer(config, spec=spec, seed=seed)
+
+
+def _replay(path, *, spec, **_):
+    return VLMProposer(ReplayClient(path), spec=spec)
+
+
+def _litellm(model, *, spec, record_path, seed=0, **client_kw):
+    return VLMProposer(LiteLLMClient(model, record_path=record_path, **client_kw), spec=spec)
+
+
+register_proposer("geometric", _geometric, _max_waypoints, usage="geometric or geometric:max_waypoints=N",
+                  description="offline shortest-path waypoints, NOT a VLM; at most N waypoints per split, 32 "
+                              "unless given")
+register_proposer("random", _random, _no_options("random"), description="random free-space waypoints, ablation")
+register_proposer("imperfect", _imperfect, parse_imperfect, usage="imperfect:PRESET",
+                  description="or imperfect:key=value,...: a VLM-like error model, offline, NOT a VLM; presets "
+                              "mild, moderate, severe")
+register_proposer("replay", _replay, _needs("replay", "recording's path"), usage="replay:PATH",
+                  description="recorded VLM replies")
+register_proposer("litellm", _litellm, _needs("litellm", "model"), usage="litellm:MODEL",
+                  description="any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; keys from "
+                              "the environment")

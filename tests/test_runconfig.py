@@ -1,0 +1,41 @@
+"""One run configuration: RunConfig's defaults are the CLI's, and result.json records what a run ran with."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, fields
+
+import pytest
+
+from specrefine.cli import build_parser, main
+from specrefine.pipeline import refine_maze
+from specrefine.runconfig import DEFAULTS, RunConfig
+
+
+def test_the_paper_settings_are_the_defaults_of_the_cli():
+    args = build_parser().parse_args(["refine", "u_maze"])
+    assert RunConfig.from_namespace(args) == DEFAULTS == RunConfig()
+    assert (DEFAULTS.rollouts, DEFAULTS.episodes, DEFAULTS.w, DEFAULTS.d, DEFAULTS.k) == (32, 200, 3, 2, 5)
+    assert all(f.metadata["help"] for f in fields(RunConfig))  # every field documented
+
+
+def test_every_field_is_an_option(capsys):
+    args = build_parser().parse_args(["refine", "u_maze", "--agent", "point", "--method", "symbolic", "--proposer",
+                                      "random", "--spec", "a -> G", "--seed", "4", "--rollouts", "8", "--episodes",
+                                      "9", "--policy", "scripted", "-w", "4", "-d", "1", "-k", "6", "--evaluation",
+                                      "adaptive"])
+    assert asdict(RunConfig.from_namespace(args)) == dict(
+        agent="point", method="symbolic", proposer="random", spec="a -> G", seed=4, rollouts=8, episodes=9,
+        policy="scripted", w=4, d=1, k=6, evaluation="adaptive")
+
+
+def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_path, capsys):
+    assert main(["refine", "u_maze", "--method", "dirl", "--rollouts", "8", "--episodes", "16", "-k", "7",
+                 "--out", str(tmp_path / "cli")]) == 0
+    recorded = json.loads((tmp_path / "cli" / "result.json").read_text())["config"]
+    assert recorded == {**asdict(DEFAULTS), "method": "dirl", "rollouts": 8, "episodes": 16, "k": 7,
+                        "evaluation": "fixed"}  # evaluation: the agent's default, resolved
+    data = refine_maze("u_maze", method="dirl", rollouts=8, episodes=16, k=7, out=tmp_path / "kw").data
+    assert data["config"] == recorded
+    with pytest.raises(TypeError):
+        refine_maze("u_maze", rolouts=8, out=tmp_path / "typo")
