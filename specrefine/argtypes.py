@@ -99,30 +99,3 @@ def out_path(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: name a folder (e.g. runs/mine)")
     return Path(text)
-
-
-def proposer_arg(text: str) -> str:
-    """An argparse type: any proposer the library accepts (its one parser, ``proposers.factory.parse_proposer``)."""
-    from .errors import SpecrefineError
-    from .proposers.factory import parse_proposer
-
-    try:
-        parse_proposer(text)
-    except SpecrefineError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
-
-
-def maze_problem(mazes) -> str | None:
-    """The first maze argument (a name, a file, or ``MAZE=SPEC``) that does not load, as one line (None: all do)."""
-    from .errors import SpecrefineError
-    from .mazes import load_maze
-    from .spec import maze_task
-
-    for arg in mazes:
-        maze, _, spec = str(arg).partition("=")
-        try:
-            maze_task(load_maze(maze), spec.strip() or None)
-        except SpecrefineError as exc:
-            return str(exc)
-    return None

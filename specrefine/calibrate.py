@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .runconfig import DEFAULTS
+from .paper import PAPER
 
 HOLDOUT_SEED_OFFSET = 2_000_029  # neither the search's seed nor the measurement's
 HOLDOUT_EPISODES = 64  # end-to-end episodes behind a prediction
@@ -66,7 +66,7 @@ def product_posterior(successes, rollouts, seed: int = 0, draws: int = DRAWS,
     return float(np.prod(a / (a + b))), (float(lo), float(hi))
 
 
-def predict(evaluator, original, graph, path, seed: int = 0, episodes: int = DEFAULTS.episodes,
+def predict(evaluator, original, graph, path, seed: int = 0, episodes: int = PAPER.episodes,
             holdout_episodes: int = HOLDOUT_EPISODES) -> Prediction:
     """Held-out end-to-end estimate of the compositional policy along ``path`` of ``graph``, judged as the
     measurement judges it (on the ``original`` task graph, from its initial set)."""
@@ -199,7 +199,7 @@ def table_rows(table) -> list[dict]:
     """The rows of a predictions table (any CSV with success_rate and predicted_ci_low/high) that have an interval;
     a table that does not parse, or holds no such row, is a one-line :class:`~specrefine.errors.SpecrefineError`."""
     from .errors import SpecrefineError
-    from .sweep import read_checked_table
+    from .tables import read_checked_table
 
     rows = [r for r in read_checked_table(table) if r.get("predicted_ci_low") not in (None, "")
             and r.get("predicted_ci_high") not in (None, "")]

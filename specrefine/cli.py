@@ -16,9 +16,9 @@ import sys
 from pathlib import Path
 
 from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, out_path, proposer_arg, silence_stdout
+from .argtypes import OneLineParser, bounded_int, out_path, silence_stdout
 from .errors import SpecrefineError
-from .runconfig import DEFAULTS, RunConfig, add_run_options
+from .runconfig import DEFAULTS, RunConfig, add_run_options, proposer_arg
 
 AGENTS = tuple(_AGENT_REGISTRY)
 

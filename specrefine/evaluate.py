@@ -48,6 +48,7 @@ import numpy as np
 from .agents import get_agent
 from .errors import PolicyError, SpecrefineError
 from .mazes import Maze
+from .paper import PAPER
 from .regions import CompiledRegion, Region
 from .results import (
     AVOID,
@@ -61,7 +62,6 @@ from .results import (
     unreached,
     wilson_ci,
 )
-from .runconfig import DEFAULTS
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
@@ -89,7 +89,7 @@ class EvaluationFacts:
         return self.horizon * self.control_period
 
     @classmethod
-    def default(cls, agent: str, maze: Maze, rollouts: int = DEFAULTS.rollouts) -> EvaluationFacts:
+    def default(cls, agent: str, maze: Maze, rollouts: int = PAPER.rollouts) -> EvaluationFacts:
         """The facts of an ``Evaluator(maze, agent, ...)`` with default settings, without building one."""
         from .sim import build_model, contact_margin
 
@@ -115,7 +115,7 @@ class Evaluator:
     MIN_BATCH = 8  # running rollouts are compacted into batches of 8, 16, 32, ... (never below 8)
     MEMO_SIZE = 512  # results kept in memory (least recently used dropped; the disk cache keeps everything)
 
-    def __init__(self, maze: Maze, agent: str, policy, n: int = DEFAULTS.rollouts, horizon: int | None = None,
+    def __init__(self, maze: Maze, agent: str, policy, n: int = PAPER.rollouts, horizon: int | None = None,
                  seed: int = 0, cache_dir=None, nthread: int | None = None):
         from .sim import build_model, contact_margin, footprint_radius
 

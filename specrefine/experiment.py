@@ -15,7 +15,7 @@ from .agents import get_agent
 from .errors import PolicyError
 from .graph import TaskGraph
 from .mazes import Maze, load_maze
-from .runconfig import DEFAULTS
+from .paper import PAPER
 
 
 @dataclass
@@ -56,7 +56,7 @@ def load_goal_policy(agent: str, policy="shipped"):
     return loaded, f"trained policy {Path(policy).name}"
 
 
-def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = DEFAULTS.rollouts,
+def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = PAPER.rollouts,
           policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None,
           spec: str | None = None) -> Experiment:
     """Everything an experiment starts from.

@@ -61,9 +61,9 @@ class Maze:
     def from_gymnasium(cls, map_list, name: str = "gymnasium_map", cell_size: float = 1.0) -> Maze:
         """A Gymnasium-Robotics map (rows of 1 / 0 / 'r' / 'g' / 'c'); start and goal as in
         :mod:`specrefine.standard_maps`."""
-        from .standard_maps import from_gymnasium
+        from .standard_maps import maze_text
 
-        return from_gymnasium(map_list, name=name, cell_size=cell_size)
+        return parse_maze(maze_text(map_list, name=name), name, cell_size)
 
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
     @property
@@ -267,10 +267,11 @@ def reachable_cells(maze: Maze, sources, through=None) -> set[tuple[int, int]]:
 def load_maze(path, cell_size: float = 1.0) -> Maze:
     """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/, and 'gr:NAME' is the
     Gymnasium-Robotics map NAME (``specrefine.standard_maps``)."""
-    from .standard_maps import PREFIX, load_standard
+    from .standard_maps import PREFIX, standard_text
 
     if isinstance(path, str) and path.startswith(PREFIX):
-        return load_standard(path, cell_size)
+        name, text = standard_text(path)
+        return parse_maze(text, name, cell_size)
     path = Path(path)
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"

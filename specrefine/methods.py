@@ -10,11 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 from .agents import get_agent
 from .errors import SpecrefineError
 from .queries import candidate_picture, edge_query_builder
-from .runconfig import RunConfig
+
+if TYPE_CHECKING:  # an annotation only: runconfig reads the registry for its choices
+    from .runconfig import RunConfig
 
 KNOBS = ("w", "d", "k")  # the search settings of RunConfig a method may read
 

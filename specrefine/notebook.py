@@ -57,8 +57,6 @@ def record(name: str, value, *, tol: float | None = None, rel: float | None = No
     """Display ``name = value`` and store it in the cell's output for ``read_records``; returns the value."""
     from IPython.display import display
 
-    import specrefine
-
     stored = _jsonable(value)
     if isinstance(stored, float) and not math.isfinite(stored):
         stored = str(stored)  # JSON has no inf/nan; compare as text
@@ -66,7 +64,7 @@ def record(name: str, value, *, tol: float | None = None, rel: float | None = No
     text = f"{name} = {stored!r}" + (f"  ({', '.join(b for b in bounds if b)})" if any(bounds) else "")
     payload = {"name": name, "value": stored, "tol": tol, "rel": rel}
     display({MIME: payload, "text/plain": text}, raw=True,
-            metadata={MIME: {"package": str(Path(specrefine.__file__).resolve().parent)}})
+            metadata={MIME: {"package": str(Path(__file__).resolve().parent)}})
     return value
 
 
@@ -99,8 +97,9 @@ def _check_value(name: str, value, rule: str) -> None:
     import argparse
 
     from .agents import AGENTS
-    from .argtypes import LIMITS, bounded_int, proposer_arg
+    from .argtypes import LIMITS, bounded_int
     from .pipeline import METHODS
+    from .runconfig import proposer_arg
 
     if rule in LIMITS:
         if isinstance(value, bool) or not isinstance(value, int):

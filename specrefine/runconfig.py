@@ -22,6 +22,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 from .argtypes import bounded_int
+from .paper import PAPER
 
 
 def option(default, help, *, flags: tuple[str, ...] = (), type: Callable | None = None,
@@ -80,16 +81,16 @@ class RunConfig:
                                     "must end in G; e.g. '(a | b) -> c -> G'", metavar="EXPR",
                               shown="the maze's '; spec:' line, else its chain a -> b -> ... -> G")
     seed: int = option(0, "random seed for rollouts and proposers", type=bounded_int("seed"))
-    rollouts: int = option(32, "rollouts per subtask evaluation", type=bounded_int("rollouts"))
-    episodes: int = option(200, "fresh end-to-end episodes to measure the final policy on the original task",
+    rollouts: int = option(PAPER.rollouts, "rollouts per subtask evaluation", type=bounded_int("rollouts"))
+    episodes: int = option(PAPER.episodes, "fresh end-to-end episodes to measure the final policy on the original task",
                            type=bounded_int("episodes"))
     policy: str = option("shipped", "policy checkpoint: a path, 'shipped' (data/policies/AGENT.pt) or 'scripted' "
                                     "(the point mass's straight-line controller)", type=policy_arg,
                          shown="the shipped data/policies/AGENT.pt")
-    w: int = option(3, "candidate edge splits per VLM query (at most 20)", flags=("-w",),
+    w: int = option(PAPER.w, "candidate edge splits per VLM query (at most 20)", flags=("-w",),
                     type=bounded_int("w"))
-    d: int = option(2, "VLM query rounds per edge split (at most 10)", flags=("-d",), type=bounded_int("d"))
-    k: int = option(5, "subsets sampled per vertex refinement (at most 100)", flags=("-k",),
+    d: int = option(PAPER.d, "VLM query rounds per edge split (at most 10)", flags=("-d",), type=bounded_int("d"))
+    k: int = option(PAPER.k, "subsets sampled per vertex refinement (at most 100)", flags=("-k",),
                     type=bounded_int("k"))
     evaluation: str | None = option(None, "fixed: every subtask estimate on --rollouts rollouts (the paper); "
                                           "adaptive: the vertex refinement's candidates in stages, stopping those "
@@ -141,3 +142,31 @@ def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[s
         if meta["metavar"] is not None:
             kwargs["metavar"] = meta["metavar"]
         parser.add_argument(*(meta["flags"] or ("--" + name.replace("_", "-"),)), dest=name, **kwargs)
+
+
+# --- argument checks that need the registries (argtypes holds those that need nothing) -----------------
+def proposer_arg(text: str) -> str:
+    """An argparse type: any proposer the library accepts (its one parser, ``proposers.factory.parse_proposer``)."""
+    from .errors import SpecrefineError
+    from .proposers.factory import parse_proposer
+
+    try:
+        parse_proposer(text)
+    except SpecrefineError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def maze_problem(mazes) -> str | None:
+    """The first maze argument (a name, a file, or ``MAZE=SPEC``) that does not load, as one line (None: all do)."""
+    from .errors import SpecrefineError
+    from .mazes import load_maze
+    from .spec import maze_task
+
+    for arg in mazes:
+        maze, _, spec = str(arg).partition("=")
+        try:
+            maze_task(load_maze(maze), spec.strip() or None)
+        except SpecrefineError as exc:
+            return str(exc)
+    return None

@@ -278,11 +278,3 @@ def sample_goals(xy: np.ndarray, lo: float, hi: float, rng: np.random.Generator)
     r = rng.uniform(lo, hi, size=len(xy))
     a = rng.uniform(-np.pi, np.pi, size=len(xy))
     return xy + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
-
-
-def __getattr__(name: str):
-    if name == "GoalReachEnv":  # the TorchRL training env lives in reach_env (TorchRL is slow to import)
-        from .reach_env import GoalReachEnv
-
-        return GoalReachEnv
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

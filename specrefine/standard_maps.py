@@ -62,19 +62,19 @@ def gymnasium_maps() -> dict[str, list]:
             if name.isupper() and isinstance(value, list) and value and isinstance(value[0], list)}
 
 
-def load_standard(ref: str, cell_size: float = 1.0):
-    """``'gr:NAME'`` -> the Maze of that Gymnasium-Robotics map; an unknown name is one MazeError line."""
+def standard_text(ref: str) -> tuple[str, str]:
+    """``'gr:NAME'`` -> (its maze name, the ``.maze`` text of that Gymnasium-Robotics map); an unknown name is one
+    MazeError line.  ``mazes.load_maze`` parses it."""
     name = ref[len(PREFIX):] if ref.startswith(PREFIX) else ref
     maps = gymnasium_maps()
     if name not in maps:
         raise MazeError(f"{ref}: no Gymnasium-Robotics map {name!r}; known: {', '.join(sorted(maps))}")
-    return from_gymnasium(maps[name], name=f"{PREFIX}{name}", cell_size=cell_size)
+    return f"{PREFIX}{name}", maze_text(maps[name], name=f"{PREFIX}{name}")
 
 
-def from_gymnasium(map_list, name: str = "gymnasium_map", cell_size: float = 1.0):
-    """A Gymnasium-Robotics map (list of lists of 1 / 0 / 'r' / 'g' / 'c') as a Maze (see the module docstring)."""
-    from .mazes import parse_maze
-
+def maze_text(map_list, name: str = "gymnasium_map") -> str:
+    """A Gymnasium-Robotics map (list of lists of 1 / 0 / 'r' / 'g' / 'c') as ``.maze`` text, start and goal by the
+    rules of the module docstring (``mazes.Maze.from_gymnasium`` parses it)."""
     rows = _checked(map_list, name)
     walls = [[cell == 1 for cell in row] for row in rows]
     free = [(r, c) for r, row in enumerate(walls) for c, wall in enumerate(row) if not wall]
@@ -92,7 +92,7 @@ def from_gymnasium(map_list, name: str = "gymnasium_map", cell_size: float = 1.0
     grid = ["".join("#" if wall else "." for wall in row) for row in walls]
     for (r, c), ch in [(cell, "S") for cell in starts] + [(goal, "G")]:
         grid[r] = grid[r][:c] + ch + grid[r][c + 1:]
-    return parse_maze("\n".join(grid), name, cell_size)
+    return "\n".join(grid)
 
 
 def to_gymnasium(maze) -> list[list[int]]:

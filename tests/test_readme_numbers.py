@@ -14,7 +14,8 @@ from pathlib import Path
 from specrefine.sweep import read_table, summarise
 
 ROOT = Path(__file__).parents[1]
-README = (ROOT / "README.md").read_text()
+README = (ROOT / "docs" / "results.md").read_text()  # the results page (README, the front page, links to it)
+FRONT = (ROOT / "README.md").read_text()
 
 _spec = importlib.util.spec_from_file_location("per_maze_report", ROOT / "scripts" / "per_maze_report.py")
 per_maze_report = importlib.util.module_from_spec(_spec)
@@ -205,3 +206,22 @@ def test_repair_summary_is_the_repair_grid():
     assert "(*partial*)" not in summary
     assert f"<!-- repair summary -->\n{summary}\n" in README
     assert (ROOT / "data/results/repair/summary.md").read_text() == summary + "\n"
+
+
+def test_front_page_point_line_is_results_csv():
+    rows = [r for r in read_table(ROOT / "data/results/results.csv") if r["proposer"] in ("geometric", "none")]
+    ours = {r["maze"]: r["success_rate"] for r in rows if r["method"] == "ours" and r["seed"] == 0}
+    dirl = {r["maze"]: r["success_rate"] for r in rows if r["method"] == "dirl" and r["seed"] == 0}
+    good = [m for m, p in ours.items() if p >= 0.99 and dirl[m] == 0.0]
+    rest = sorted(set(ours) - set(good))
+    text = " ".join(FRONT.split())
+    assert f"`ours` reaches at least 0.99 on {len(good)} of the {len(ours)} mazes" in text
+    assert rest == ["two_doors"] and f"0.955 (`dirl` {dirl['two_doors']:.3f})" in text
+    assert ours["two_doors"] == 0.955
+
+
+def test_front_page_shows_the_ant_claims_as_computed():
+    claims = (ROOT / "data/results/ant/comparison/claims.md").read_text()
+    block = FRONT[FRONT.index("<!-- ant comparison claims -->"):].split("\n\n")[0]
+    assert block.splitlines()[1:] and all(line in claims for line in block.splitlines()[1:])
+    assert block in README  # the same table as the results page, whose test recomputes it from the CSV

@@ -8,10 +8,10 @@ import warnings
 from pathlib import Path
 
 from ..agents import AGENTS
-from ..argtypes import OneLineParser, bounded_int, maze_problem, out_path, positive_float, proposer_arg
+from ..argtypes import OneLineParser, bounded_int, out_path, positive_float
 from ..errors import SpecrefineError
 from ..methods import METHODS
-from ..runconfig import DEFAULTS
+from ..runconfig import DEFAULTS, maze_problem, proposer_arg
 from . import __doc__ as package_doc
 
 

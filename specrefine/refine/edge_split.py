@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..paper import PAPER
 from ..regions import Region
-from ..runconfig import DEFAULTS
 from .common import Leg, SubtaskEvaluator, estimate_legs
 from .vertex import refine_chain
 
@@ -57,8 +57,8 @@ def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
     return [Leg(x, avoid) for x in waypoints] + [Leg(goal, avoid, goal_point)]
 
 
-def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = DEFAULTS.w,
-               d: int = DEFAULTS.d, k: int = DEFAULTS.k, rng: np.random.Generator, picture: Callable | None = None,
+def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = PAPER.w,
+               d: int = PAPER.d, k: int = PAPER.k, rng: np.random.Generator, picture: Callable | None = None,
                racing=None, feedback: bool = True, tune: bool = True) -> SplitOutcome:
     """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
     from ..proposers import CandidateFeedback

@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..graph import check_refines
-from ..runconfig import DEFAULTS
+from ..paper import PAPER
 from .search import SearchResult, shortest_path
 
 
-def oneshot(original, evaluator, proposer, *, maze, agent, w=DEFAULTS.w, rounds=DEFAULTS.d, seed=0, on_step=None,
+def oneshot(original, evaluator, proposer, *, maze, agent, w=PAPER.w, rounds=PAPER.d, seed=0, on_step=None,
             budget: tuple[int, int] | None = None) -> SearchResult:
     """The paper's baseline; with ``budget = (proposer calls, subtask evaluations)`` instead a best-of-N:
     first-round queries (no feedback) repeated until either budget is spent (the matched control)."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..graph import TaskGraph, assert_refines
-from ..runconfig import DEFAULTS
+from ..paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .racing import Racing
@@ -42,9 +42,9 @@ EVALUATIONS = ("fixed", "adaptive")
 
 @dataclass
 class SearchConfig:
-    w: int = DEFAULTS.w  # candidate edge splits per proposer query
-    d: int = DEFAULTS.d  # proposer rounds per edge split
-    k: int = DEFAULTS.k  # subsets sampled per vertex refinement
+    w: int = PAPER.w  # candidate edge splits per proposer query
+    d: int = PAPER.d  # proposer rounds per edge split
+    k: int = PAPER.k  # subsets sampled per vertex refinement
     edge_refinement: bool = True
     vertex_refinement: bool = True  # the search's own vertex refinements (Algorithm 3)
     split_tuning: bool = True  # Algorithm 2 on an edge split's later-round candidates (Algorithm 1, line 10)

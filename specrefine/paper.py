@@ -1,0 +1,18 @@
+"""The paper's settings, written once. A run's defaults (``runconfig.RunConfig``) and the algorithms called directly
+both read them here; this module imports nothing, so every layer may."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PaperSettings:
+    w: int = 3  # candidate edge splits per proposer query (Algorithm 1)
+    d: int = 2  # proposer rounds per edge split (Algorithm 1)
+    k: int = 5  # subsets sampled per vertex refinement (Algorithm 2)
+    rollouts: int = 32  # rollouts per subtask evaluation
+    episodes: int = 200  # fresh end-to-end episodes of the final measurement
+
+
+PAPER = PaperSettings()
