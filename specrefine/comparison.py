@@ -33,7 +33,8 @@ from .render import PngFigure
 from .runfolder import save_figure, write_atomic
 from .sweep import is_done, mean_std
 
-COMPARISON_METHODS = ["ours", "ours-novertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"]
+COMPARISON_METHODS = ["ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
+                      "vlm-oneshot", "vlm-oneshot-matched"]
 ERROR_LEVELS = ["imperfect:mild", "imperfect:moderate", "imperfect:severe"]  # alpha = 0: the x axis, in order
 ALPHA_PRESET = "imperfect:moderate,alpha=0.1"  # builds the paper's hypothesis into the model: shown apart
 PRESETS = ERROR_LEVELS + [ALPHA_PRESET]
@@ -69,10 +70,11 @@ class Grid:
     contrasts: tuple = ()  # (first, second) method pairs: paired differences on the multi-room cells (descriptive)
 
 
-#: The offline comparison of docs/proposers.md (point mass, five methods, four presets, four seeds).
+#: The offline comparison of docs/proposers.md (point mass, eight methods, four presets, four seeds).
 POINT_GRID = Grid("point", tuple(COMPARISON_METHODS), tuple(COMPARISON_METHODS), tuple(PRESETS), SEEDS,
                   tuple(ERROR_LEVELS), (("vlm-oneshot-matched", "vlm-oneshot"), ("ours", "ours-novertex"),
-                                        ("ours", "ours-d1")))
+                                        ("ours", "ours-nosearchvertex"), ("ours", "ours-notune"),
+                                        ("ours", "ours-nofeedback"), ("ours", "ours-d1")))
 #: The Ant comparison of docs/ant_experiments.md section 3: the paper's methods, claims on ours and one-shot.
 ANT_GRID = Grid("ant", ("dirl", "symbolic", "vlm-oneshot", "ours"), ("ours", "vlm-oneshot"),
                 ("geometric", "imperfect:moderate"), (0, 1, 2))

@@ -225,3 +225,24 @@ def test_front_page_shows_the_ant_claims_as_computed():
     block = FRONT[FRONT.index("<!-- ant comparison claims -->"):].split("\n\n")[0]
     assert block.splitlines()[1:] and all(line in claims for line in block.splitlines()[1:])
     assert block in README  # the same table as the results page, whose test recomputes it from the CSV
+
+
+#: the control contrasts the results page quotes: (preset, control, verdict of ours - control)
+ATTRIBUTION = [("mild", "ours-d1", "higher"), ("moderate", "ours-d1", "higher"),
+               ("moderate,alpha=0.1", "ours-d1", "higher"),
+               ("mild", "ours-nofeedback", "undecided"), ("moderate", "ours-nofeedback", "undecided"),
+               ("moderate,alpha=0.1", "ours-nofeedback", "lower"),
+               ("mild", "ours-novertex", "higher"), ("moderate", "ours-novertex", "higher"),
+               ("moderate,alpha=0.1", "ours-novertex", "higher"),
+               ("mild", "ours-notune", "higher"), ("moderate", "ours-notune", "undecided"),
+               ("mild", "ours-nosearchvertex", "undecided"), ("moderate", "ours-nosearchvertex", "lower")]
+
+
+def test_control_attribution_is_the_tables_contrasts():
+    _, contrasts, _ = _offline()
+    text = " ".join(README.split())
+    for preset, control, verdict in ATTRIBUTION:
+        c = contrasts["imperfect:" + preset, f"ours - {control}"]
+        assert f"{c['estimate']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]" in text, (preset, control)
+        assert c["verdict"] == verdict, (preset, control)
+    assert all(c["verdict"] == "undecided" for (p, name), c in contrasts.items() if p == "imperfect:severe")
