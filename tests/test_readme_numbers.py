@@ -246,3 +246,15 @@ def test_control_attribution_is_the_tables_contrasts():
         assert f"{c['estimate']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]" in text, (preset, control)
         assert c["verdict"] == verdict, (preset, control)
     assert all(c["verdict"] == "undecided" for (p, name), c in contrasts.items() if p == "imperfect:severe")
+
+
+def test_front_page_offline_line_is_the_claims():
+    by, contrasts, _ = _offline()
+    verdict = {p: by["imperfect:" + p, "ours / vlm-oneshot"]["verdict"] for p in ("mild", "moderate", "severe")}
+    assert verdict == {"mild": "undecided", "moderate": "holds", "severe": "undecided"}
+    assert all(by[p, "ours"]["verdict"] == "falls" for p, m in by if m == "ours")  # falls at every error level
+    said = {("mild", "ours-d1"): "higher", ("moderate", "ours-d1"): "higher", ("mild", "ours-notune"): "higher",
+            ("mild", "ours-nofeedback"): "undecided", ("moderate", "ours-nofeedback"): "undecided",
+            ("mild", "ours-nosearchvertex"): "undecided"}  # later round and tuning help; feedback, search vertices not
+    assert {k: contrasts["imperfect:" + k[0], f"ours - {k[1]}"]["verdict"] for k in said} == said
+    assert "at least 2x the one-shot on the multi-room tasks at moderate errors" in " ".join(FRONT.split())
