@@ -141,15 +141,15 @@ def test_a_rerun_stopped_midway_keeps_the_finished_runs_record(tmp_path, monkeyp
 
     assert cli_main(refine_args(tmp_path, maze="u_chain_1")) == 0
     before = {name: (tmp_path / name).read_bytes() for name in ("steps.jsonl", "result.json", "run.json")}
-    real = pipeline._search
+    real = pipeline.run_search
 
-    def stopped(*args, **kw):  # the rerun logs a step, then is stopped (as by a kill) before it finishes
-        args[10]({"step": 0, "event": "expand"})
+    def stopped(config, graph, evaluator, proposer, maze, on_step=None):  # logs a step, then is stopped (a kill)
+        on_step({"step": 0, "event": "expand"})
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(pipeline, "_search", stopped)
+    monkeypatch.setattr(pipeline, "run_search", stopped)
     assert cli_main(refine_args(tmp_path, maze="u_chain_1")) == 130
-    monkeypatch.setattr(pipeline, "_search", real)
+    monkeypatch.setattr(pipeline, "run_search", real)
     assert {name: (tmp_path / name).read_bytes() for name in before} == before
     assert not [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]  # no temporary file left behind
 
