@@ -53,44 +53,50 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def official(args) -> int:
+def _command(work, show, interrupted: str) -> int:
+    """Run ``work()`` and print ``show(its result)``: bad input is one line and exit 2, Ctrl-C exit 130, and a
+    closed pipe (``specrefine ... | head``) no traceback once the work is done and written."""
     try:
-        from .official import run_official, summary
-
-        data = run_official(args.run_dir, episodes=args.episodes, seed=args.seed)
+        result = work()
     except SpecrefineError as exc:
         print(f"specrefine: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("specrefine: interrupted; nothing written", file=sys.stderr)
+        print(f"specrefine: interrupted; {interrupted}", file=sys.stderr)
         return 130
     try:
-        print(summary(data) + f"\n  -> {args.run_dir / 'official.json'}", flush=True)
+        print(show(result), flush=True)
     except BrokenPipeError:
         silence_stdout()
     return 0
+
+
+def official(args) -> int:
+    def work():
+        from .official import run_official
+
+        return run_official(args.run_dir, episodes=args.episodes, seed=args.seed)
+
+    def show(data):
+        from .official import summary
+
+        return summary(data) + f"\n  -> {args.run_dir / 'official.json'}"
+
+    return _command(work, show, "nothing written")
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "official":
         return official(args)
-    try:
+
+    def work():
         from .pipeline import refine_maze  # heavy imports only after argument parsing
 
-        result = refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out,
-                             progress=False if args.quiet else None)
-    except SpecrefineError as exc:
-        print(f"specrefine: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("specrefine: interrupted; evaluations so far are kept in the cache under --out", file=sys.stderr)
-        return 130
-    try:
-        print(result.summary(), flush=True)
-    except BrokenPipeError:  # `specrefine refine ... | head`: the run is done and written; no traceback at exit
-        silence_stdout()
-    return 0
+        return refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out,
+                           progress=False if args.quiet else None)
+
+    return _command(work, lambda result: result.summary(), "evaluations so far are kept in the cache under --out")
 
 
 if __name__ == "__main__":

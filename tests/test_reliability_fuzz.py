@@ -50,18 +50,23 @@ def time_limit(seconds: int):
 def refine(*args: str) -> tuple[int, str, str, Path]:
     """Exit code, the CLI's stderr, the log records and the run folder of ``specrefine refine ARGS``."""
     out = Path(tempfile.mkdtemp(prefix="fuzz_"))
+    return (*captured(cli_main, ["refine", *args, "--out", str(out / "run"), *TINY]), out)
+
+
+def captured(main, argv: list[str]) -> tuple[int, str, str]:
+    """Exit code, stderr and the log records of ``main(argv)``, within the time limit."""
     err, logs = io.StringIO(), io.StringIO()
     handler = logging.StreamHandler(logs)
     logging.getLogger().addHandler(handler)
     try:
         with time_limit(LIMIT_S), contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             try:
-                code = cli_main(["refine", *args, "--out", str(out / "run"), *TINY])
-            except SystemExit as exc:  # argparse
+                code = main(argv)
+            except SystemExit as exc:  # argparse, p.exit
                 code = exc.code
     finally:
         logging.getLogger().removeHandler(handler)
-    return code, err.getvalue(), logs.getvalue(), out
+    return code, err.getvalue(), logs.getvalue()
 
 
 def assert_result_or_one_line(code, err, logs, out):
@@ -300,19 +305,7 @@ COMMANDS = {"sweep": "specrefine.sweep", "calibrate": "specrefine.calibrate", "f
 
 
 def run_command(module: str, argv: list[str]) -> tuple[int, str, str]:
-    main = import_module(module).main
-    err, logs = io.StringIO(), io.StringIO()
-    handler = logging.StreamHandler(logs)
-    logging.getLogger().addHandler(handler)
-    try:
-        with time_limit(LIMIT_S), contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-            try:
-                code = main(argv)
-            except SystemExit as exc:  # argparse, p.exit
-                code = exc.code
-    finally:
-        logging.getLogger().removeHandler(handler)
-    return code, err.getvalue(), logs.getvalue()
+    return captured(import_module(module).main, argv)
 
 
 @pytest.mark.parametrize("name", sorted(COMMANDS))
