@@ -9,10 +9,12 @@ each leg would lose if legs failed independently and alike. Rooms: N of a ``u_ch
 """
 import argparse
 import re
+import sys
 
 from specrefine.argtypes import exit_code_quiet_on_broken_pipe
+from specrefine.errors import SpecrefineError
 from specrefine.results import wilson_ci
-from specrefine.sweep import is_done, read_table
+from specrefine.sweep import is_done, read_checked_table
 
 HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | legs | legs per room | per-leg failure | "
           "evaluations | sim steps | wall s |\n|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -40,7 +42,7 @@ def line(key: tuple, runs: list[dict]) -> str:
 def report(tables, method=None, proposer=None) -> str:
     groups: dict[tuple, list[dict]] = {}
     for table in tables:
-        for r in read_table(table):
+        for r in read_checked_table(table):
             if is_done(r) and method in (None, r["method"]) and proposer in (None, r["proposer"]):
                 policy = str(r.get("policy") or "shipped").rsplit("/", 1)[-1]
                 groups.setdefault((r["maze"], r["method"], r["proposer"], policy), []).append(r)
@@ -54,7 +56,11 @@ def main(argv=None) -> int:
     ap.add_argument("--method")
     ap.add_argument("--proposer")
     args = ap.parse_args(argv)
-    print(report(args.tables, args.method, args.proposer))
+    try:
+        print(report(args.tables, args.method, args.proposer))
+    except SpecrefineError as exc:  # a missing or malformed table: one line
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     return 0
 
 

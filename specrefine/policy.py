@@ -142,10 +142,10 @@ def load_policy(path_or_agent) -> GoalPolicy:
                           "does not match a known agent")
     if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS and agent != path_or_agent:
         raise PolicyError(f"{path}: holds a {agent} policy, expected {path_or_agent}")
-    frame = blob.get("observation_frame", "world")  # files written before the heading frame carry none
-    if frame not in OBSERVATION_FRAMES:
-        raise PolicyError(f"{path}: observation frame {frame!r} is not one of {', '.join(OBSERVATION_FRAMES)}")
-    policy = GoalPolicy(agent, observation_frame=frame)
+    try:  # files written before the heading frame carry none
+        policy = GoalPolicy(agent, observation_frame=blob.get("observation_frame", "world"))
+    except PolicyError as exc:
+        raise PolicyError(f"{path}: {exc}") from None
     state = blob.get("state_dict")
     if not isinstance(state, dict):
         raise PolicyError(f"{path}: no weights (state_dict) in the policy file")

@@ -110,12 +110,8 @@ def heading(quat: np.ndarray) -> np.ndarray:
     return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
-def in_heading_frame(rel: np.ndarray, quat: np.ndarray) -> np.ndarray:
-    """Planar vectors ``rel`` (n, 2) in the heading (yaw) frame of the quaternions ``quat`` (n, 4)."""
-    return _rotated(rel, heading(quat))
-
-
 def _rotated(vec: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Planar vectors ``vec`` (n, 2) in the frame turned by ``yaw`` (n,)."""
     c, s = np.cos(yaw), np.sin(yaw)
     return np.stack([c * vec[:, 0] + s * vec[:, 1], -s * vec[:, 0] + c * vec[:, 1]], axis=1)
 

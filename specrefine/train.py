@@ -187,9 +187,10 @@ class Trainer:
         if cfg.switch_radius is not None:
             optional["goal_radius"] = _radius_range(cfg.switch_radius)
         task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
+        # the policy first: a bad --observation-frame is one line before the simulator is built
+        self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
                                 frame=cfg.observation_frame)
-        self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.actor, self.critic = make_modules(self.policy, self.env)
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
                                 entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,
