@@ -34,7 +34,7 @@ notebook-expected-full: $(VENV)/.installed
 	$(BIN)/python -m pytest -q -m notebooks_full --update-notebook-expected
 
 executed: $(VENV)/.installed
-	$(BIN)/python -m specrefine.notebook executed --tier full --out notebooks/executed
+	$(BIN)/python -m specrefine.runs.notebook executed --tier full --out notebooks/executed
 
 LAB_PORT ?= 8888
 lab: $(VENV)/.installed

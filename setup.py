@@ -1,7 +1,7 @@
 """Build hook: a wheel carries the top-level ``prompts/`` and ``data/`` files the package reads.
 
 The checkout's ``prompts/`` and ``data/`` stay the source; ``build_py`` copies the files a run needs
-into ``specrefine/_shipped/`` of the build, where :mod:`specrefine.paths` finds them when no
+into ``specrefine/_shipped/`` of the build, where :mod:`specrefine.core.paths` finds them when no
 checkout is around.  Everything else is in ``pyproject.toml``.
 """
 

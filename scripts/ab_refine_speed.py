@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import specrefine
-from specrefine.pipeline import refine_maze
+from specrefine.runs.pipeline import refine_maze
 
 
 def main() -> None:

@@ -9,15 +9,15 @@ py=${PYTHON:-.venv/bin/python}
 mkdir -p "$out"
 for tag in stage3 stage4; do
     pol=$([ "$tag" = stage3 ] && echo data/policies/ant.pt || echo "$new")
-    [ -s "$out/open_floor_$tag.json" ] || $py -m specrefine.train --agent ant --evaluate "$pol" --episodes 500 \
+    [ -s "$out/open_floor_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --episodes 500 \
         --seed 1 --goal-range 2 6 > "$out/open_floor_$tag.json"
-    [ -s "$out/chain8_$tag.json" ] || $py -m specrefine.train --agent ant --evaluate "$pol" --chain 8 \
+    [ -s "$out/chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
         --goal-range 3 5 --episodes 200 --seed 5 > "$out/chain8_$tag.json"
     for run in u_chain_3__ant__ours__geometric__s0__adaptive u_chain_2__ant__ours__geometric__s1__adaptive \
                u_chain_2__ant__ours__geometric__s2__adaptive; do
         seed=${run##*geometric__}
         file="$out/${run%%__ant*}_${seed%%__*}_$tag.json"
-        [ -s "$file" ] || $py -m specrefine.failures "$cells/$run/result.json" --episodes 300 --seed 77 \
+        [ -s "$file" ] || $py -m specrefine.experiments.failures "$cells/$run/result.json" --episodes 300 --seed 77 \
             --policy "$pol" --out "$file" > /dev/null
     done
 done

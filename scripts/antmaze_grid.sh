@@ -1,6 +1,6 @@
 #!/bin/bash
 # The AntMaze grid of issue 28 (NOT RUN YET: many hours of Ant simulation on a 2-core machine): the D4RL AntMaze
-# maps U, MEDIUM and LARGE (gr:NAME, start and goal as in specrefine/standard_maps.py) with the Ant, the methods
+# maps U, MEDIUM and LARGE (gr:NAME, start and goal as in specrefine/core/standard_maps.py) with the Ant, the methods
 # dirl, vlm-oneshot and ours, the proposers geometric and imperfect:moderate, seeds 0-2, 200 episodes per cell:
 #   mkdir -p runs && nohup setsid bash scripts/antmaze_grid.sh > runs/antmaze.log 2>&1 &
 # Resumable (rerun the same command). POLICY defaults to the goal policy of the Ant comparison
@@ -10,6 +10,6 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 policy=${POLICY:-$root/data/policies/ant_stage4.pt}
-python -m specrefine.sweep --agent ant --mazes gr:U_MAZE gr:MEDIUM_MAZE gr:LARGE_MAZE \
+python -m specrefine.runs.sweep --agent ant --mazes gr:U_MAZE gr:MEDIUM_MAZE gr:LARGE_MAZE \
     --methods dirl vlm-oneshot ours --proposers geometric imperfect:moderate --seeds 0 1 2 \
     --episodes 200 --policy "$policy" --workers "${WORKERS:-2}" --out "${OUT:-$root/runs/antmaze}"

@@ -12,11 +12,11 @@ from __future__ import annotations
 import json
 import sys
 
-from specrefine.errors import ProposalRejected
-from specrefine.mazes import benchmark_mazes, load_maze
+from specrefine.core.errors import ProposalRejected
+from specrefine.core.mazes import benchmark_mazes, load_maze
+from specrefine.core.spec import maze_task
 from specrefine.proposers import EdgeQuery, GraphQuery, parse_graph, parse_split
 from specrefine.proposers.imperfect import ALPHA_ON, PRESETS, ErrorModelClient
-from specrefine.spec import maze_task
 
 REPLIES = 100
 

@@ -11,10 +11,10 @@ import argparse
 import re
 import sys
 
-from specrefine.argtypes import exit_code_quiet_on_broken_pipe
-from specrefine.errors import SpecrefineError
-from specrefine.results import wilson_ci
-from specrefine.sweep import is_done, read_checked_table
+from specrefine.core.argtypes import exit_code_quiet_on_broken_pipe
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.results import wilson_ci
+from specrefine.runs.sweep import is_done, read_checked_table
 
 HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | legs | legs per room | per-leg failure | "
           "evaluations | sim steps | wall s |\n|---|---|---|---|---|---|---|---|---|---|---|---|")

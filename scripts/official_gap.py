@@ -22,9 +22,9 @@ SIM_SEED = 777  # fresh episodes: neither the search's seed nor the run's measur
 
 def sim_side(run: Path, episodes: int) -> dict:
     import specrefine
-    from specrefine.graph import TaskGraph
-    from specrefine.monitor import measure
-    from specrefine.results import wilson_ci
+    from specrefine.core.graph import TaskGraph
+    from specrefine.core.results import wilson_ci
+    from specrefine.evaluation.monitor import measure
 
     result = json.loads((run / "result.json").read_text())
     exp = specrefine.setup(json.loads((run / "run.json").read_text())["maze"], agent="point")
@@ -36,7 +36,7 @@ def sim_side(run: Path, episodes: int) -> dict:
 
 def main() -> None:
     from specrefine.cli import main as cli
-    from specrefine.official import run_official
+    from specrefine.runs.official import run_official
 
     p = argparse.ArgumentParser()
     p.add_argument("--episodes", type=int, default=1000)

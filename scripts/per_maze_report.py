@@ -9,9 +9,9 @@ such, so a partial table says what it lacks.
 """
 import argparse
 
-from specrefine.argtypes import exit_code_quiet_on_broken_pipe
-from specrefine.results import wilson_ci
-from specrefine.sweep import is_done, read_table
+from specrefine.core.argtypes import exit_code_quiet_on_broken_pipe
+from specrefine.core.results import wilson_ci
+from specrefine.runs.sweep import is_done, read_table
 
 
 def line(r: dict) -> str:

@@ -1,10 +1,12 @@
 #!/bin/bash
-# One specrefine.sweep run with the code of one commit (a detached worktree), whatever the checkout holds, so that
+# One sweep run with the code of one commit (a detached worktree), whatever the checkout holds, so that
 # a session may edit specrefine/ while a long grid runs and its table stays one code's; the sweep's done rows are
 # copied to a shipped table every two minutes, and a new machine resumes from that table (copied into OUT when
 # OUT has none). Every argument is passed to the sweep (--out is added):
 #   CODE=COMMIT OUT=runs/NAME SHIPPED=data/results/NAME.csv bash scripts/pinned_sweep.sh --mazes ... --seeds ...
 # TREE: the worktree (default runs/code_COMMIT); PYTHON: the interpreter (default the checkout's .venv).
+# The sweep module is the tree's own: specrefine.runs.sweep, or specrefine.sweep in a commit from before the
+# sub-package layout (grids pinned to such a commit keep running through this script).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 code=${CODE:?CODE=COMMIT: the code the grid runs}
@@ -18,14 +20,15 @@ if [ "$(git -C "$tree" rev-parse HEAD)" != "$(git -C "$root" rev-parse "$code^{c
     exit 2
 fi
 export PYTHONPATH=$tree  # before the checkout's editable install on sys.path
+if [ -f "$tree/specrefine/runs/sweep.py" ]; then sweep=specrefine.runs.sweep; else sweep=specrefine.sweep; fi
 mkdir -p "$out" "$(dirname "$shipped")"
 [ -s "$out/results.csv" ] || { [ -s "$shipped" ] && cp "$shipped" "$out/results.csv"; } || true
 
 ship() {  # the table's done rows only (a row being appended is never half-copied)
-    "$py" - "$out/results.csv" "$shipped" <<'PY'
-import csv, sys
-from specrefine.sweep import _typed, is_done
-src, dst = sys.argv[1:]
+    "$py" -P - "$out/results.csv" "$shipped" "$sweep" <<'PY'  # -P: the tree's code, not the cwd's
+import csv, importlib, sys
+src, dst, sweep = sys.argv[1:]
+_typed, is_done = (getattr(importlib.import_module(sweep), name) for name in ("_typed", "is_done"))
 with open(src, newline="") as fh:
     reader = csv.DictReader(fh)
     rows = [r for r in reader if None not in r and None not in r.values() and is_done(_typed(r))]
@@ -43,4 +46,4 @@ trap 'kill $watcher 2>/dev/null; [ -s "$out/results.csv" ] && ship' EXIT
 
 echo "code $(git -C "$tree" rev-parse --short HEAD) in $tree; table $out/results.csv -> $shipped"
 cd "$tree"
-"$py" -m specrefine.sweep "$@" --out "$out"
+"$py" -m "$sweep" "$@" --out "$out"

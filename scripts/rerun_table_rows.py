@@ -5,7 +5,8 @@
 
 For a table whose first rows came from older code (data/results/imperfect: rows 1-485, commit 6f3114f): the cells
 are rebuilt from the rows (maze, agent, method, proposer, seed, rollouts, episodes, spec), the sweep runs them
-(resumable, as ``specrefine.sweep``), and ``--compare`` lists the columns in which the new rows differ from the old.
+(resumable, as ``specrefine.runs.sweep``), and ``--compare`` lists the columns in which the new rows differ
+from the old.
 ``--compare --shared`` compares only the cells both tables hold, e.g. the reruns inside another grid:
 
     python scripts/rerun_table_rows.py data/results/imperfect/results.csv --rows 1360 --out data/results/repair \
@@ -14,7 +15,7 @@ are rebuilt from the rows (maze, agent, method, proposer, seed, rollouts, episod
 import argparse
 from pathlib import Path
 
-from specrefine.sweep import Cell, read_table, run_sweep
+from specrefine.runs.sweep import Cell, read_table, run_sweep
 
 SEARCH_COLUMNS = ("success_rate", "evaluations", "proposer_calls", "path_edges", "graph_vertices", "graph_edges",
                   "refinements", "search_estimate")  # what a code change that keeps the search must keep

@@ -3,11 +3,11 @@
     .venv/bin/python scripts/run_unseen.py --out runs/unseen            # point, ours, geometric, seed 0
     cp runs/unseen/results.csv data/results/unseen/
 
-Why not ``python -m specrefine.sweep --mazes data/mazes/unseen/*.maze``: the sweep keeps only a maze
+Why not ``python -m specrefine.runs.sweep --mazes data/mazes/unseen/*.maze``: the sweep keeps only a maze
 file's stem and loads that name from data/mazes/, so it cannot load files from a subfolder (a known
 bug, being fixed separately). This script runs the same cells one at a time with the full path and
-writes the same layout as the sweep: ``OUT/results.csv`` (columns ``specrefine.sweep.COLUMNS``, one
-row per run, built by ``specrefine.sweep.result_row``) and ``OUT/cells/<cell id>/`` (each run's
+writes the same layout as the sweep: ``OUT/results.csv`` (columns ``specrefine.runs.sweep.COLUMNS``, one
+row per run, built by ``specrefine.runs.sweep.result_row``) and ``OUT/cells/<cell id>/`` (each run's
 ``result.json``, pictures, step log, cache). Cells that already have an ``ok`` row are skipped.
 """
 
@@ -21,8 +21,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from specrefine.pipeline import refine_maze  # noqa: E402
-from specrefine.sweep import Cell, _append, pending, result_row  # noqa: E402
+from specrefine.runs.pipeline import refine_maze  # noqa: E402
+from specrefine.runs.sweep import Cell, _append, pending, result_row  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -48,7 +48,7 @@ def main(argv=None) -> int:
                              seed=cell.seed, out=out / "cells" / cell.id, rollouts=cell.rollouts,
                              episodes=cell.episodes)
         d = result.data
-        # the row as specrefine.sweep.run_cell builds it
+        # the row as specrefine.runs.sweep.run_cell builds it
         _append(table, result_row(d, {**asdict(cell), "cell": cell.id}) | {"proposer_is_vlm": d["proposer_is_vlm"]})
         lo, hi = d["success_ci"]
         print(f"{cell.id}: {d['success_rate']:.3f} [{lo:.3f}, {hi:.3f}] over {d['episodes']} episodes, "

@@ -4,7 +4,7 @@
         --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
     specrefine official RUN_DIR [--episodes N] [--seed S]
 
-The options of ``refine`` are the fields of :class:`specrefine.runconfig.RunConfig` (defaults, help, bounds).
+The options of ``refine`` are the fields of :class:`specrefine.runs.config.RunConfig` (defaults, help, bounds).
 
 Bad input exits 2 with one line on stderr; never a traceback.
 """
@@ -15,10 +15,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from .agents import AGENTS as _AGENT_REGISTRY
-from .argtypes import OneLineParser, bounded_int, out_path, silence_stdout
-from .errors import SpecrefineError
-from .runconfig import DEFAULTS, RunConfig, add_run_options, proposer_arg
+from .core.agents import AGENTS as _AGENT_REGISTRY
+from .core.argtypes import OneLineParser, bounded_int, out_path, silence_stdout
+from .core.errors import SpecrefineError
+from .runs.config import DEFAULTS, RunConfig, add_run_options, proposer_arg
 
 AGENTS = tuple(_AGENT_REGISTRY)
 
@@ -73,12 +73,12 @@ def _command(work, show, interrupted: str) -> int:
 
 def official(args) -> int:
     def work():
-        from .official import run_official
+        from .runs.official import run_official
 
         return run_official(args.run_dir, episodes=args.episodes, seed=args.seed)
 
     def show(data):
-        from .official import summary
+        from .runs.official import summary
 
         return summary(data) + f"\n  -> {args.run_dir / 'official.json'}"
 
@@ -91,7 +91,7 @@ def main(argv=None) -> int:
         return official(args)
 
     def work():
-        from .pipeline import refine_maze  # heavy imports only after argument parsing
+        from .runs.pipeline import refine_maze  # heavy imports only after argument parsing
 
         return refine_maze(args.maze, RunConfig.from_namespace(args), out=args.out,
                            progress=False if args.quiet else None)

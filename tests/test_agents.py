@@ -3,12 +3,12 @@
 import pytest
 
 from specrefine import cli
-from specrefine.agents import AGENTS, get_agent
-from specrefine.errors import SpecrefineError
-from specrefine.mazes import load_maze
-from specrefine.policy import GoalPolicy
-from specrefine.sim import BatchedSim
-from specrefine.train import make_config
+from specrefine.core.agents import AGENTS, get_agent
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.mazes import load_maze
+from specrefine.sim.policy import GoalPolicy
+from specrefine.sim.simulator import BatchedSim
+from specrefine.sim.train import make_config
 
 
 @pytest.mark.parametrize("name", sorted(AGENTS))

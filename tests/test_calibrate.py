@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
-from specrefine.calibrate import coverage, product_posterior
-from specrefine.mazes import MAZE_DIR
-from specrefine.pipeline import refine_maze
+from specrefine.core.mazes import MAZE_DIR
+from specrefine.runs.calibrate import coverage, product_posterior
+from specrefine.runs.pipeline import refine_maze
 
 
 def test_each_leg_is_charged_even_at_32_of_32():
@@ -66,7 +66,7 @@ def test_result_json_carries_the_calibrated_prediction(tmp_path):
 
 
 def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
-    from specrefine.calibrate import main, predict_run
+    from specrefine.runs.calibrate import main, predict_run
 
     run = tmp_path / "run"
     data = refine_maze("u_chain_1", agent="point", method="dirl", seed=1, rollouts=8, episodes=20, out=run).data
@@ -104,7 +104,7 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
 def test_coverage_counts_each_run_once_and_reports_the_runs_above_zero(tmp_path, capsys):
     """A run shipped in two tables (an older one without the evaluation and policy columns) counts once; the runs
     measured above 0 are reported apart (a run at 0 predicted near 0 is covered trivially)."""
-    from specrefine.calibrate import main
+    from specrefine.runs.calibrate import main
 
     run = dict(maze="u_maze", agent="point", method="ours", proposer="geometric", rollouts_per_evaluation="32",
                episodes="200", predicted_ci_low="0.9", predicted_ci_high="1.0")

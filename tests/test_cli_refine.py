@@ -7,9 +7,9 @@ import json
 import pytest
 
 from specrefine.cli import main
-from specrefine.graph import TaskGraph, check_refines
-from specrefine.mazes import load_maze
-from specrefine.spec import maze_task
+from specrefine.core.graph import TaskGraph, check_refines
+from specrefine.core.mazes import load_maze
+from specrefine.core.spec import maze_task
 
 REQUIRED = ["success_rate", "success_ci", "episodes", "predicted_success", "evaluations", "sim_steps", "vlm_calls",
             "wall_seconds", "graph"]

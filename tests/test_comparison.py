@@ -1,4 +1,5 @@
-"""specrefine.comparison on small synthetic tables: the claims' verdicts, missing cells, figures and the CLI."""
+"""specrefine.experiments.comparison on small synthetic tables: the claims' verdicts, missing cells, figures and the
+CLI."""
 
 from __future__ import annotations
 
@@ -8,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
-from specrefine import comparison as cmp
-from specrefine.sweep import COLUMNS, read_table
+from specrefine.experiments import comparison as cmp
+from specrefine.runs.sweep import COLUMNS, read_table
 
 MODERATE = "imperfect:moderate"
 
@@ -198,7 +199,7 @@ def test_figure5_legend_when_the_last_preset_has_no_u_chain_runs_yet():
 
 
 def test_calibration_figure_counts_runs_inside_the_predicted_interval():
-    from specrefine.figures import calibration_figure
+    from specrefine.experiments.figures import calibration_figure
 
     rows = [{"success_rate": 0.9, "predicted_success": 0.88, "predicted_ci_low": 0.8, "predicted_ci_high": 0.95},
             {"success_rate": 0.5, "predicted_success": 0.9, "predicted_ci_low": 0.8, "predicted_ci_high": 0.97},
@@ -214,7 +215,7 @@ def ant_row(maze, method, success, seed, proposer):
 
 
 def test_ant_grid_counts_methods_without_a_proposer_once_per_seed():
-    from specrefine.mazes import benchmark_mazes
+    from specrefine.core.mazes import benchmark_mazes
 
     # dirl and symbolic once per seed, vlm-oneshot and ours once per proposer: 6 runs per maze and seed
     assert cmp.expected_cells(cmp.ANT_GRID) == len(benchmark_mazes()) * 6 * 3
@@ -255,7 +256,7 @@ def test_ant_cli_draws_figures_4_and_5_without_error_levels(tmp_path):
 
 
 def test_seed_table_one_line_per_maze_methods_without_a_proposer_once():
-    from specrefine.mazes import benchmark_mazes
+    from specrefine.core.mazes import benchmark_mazes
 
     rows = [ant_row("u_maze", "dirl", 0.0, 1, "none"), ant_row("u_maze", "ours", 0.9, 1, "imperfect:moderate"),
             ant_row("u_maze", "ours", 0.8, 0, "geometric"),  # another seed
@@ -272,7 +273,7 @@ def test_seed_table_one_line_per_maze_methods_without_a_proposer_once():
 
 
 def test_seed_contrast_sorts_mazes_by_disjoint_intervals_and_counts_the_absent():
-    from specrefine.mazes import benchmark_mazes
+    from specrefine.core.mazes import benchmark_mazes
 
     def run(maze, method, success, low, high, proposer="geometric", seed=2):
         return ant_row(maze, method, success, seed, proposer) | {"success_ci_low": low, "success_ci_high": high}
@@ -293,7 +294,8 @@ def test_seed_contrast_sorts_mazes_by_disjoint_intervals_and_counts_the_absent()
 
 
 def test_cli_keeps_its_files_when_stdout_is_closed(tmp_path):
-    """`python -m specrefine.comparison ... | head`: the reader gone, the figures and claims are still written."""
+    """`python -m specrefine.experiments.comparison ... | head`: the reader gone, the figures and claims are still
+    written."""
     import os
     import subprocess
     import sys
@@ -302,7 +304,7 @@ def test_cli_keeps_its_files_when_stdout_is_closed(tmp_path):
     write_csv(table, ratio_rows(lambda i, seed: 0.3, 2.5))
     read_end, write_end = os.pipe()
     os.close(read_end)  # every write to stdout now fails with a broken pipe
-    proc = subprocess.run([sys.executable, "-m", "specrefine.comparison", str(table), "--out", str(out)],
+    proc = subprocess.run([sys.executable, "-m", "specrefine.experiments.comparison", str(table), "--out", str(out)],
                           stdout=write_end, stderr=subprocess.PIPE, text=True)
     os.close(write_end)
     assert (proc.returncode, proc.stderr) == (1, "")

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from specrefine.cli import main
-from specrefine.compositional import POLICY_JSON, CompositionalPolicy, Leg, policy_observation
-from specrefine.errors import PolicyError
-from specrefine.evaluate import Evaluator
-from specrefine.mazes import load_maze
-from specrefine.policy import PointController
-from specrefine.regions import Box
-from specrefine.sim import BatchedSim
+from specrefine.core.errors import PolicyError
+from specrefine.core.mazes import load_maze
+from specrefine.core.regions import Box
+from specrefine.evaluation.compositional import POLICY_JSON, CompositionalPolicy, Leg, policy_observation
+from specrefine.evaluation.evaluator import Evaluator
+from specrefine.sim.policy import PointController
+from specrefine.sim.simulator import BatchedSim
 
 
 def gr_observation(sim: BatchedSim, row: int = 0) -> dict:

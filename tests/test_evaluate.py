@@ -4,15 +4,15 @@
 import numpy as np
 import pytest
 
-from specrefine.errors import SpecrefineError
-from specrefine.evaluate import Evaluator, path_legs
-from specrefine.graph import TaskGraph
-from specrefine.mazes import load_maze
-from specrefine.monitor import satisfies
-from specrefine.policy import PointController
-from specrefine.regions import Box, CompiledRegion, Disc, union
-from specrefine.results import AVOID, SUCCESS, StartStates, wilson_ci
-from specrefine.spec import maze_task
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.graph import TaskGraph
+from specrefine.core.mazes import load_maze
+from specrefine.core.regions import Box, CompiledRegion, Disc, union
+from specrefine.core.results import AVOID, SUCCESS, StartStates, wilson_ci
+from specrefine.core.spec import maze_task
+from specrefine.evaluation.evaluator import Evaluator, path_legs
+from specrefine.evaluation.monitor import satisfies
+from specrefine.sim.policy import PointController
 
 # Floats computed through different batch shapes, thread counts or CPUs agree only to a tolerance
 # (batched matrix products may round differently); discrete outcomes are compared exactly.
@@ -294,7 +294,7 @@ def test_point_spawns_where_its_body_fits(maze):
 
 
 def test_evaluate_many_equals_one_evaluate_per_subtask(maze):
-    from specrefine.policy import load_policy
+    from specrefine.sim.policy import load_policy
 
     task, policy = maze_task(maze), load_policy("point")
     S, G, walls = task.region("S"), task.region("G"), maze.walls

@@ -1,14 +1,14 @@
-"""Per-leg failure reports of a finished run's path (specrefine.failures)."""
+"""Per-leg failure reports of a finished run's path (specrefine.experiments.failures)."""
 
 import json
 
 import numpy as np
 import pytest
 
-from specrefine.failures import leg_table, main, open_floor, path_failures, turn_angles
-from specrefine.mazes import load_maze
-from specrefine.pipeline import refine_maze
-from specrefine.results import OUTCOMES
+from specrefine.core.mazes import load_maze
+from specrefine.core.results import OUTCOMES
+from specrefine.experiments.failures import leg_table, main, open_floor, path_failures, turn_angles
+from specrefine.runs.pipeline import refine_maze
 
 
 def test_open_floor_frees_inner_walls_and_keeps_the_border_and_coordinates():

@@ -11,15 +11,15 @@ import pytest
 from matplotlib.image import imread
 
 from specrefine import cli
-from specrefine.errors import MazeError
-from specrefine.evaluate import AVOID, Evaluator
-from specrefine.mazes import load_maze, parse_maze
-from specrefine.monitor import satisfies
-from specrefine.policy import PointController
+from specrefine.core.errors import MazeError
+from specrefine.core.mazes import load_maze, parse_maze
+from specrefine.core.regions import is_subset
+from specrefine.core.spec import maze_task
+from specrefine.evaluation.evaluator import AVOID, Evaluator
+from specrefine.evaluation.monitor import satisfies
+from specrefine.pictures.render import render_task, to_png
 from specrefine.proposers import EdgeQuery, environment_text, make_proposer, segment_clear
-from specrefine.regions import is_subset
-from specrefine.render import render_task, to_png
-from specrefine.spec import maze_task
+from specrefine.sim.policy import PointController
 
 # hazard_pool at point scale: a 4 x 3 pool of '~' (x in [-1.5, 1.5], y in [-2, 2]) between S (x ~ -4) and G (x ~ 4)
 
@@ -76,7 +76,7 @@ def test_every_edge_avoids_walls_and_hazards(pool):
 
 
 def test_the_simulator_builds_no_walls_for_hazards(pool):
-    from specrefine.sim import build_model
+    from specrefine.sim.simulator import build_model
 
     dry = parse_maze("\n".join(pool.grid).replace("~", "."), "dry.maze")
     assert build_model("point", pool).ngeom == build_model("point", dry).ngeom
@@ -127,7 +127,7 @@ def test_geometric_route_goes_around_the_pool(pool):
 
 
 def test_geometric_refinement_beats_the_straight_line(pool):
-    from specrefine.pipeline import refine_maze
+    from specrefine.runs.pipeline import refine_maze
 
     ev = Evaluator(pool, "point", PointController(), n=8, horizon=120)
     dirl = refine_maze("hazard_pool", method="dirl", evaluator=ev, episodes=16, out=_tmp("dirl"))

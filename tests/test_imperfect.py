@@ -10,8 +10,9 @@ import sys
 import numpy as np
 import pytest
 
-from specrefine.errors import SpecrefineError
-from specrefine.mazes import load_maze, parse_maze
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.mazes import load_maze, parse_maze
+from specrefine.core.spec import maze_task
 from specrefine.proposers import CandidateFeedback, EdgeQuery, GraphQuery, make_proposer, parse_split
 from specrefine.proposers.imperfect import (
     PRESETS,
@@ -21,7 +22,6 @@ from specrefine.proposers.imperfect import (
     convex_corners,
     parse_imperfect,
 )
-from specrefine.spec import maze_task
 
 N = 200  # replies per measurement
 
@@ -247,7 +247,7 @@ def test_feedback_repairs_the_weakest_leg_with_probability_rho():
 
 
 def _disc(p):
-    from specrefine.regions import Disc
+    from specrefine.core.regions import Disc
 
     return Disc(float(p[0]), float(p[1]), 0.4)
 

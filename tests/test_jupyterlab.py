@@ -27,7 +27,7 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.notebook import kernel_env
+from specrefine.runs.notebook import kernel_env
 
 REPO = Path(__file__).resolve().parent.parent
 NOTEBOOK = REPO / "notebooks" / "05_astar_refinement.ipynb"

@@ -1,35 +1,58 @@
-"""The package's modules import each other without cycles, and no layer imports a layer above it (README, Package)."""
+"""The package's layers (README, Package): no import cycle between modules or between sub-packages, no sub-package
+importing a layer above it, and a core that imports neither MuJoCo, torch nor matplotlib."""
 
 from __future__ import annotations
 
 import ast
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import networkx as nx
 
-PACKAGE = Path(__file__).resolve().parents[1] / "specrefine"
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "specrefine"
 
-#: README's layers, lowest first; a module may import its own layer and those before it
+#: README's layers, lowest first: a sub-package (or top-level module) may import its own layer and those before it;
+#: ``specrefine`` is the package's ``__init__.py``
 LAYERS = [
-    {"errors", "paths", "paper", "argtypes", "regions", "agents", "results", "tables"},
-    {"mazes", "standard_maps", "spec", "graph", "runfolder"},
-    {"sim", "policy", "reach_env", "policy_eval", "curves", "train", "render"},
-    {"evaluate", "monitor", "compositional"},
-    {"proposers", "vlm"},
+    {"core"},
+    {"pictures"},
+    {"sim"},
+    {"evaluation"},
+    {"vlm"},
+    {"proposers"},
     {"refine"},
-    {"queries", "methods", "runconfig", "experiment", "calibrate", "progress", "pipeline", "sweep", "cli",
-     "official", "failures", "explore", "notebook", "bench", "specrefine"},
-    {"figures", "comparison", "repair_claims"},
+    {"runs"},
+    {"experiments"},
+    {"cli", "bench", "specrefine"},
 ]
+HEAVY = ("mujoco", "torch", "matplotlib")  # what the core must not import
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _targets(node, package: list[str], modules: set[str]) -> list[str]:
+    """The package's modules an import statement loads (``from P import m``: the module P.m when it is one, else P)."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names]
+    base = package[:len(package) - node.level + 1] if node.level else []
+    base = ".".join(base + (node.module.split(".") if node.module else []))
+    return [f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base for a in node.names]
 
 
 def _imports() -> nx.DiGraph:
-    """Edges between top-level modules (``specrefine.X``), function-level imports included, type-only ones not."""
+    """Edges between the package's modules, function-level imports included, type-only ones not."""
+    paths = sorted(PACKAGE.rglob("*.py"))
+    modules = {_module_name(p) for p in paths}
     graph = nx.DiGraph()
-    for path in PACKAGE.rglob("*.py"):
-        rel = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        here = rel[1] if len(rel) > 1 and rel[1] != "__init__" else "specrefine"
-        package = list(rel[:-1]) if path.name != "__init__.py" else list(rel[:-1])
+    for path in paths:
+        here = _module_name(path)
+        package = here.split(".") if path.name == "__init__.py" else here.split(".")[:-1]
         graph.add_node(here)
         tree = ast.parse(path.read_text())
         type_only = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
@@ -37,28 +60,60 @@ def _imports() -> nx.DiGraph:
         for node in ast.walk(tree):
             if id(node) in type_only or not isinstance(node, ast.ImportFrom | ast.Import):
                 continue
-            if isinstance(node, ast.ImportFrom):
-                base = package[:len(package) - node.level + 1] if node.level else []
-                names = [".".join(base + ([node.module] if node.module else []) + ([a.name] if not node.module else []))
-                         for a in node.names] if node.level else [node.module or ""]
-            else:
-                names = [a.name for a in node.names]
-            for name in names:
-                parts = name.split(".")
-                if parts[0] == "specrefine":
-                    there = parts[1] if len(parts) > 1 else "specrefine"
-                    if there != here:
-                        graph.add_edge(here, there)
+            for there in _targets(node, package, modules):
+                if there.split(".")[0] == "specrefine" and there != here:
+                    assert there in modules, f"{here} imports {there}, which is not a module of the package"
+                    graph.add_edge(here, there)
     return graph
 
 
-def test_no_import_cycles():
+def _part(module: str) -> str:
+    """A module's layer unit: its sub-package (``specrefine.runs.sweep`` -> ``runs``), ``cli``, or ``specrefine``."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "specrefine"
+
+
+def _parts_graph() -> nx.DiGraph:
+    graph = _imports()
+    parts = nx.DiGraph()
+    parts.add_nodes_from(_part(m) for m in graph)
+    parts.add_edges_from((_part(a), _part(b)) for a, b in graph.edges if _part(a) != _part(b))
+    return parts
+
+
+def test_no_import_cycles_between_modules():
     assert list(nx.simple_cycles(_imports())) == []
 
 
-def test_every_module_has_a_layer_and_imports_none_above_it():
-    graph = _imports()
-    layer = {m: i for i, group in enumerate(LAYERS) for m in group}
-    assert sorted(set(graph) - set(layer)) == []  # a new module: give it a layer here and in README
+def test_no_import_cycles_between_sub_packages():
+    assert list(nx.simple_cycles(_parts_graph())) == []
+
+
+def test_every_sub_package_has_a_layer_and_imports_none_above_it():
+    graph = _parts_graph()
+    layer = {part: i for i, group in enumerate(LAYERS) for part in group}
+    assert sorted(set(graph) - set(layer)) == []  # a new sub-package: give it a layer here and in README
+    assert sorted(set(layer) - set(graph)) == []
     upward = sorted((a, b) for a, b in graph.edges if layer[b] > layer[a])
     assert upward == []
+    modules = _imports()
+    upward_modules = sorted((a, b) for a, b in modules.edges if layer[_part(b)] > layer[_part(a)])
+    assert upward_modules == []
+
+
+def test_readme_names_the_same_layers_in_the_same_order():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    paragraph = text.split("\n## Package\n", 1)[1].strip().split("\n\n", 1)[0]
+    named = [{"specrefine" if name == "__init__" else name for name in re.findall(r"`(\w+)(?:/|\.py)`", segment)}
+             for segment in re.split(r"\s→\s", paragraph)]
+    assert named == LAYERS
+
+
+def test_the_core_imports_neither_mujoco_nor_torch_nor_matplotlib():
+    core = sorted(_module_name(p) for p in (PACKAGE / "core").glob("*.py"))
+    assert "specrefine.core.graph" in core and "specrefine.core.runfolder" in core
+    probe = (f"import importlib, sys\nfor m in {core!r}:\n    importlib.import_module(m)\n"
+             f"print(sorted(h for h in {HEAVY!r} if h in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip() == "[]"

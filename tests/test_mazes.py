@@ -1,4 +1,4 @@
-"""specrefine.mazes: maze files, cell <-> xy, regions, and malformed files through the CLI."""
+"""specrefine.core.mazes: maze files, cell <-> xy, regions, and malformed files through the CLI."""
 
 import re
 import subprocess
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from specrefine import cli
-from specrefine.errors import MazeError
-from specrefine.mazes import CELL_SIZE, MAZE_DIR, Maze, benchmark_mazes, load_maze, parse_maze
-from specrefine.regions import is_subset
+from specrefine.core.errors import MazeError
+from specrefine.core.mazes import CELL_SIZE, MAZE_DIR, Maze, benchmark_mazes, load_maze, parse_maze
+from specrefine.core.regions import is_subset
 
 BENCHMARK = benchmark_mazes()
 

@@ -6,11 +6,11 @@ import json
 
 import pytest
 
-from specrefine.experiment import setup
-from specrefine.methods import run_search
-from specrefine.pipeline import METHODS, PROPOSER_METHODS, refine_maze
 from specrefine.proposers.geometric import GeometricProposer
-from specrefine.runconfig import RunConfig
+from specrefine.runs.config import RunConfig
+from specrefine.runs.experiment import setup
+from specrefine.runs.methods import run_search
+from specrefine.runs.pipeline import METHODS, PROPOSER_METHODS, refine_maze
 
 SMALL = dict(agent="point", rollouts=8, episodes=20, seed=0)
 

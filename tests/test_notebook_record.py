@@ -4,7 +4,7 @@ import nbformat
 import numpy as np
 from nbformat.v4 import new_code_cell, new_notebook, new_output
 
-from specrefine.notebook import MIME, _jsonable, compare, read_records
+from specrefine.runs.notebook import MIME, _jsonable, compare, read_records
 
 
 def _nb(*payloads):

@@ -41,7 +41,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from specrefine.notebook import DEFAULT_TIMEOUT_S, TIERS, compare, execute, kernel_env, read_records, tier_settings
+from specrefine.runs.notebook import DEFAULT_TIMEOUT_S, TIERS, compare, execute, kernel_env, read_records, tier_settings
 
 REPO = Path(__file__).resolve().parent.parent  # the checkout under test (its kernel must import this one)
 NOTEBOOKS = sorted((REPO / "notebooks").glob("[0-9][0-9]_*.ipynb"))

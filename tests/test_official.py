@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from specrefine.cli import main
-from specrefine.mazes import load_maze
-from specrefine.official import env_id, make_env
+from specrefine.core.mazes import load_maze
+from specrefine.runs.official import env_id, make_env
 
 FAST = ["--rollouts", "8", "--episodes", "8"]
 

@@ -2,8 +2,8 @@
 import importlib.util
 from pathlib import Path
 
-from specrefine.results import wilson_ci
-from specrefine.sweep import _NUMBERS
+from specrefine.core.results import wilson_ci
+from specrefine.runs.sweep import _NUMBERS
 
 _spec = importlib.util.spec_from_file_location("per_maze_report",
                                                Path(__file__).parents[1] / "scripts" / "per_maze_report.py")

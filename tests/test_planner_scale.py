@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from specrefine.evaluate import EvaluationFacts
-from specrefine.mazes import MAZE_DIR, Maze, load_maze, parse_maze
+from specrefine.core.mazes import MAZE_DIR, Maze, load_maze, parse_maze
+from specrefine.core.spec import maze_task
+from specrefine.evaluation.evaluator import EvaluationFacts
 from specrefine.proposers import CandidateFeedback, EdgeQuery, make_proposer
 from specrefine.proposers.geometric import clear_of_obstacles
-from specrefine.spec import maze_task
 
 ROUTES = Path(__file__).parent / "data" / "planner_routes.json"
 SHIPPED = sorted(MAZE_DIR.glob("*.maze")) + sorted((MAZE_DIR / "unseen").glob("*.maze"))
@@ -90,7 +90,7 @@ def open_maze(side: int) -> str:
 
 PLAN = """
 import sys
-from specrefine.mazes import load_maze
+from specrefine.core.mazes import load_maze
 from specrefine.proposers import EdgeQuery, make_proposer
 maze = load_maze(sys.argv[1])
 q = EdgeQuery(maze, "point", maze.start, maze.goal, maze.obstacles, 0.0, 32, None)
@@ -111,7 +111,7 @@ def test_planning_on_a_300_by_300_open_maze_finishes(tmp_path):
 def test_a_big_avoid_set_is_inside_itself_without_pairwise_tests(monkeypatch):
     """Each refined edge checks that it avoids what its parent avoided: on a 300x300 maze, 600 wall boxes against
     600 took 360,000 box tests per edge (15 s of a refine run)."""
-    from specrefine import regions
+    from specrefine.core import regions
 
     walls = parse_maze(open_maze(300)).obstacles
     tests = []

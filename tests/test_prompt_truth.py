@@ -5,12 +5,12 @@ import re
 import numpy as np
 import pytest
 
-from specrefine.agents import AGENTS
-from specrefine.evaluate import EvaluationFacts, Evaluator
-from specrefine.mazes import load_maze
-from specrefine.policy import PointController
+from specrefine.core.agents import AGENTS
+from specrefine.core.mazes import load_maze
+from specrefine.core.spec import maze_task
+from specrefine.evaluation.evaluator import EvaluationFacts, Evaluator
 from specrefine.proposers import EdgeQuery, GraphQuery, graph_messages, split_messages
-from specrefine.spec import maze_task
+from specrefine.sim.policy import PointController
 from specrefine.vlm import messages_to_text
 
 

@@ -7,9 +7,11 @@ import logging
 import numpy as np
 import pytest
 
-from specrefine.errors import SpecrefineError
-from specrefine.graph import check_refines
-from specrefine.mazes import benchmark_mazes, load_maze
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.graph import check_refines
+from specrefine.core.mazes import benchmark_mazes, load_maze
+from specrefine.core.regions import Disc
+from specrefine.core.spec import maze_task
 from specrefine.proposers import (
     CandidateFeedback,
     EdgeQuery,
@@ -21,8 +23,6 @@ from specrefine.proposers import (
     split_messages,
 )
 from specrefine.proposers.schema import check_region
-from specrefine.regions import Disc
-from specrefine.spec import maze_task
 
 MAZES = sorted(benchmark_mazes())
 W = 3

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from specrefine.cli import main as cli_main
+from specrefine.core.regions import Box
+from specrefine.core.results import EdgeResult, StartStates, merge_edge_results, wilson_ci
 from specrefine.refine import refine_chain
 from specrefine.refine.racing import Racing, stage_seed
 from specrefine.refine.search import SearchConfig
-from specrefine.regions import Box
-from specrefine.results import EdgeResult, StartStates, merge_edge_results, wilson_ci
 
 WALLS = Box(100, 100, 101, 101)
 
@@ -147,7 +147,7 @@ def test_cli_adaptive_run_records_its_evaluation(tmp_path, capsys):
 
 def test_default_evaluation_is_the_agents():
     """Unasked, the Ant evaluates adaptively (its held-out benchmark) and the point mass as the paper does."""
-    from specrefine.sweep import grid
+    from specrefine.runs.sweep import grid
 
     ant, point = (grid(["u_maze"], ["ours"], ["geometric"], [0], agent=a)[0] for a in ("ant", "point"))
     assert (ant.evaluation, point.evaluation) == ("adaptive", "fixed")
@@ -156,7 +156,7 @@ def test_default_evaluation_is_the_agents():
 
 
 def test_ant_run_without_evaluation_records_adaptive(tmp_path):
-    from specrefine.pipeline import refine_maze
+    from specrefine.runs.pipeline import refine_maze
 
     run = refine_maze("u_chain_1", agent="ant", method="dirl", rollouts=4, episodes=4, out=tmp_path / "ant")
     assert run.data["evaluation"] == "adaptive"
@@ -165,7 +165,7 @@ def test_ant_run_without_evaluation_records_adaptive(tmp_path):
 
 @pytest.mark.parametrize("method", ["dirl", "vlm-oneshot"])
 def test_methods_without_the_vertex_dp_do_not_depend_on_the_evaluation(method, tmp_path):
-    from specrefine.pipeline import refine_maze
+    from specrefine.runs.pipeline import refine_maze
 
     runs = [refine_maze("u_chain_1", method=method, seed=2, rollouts=8, episodes=20, out=tmp_path / ev,
                         evaluation=ev).data for ev in ("fixed", "adaptive")]

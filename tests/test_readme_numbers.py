@@ -11,7 +11,7 @@ import math
 import re
 from pathlib import Path
 
-from specrefine.sweep import read_table, summarise
+from specrefine.runs.sweep import read_table, summarise
 
 ROOT = Path(__file__).parents[1]
 README = (ROOT / "docs" / "results.md").read_text()  # the results page (README, the front page, links to it)
@@ -80,8 +80,8 @@ def test_ant_uchain_table_is_per_maze_report():
 
 def _offline():
     """The offline comparison's claims, contrasts and multi-room means, recomputed from its table (not claims.json)."""
-    from specrefine import comparison as cmp
-    from specrefine.sweep import mean_std
+    from specrefine.experiments import comparison as cmp
+    from specrefine.runs.sweep import mean_std
 
     rows = read_table(ROOT / "data/results/imperfect/results.csv")
     cells, _ = cmp.table_cells(rows)
@@ -118,7 +118,7 @@ def test_offline_claims_table_is_recomputed_from_its_table():
 
 
 def test_offline_means_and_contrasts_are_recomputed_from_its_table():
-    from specrefine.comparison import COMPARISON_METHODS
+    from specrefine.experiments.comparison import COMPARISON_METHODS
 
     by, contrasts, means = _offline()
     for preset, label in (("mild", "mild"), ("moderate", "moderate"), ("severe", "severe"),
@@ -145,9 +145,9 @@ def test_offline_means_and_contrasts_are_recomputed_from_its_table():
 
 
 def test_calibration_headline_is_the_coverage_command():
-    from specrefine.calibrate import coverage_report
+    from specrefine.runs.calibrate import coverage_report
 
-    command = re.search(r"python -m specrefine.calibrate --coverage\s+([^`]+)`\) the measured success", README)
+    command = re.search(r"python -m specrefine.runs.calibrate --coverage\s+([^`]+)`\) the measured success", README)
     tables = [t for pattern in command.group(1).split() for t in sorted(ROOT.glob(pattern))]
     last = coverage_report(tables).splitlines()[-1]
     pattern = r"all, distinct runs: (\d+/\d+) .*?\(([\d.]+)%\); above 0: (\d+/\d+) \(([\d.]+)%\); (\d+) duplicate"
@@ -170,7 +170,7 @@ def test_adaptive_table_is_the_bench_markdown():
 def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
     """Each seed of the growing Ant comparison that README shows is complete in the table and shown as it is, with
     the lines that contrast ours and the one-shot under it."""
-    from specrefine.comparison import ANT_GRID, seed_contrast, seed_table
+    from specrefine.experiments.comparison import ANT_GRID, seed_contrast, seed_table
 
     rows = read_table(ROOT / "data/results/ant/comparison.csv")
     seeds = re.findall(r"<!-- ant comparison seed (\d+) -->", README)
@@ -183,9 +183,9 @@ def test_ant_comparison_seed_tables_are_complete_seeds_of_the_table():
 
 
 def test_ant_comparison_claims_are_recomputed_from_the_complete_grid():
-    """README's Ant claims are specrefine.comparison's claims of the table, every run of the fixed grid, and the
-    shipped claims.md says the same."""
-    from specrefine.comparison import ANT_GRID, claims, expected_cells, grid_cells, markdown, table_cells
+    """README's Ant claims are specrefine.experiments.comparison's claims of the table, every run of the fixed grid,
+    and the shipped claims.md says the same."""
+    from specrefine.experiments.comparison import ANT_GRID, claims, expected_cells, grid_cells, markdown, table_cells
 
     rows = read_table(ROOT / "data/results/ant/comparison.csv")
     assert grid_cells(ANT_GRID) <= set(table_cells(rows, "ant")[0]), "the Ant grid is not complete"
@@ -198,8 +198,9 @@ def test_ant_comparison_claims_are_recomputed_from_the_complete_grid():
 
 
 def test_repair_summary_is_the_repair_grid():
-    """README's look-ahead repair table is specrefine.repair_claims' summary of the shipped, complete grid."""
-    from specrefine.repair_claims import study
+    """README's look-ahead repair table is specrefine.experiments.repair_claims' summary of the shipped, complete
+    grid."""
+    from specrefine.experiments.repair_claims import study
 
     rows = read_table(ROOT / "data/results/repair/results.csv")
     summary = study(rows).summary()

@@ -8,10 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from specrefine.graph import TaskGraph, check_refines
+from specrefine.core.graph import TaskGraph, check_refines
+from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig, refine_chain, shortest_path
 from specrefine.refine.search import SearchResult
-from specrefine.regions import Box, Disc
 
 WALLS = Box(100, 100, 101, 101)
 
@@ -304,7 +304,7 @@ def test_every_accepted_refinement_is_checked(monkeypatch):
 def test_an_invalid_refinement_is_a_bug_not_a_warning(monkeypatch):
     """A vertex 'subset' that leaves I(v) must stop the search (Theorem 4.1 would not hold)."""
     import specrefine.refine.vertex as vertex_module
-    from specrefine.errors import InvalidRefinement
+    from specrefine.core.errors import InvalidRefinement
 
     monkeypatch.setattr(vertex_module, "sample_subsets", lambda region, k, rng, shrink=None: [Box(20, 20, 21, 21)] * k)
     with pytest.raises(InvalidRefinement, match="not a subset"):

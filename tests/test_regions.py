@@ -1,4 +1,4 @@
-"""specrefine.regions: membership, signed distance, sampling, subset test, JSON round trip."""
+"""specrefine.core.regions: membership, signed distance, sampling, subset test, JSON round trip."""
 
 import json
 
@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from specrefine.regions import Box, Disc, Region, Union, from_dict, is_subset, union
+from specrefine.core.regions import Box, Disc, Region, Union, from_dict, is_subset, union
 
 # --- membership ------------------------------------------------------------------
 

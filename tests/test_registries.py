@@ -7,13 +7,13 @@ import json
 import pytest
 
 from specrefine.cli import build_parser
-from specrefine.errors import SpecrefineError
-from specrefine.methods import METHOD_COLOURS, METHODS, PROPOSER_METHODS, SearchJob, register_method
-from specrefine.pipeline import refine_maze
+from specrefine.core.errors import SpecrefineError
 from specrefine.proposers import PROPOSERS, make_proposer, register_proposer
 from specrefine.proposers.geometric import GeometricProposer
 from specrefine.refine import shortest_path
-from specrefine.sweep import grid
+from specrefine.runs.methods import METHOD_COLOURS, METHODS, PROPOSER_METHODS, SearchJob, register_method
+from specrefine.runs.pipeline import refine_maze
+from specrefine.runs.sweep import grid
 
 TINY = dict(agent="point", rollouts=8, episodes=16)
 

@@ -18,9 +18,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from specrefine import sweep
 from specrefine.bench.__main__ import main as bench_main
 from specrefine.cli import main as cli_main
+from specrefine.runs import sweep
 
 TINY = ["--rollouts", "2", "--episodes", "2"]
 
@@ -110,12 +110,12 @@ def test_sweep_redoes_a_truncated_ok_row(tmp_path):
 
 
 def test_sweep_exits_1_when_every_cell_failed(tmp_path, capsys, monkeypatch):
-    import specrefine.pipeline
+    import specrefine.runs.pipeline
 
     def fails(*args, **kw):  # a cell that fails while it runs (a bad maze is refused before any cell: exit 2)
         raise RuntimeError("the simulator fell over")
 
-    monkeypatch.setattr(specrefine.pipeline, "refine_maze", fails)
+    monkeypatch.setattr(specrefine.runs.pipeline, "refine_maze", fails)
     code = sweep.main(["--mazes", "u_maze", "--out", str(tmp_path / "s"), *SWEEP])
     assert code == 1 and "1 failed" in capsys.readouterr().out
 
@@ -135,7 +135,7 @@ def _group(pgid: int) -> list[int]:
 
 
 def _sweep_proc(out: Path):
-    cmd = [sys.executable, "-m", "specrefine.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", "0", "1",
+    cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", "0", "1",
            "2", "3", "--rollouts", "8", "--episodes", "16", "--workers", "2", "--out", str(out)]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
@@ -161,7 +161,7 @@ def test_sweep_ctrl_c_ends_with_one_line_and_keeps_rows(tmp_path):
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130 and "Traceback" not in err, err
-    assert err.strip().splitlines()[-1].startswith("python -m specrefine.sweep: error: interrupted"), err
+    assert err.strip().splitlines()[-1].startswith("python -m specrefine.runs.sweep: error: interrupted"), err
     assert sweep.read_table(tmp_path / "results.csv")[0]["cell"] == done["cell"]  # finished rows kept
     assert _wait_for(lambda: not _group(proc.pid), 10), "pool workers outlived the sweep"
 
@@ -283,7 +283,7 @@ def test_any_argument_vector_gives_a_result_or_one_line(args):
 # --- more bad input: one line each ----------------------------------------------------------------------
 @pytest.mark.parametrize("agent,policy", [("ant", "point"), ("point", "ant")])
 def test_a_policy_for_the_other_agent_is_one_line(tmp_path, capsys, agent, policy):
-    from specrefine.paths import data_dir
+    from specrefine.core.paths import data_dir
 
     path = data_dir() / "policies" / f"{policy}.pt"
     assert_one_line_exit_2(cli_main, refine(tmp_path, "--agent", agent, "--policy", str(path)), capsys,
@@ -322,7 +322,7 @@ def test_a_closed_stdout_is_no_traceback(tmp_path):
 def test_a_policy_with_nan_or_inf_weights_is_refused_at_load(tmp_path, capsys, value):
     import torch
 
-    from specrefine.policy import GoalPolicy, save_policy
+    from specrefine.sim.policy import GoalPolicy, save_policy
 
     policy = GoalPolicy("point")
     with torch.no_grad():

@@ -13,12 +13,12 @@ from pathlib import Path
 
 import pytest
 
-from specrefine import sweep
 from specrefine.cli import main as cli_main
-from specrefine.comparison import main as comparison_main
-from specrefine.errors import RunFolderError
-from specrefine.failures import main as failures_main
-from specrefine.runfolder import claim
+from specrefine.core.errors import RunFolderError
+from specrefine.core.runfolder import claim
+from specrefine.experiments.comparison import main as comparison_main
+from specrefine.experiments.failures import main as failures_main
+from specrefine.runs import sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 TINY = ["--rollouts", "2", "--episodes", "2"]
@@ -71,7 +71,7 @@ def test_a_malicious_checkpoint_runs_no_code_and_is_one_line(tmp_path, how):
     evil.parent.mkdir()
     evil.write_bytes(pickle.dumps({"loss": _MakesAFile(marker)}))
     extra = ["--init", evil] if how == "--init" else ["--resume"]
-    proc = run_module("specrefine.train", *TRAIN_TINY, "--out", tmp_path / "out", *extra)
+    proc = run_module("specrefine.sim.train", *TRAIN_TINY, "--out", tmp_path / "out", *extra)
     assert not marker.exists()  # the pickle's code never ran
     assert_one_line_2(proc, f"{how} {evil}")
 
@@ -80,7 +80,7 @@ def test_resume_from_a_foreign_checkpoint_is_one_line(tmp_path):
     import torch
 
     torch.save({"weights": torch.zeros(3)}, tmp_path / "checkpoint.pt")  # safe to load, but not ours
-    proc = run_module("specrefine.train", *TRAIN_TINY, "--out", tmp_path, "--resume")
+    proc = run_module("specrefine.sim.train", *TRAIN_TINY, "--out", tmp_path, "--resume")
     assert "KeyError" not in assert_one_line_2(proc, "not a trainer checkpoint")
 
 
@@ -137,7 +137,7 @@ def refine_args(out, *args, maze="u_maze"):
 
 
 def test_a_rerun_stopped_midway_keeps_the_finished_runs_record(tmp_path, monkeypatch):
-    import specrefine.pipeline as pipeline
+    import specrefine.runs.pipeline as pipeline
 
     assert cli_main(refine_args(tmp_path, maze="u_chain_1")) == 0
     before = {name: (tmp_path / name).read_bytes() for name in ("steps.jsonl", "result.json", "run.json")}
@@ -184,7 +184,7 @@ def test_a_policy_with_an_unusable_normaliser_is_refused_at_load(tmp_path, monke
                                                                   needle):
     import torch
 
-    from specrefine.policy import GoalPolicy, save_policy
+    from specrefine.sim.policy import GoalPolicy, save_policy
 
     policy = GoalPolicy("point")
     with torch.no_grad():
@@ -198,7 +198,7 @@ def test_a_policy_with_an_unusable_normaliser_is_refused_at_load(tmp_path, monke
 def test_a_policy_missing_weights_is_refused_naming_them(tmp_path, capsys):
     import torch
 
-    from specrefine.policy import GoalPolicy, save_policy
+    from specrefine.sim.policy import GoalPolicy, save_policy
 
     save_policy(GoalPolicy("point"), tmp_path / "p.pt")
     blob = torch.load(tmp_path / "p.pt", weights_only=True)
@@ -211,9 +211,9 @@ def test_a_policy_missing_weights_is_refused_naming_them(tmp_path, capsys):
 def test_a_policy_acting_with_nan_stops_the_run_without_a_mujoco_log(tmp_path, monkeypatch):
     import numpy as np
 
-    from specrefine.errors import PolicyError
-    from specrefine.evaluate import Evaluator
-    from specrefine.mazes import load_maze
+    from specrefine.core.errors import PolicyError
+    from specrefine.core.mazes import load_maze
+    from specrefine.evaluation.evaluator import Evaluator
 
     monkeypatch.chdir(tmp_path)
     maze = load_maze("u_maze")
@@ -242,7 +242,7 @@ def test_failures_with_zero_episodes_is_refused(tmp_path, capsys):
 
 
 def test_a_finished_run_of_the_users_own_maze_is_reopened_from_its_record(tmp_path, capsys):
-    from specrefine.calibrate import main as calibrate_main
+    from specrefine.runs.calibrate import main as calibrate_main
 
     maze = tmp_path / "mine.maze"
     maze.write_text(ROOM)
@@ -263,8 +263,8 @@ def test_a_fifo_given_as_an_input_file_is_refused_without_opening_it(tmp_path):
             ("specrefine.cli", ["refine", "u_maze", "--policy", fifo, "--out", tmp_path / "o2", *TINY], "policy"),
             ("specrefine.cli", ["refine", "u_maze", "--proposer", f"replay:{fifo}", "--out", tmp_path / "o3", *TINY],
              "a FIFO"),
-            ("specrefine.comparison", [fifo, "--out", tmp_path / "o4"], "a FIFO"),
-            ("specrefine.failures", [fifo], "a FIFO")]:
+            ("specrefine.experiments.comparison", [fifo, "--out", tmp_path / "o4"], "a FIFO"),
+            ("specrefine.experiments.failures", [fifo], "a FIFO")]:
         assert_one_line_2(run_module(module, *args, timeout=60), needle)  # a hang would time out
 
 
@@ -279,7 +279,7 @@ def test_a_spec_nested_too_deep_is_one_line(tmp_path, capsys):
 
 
 def test_calibrate_bad_input_is_one_line_exit_2(tmp_path, capsys):
-    from specrefine.calibrate import main as calibrate_main
+    from specrefine.runs.calibrate import main as calibrate_main
 
     (tmp_path / "list").mkdir()
     (tmp_path / "list" / "result.json").write_text("[]")
@@ -339,8 +339,8 @@ def test_a_bad_mplbackend_is_one_line_before_any_work(tmp_path):
 @pytest.mark.parametrize("name,value", [("ROLLOUTS", -1), ("ROLLOUTS", 0), ("SEEDS", [0, -2]), ("AGENT", "walker"),
                                         ("PROPOSER", "gpt"), ("EPISODES", 2.5)])
 def test_notebook_parameters_are_checked_by_the_cli_rules(name, value):
-    from specrefine.errors import SpecrefineError
-    from specrefine.notebook import check_parameters
+    from specrefine.core.errors import SpecrefineError
+    from specrefine.runs.notebook import check_parameters
 
     with pytest.raises(SpecrefineError, match=f"notebook parameter {name} = "):
         check_parameters({"ROLLOUTS": 8, "SEED": 0, name: value})
@@ -348,7 +348,7 @@ def test_notebook_parameters_are_checked_by_the_cli_rules(name, value):
 
 
 def test_a_notebook_run_with_rollouts_0_names_the_parameter(tmp_path):
-    from specrefine.notebook import NB_DIR, execute, kernel_env
+    from specrefine.runs.notebook import NB_DIR, execute, kernel_env
 
     env = kernel_env(tmp_path / "k")
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])

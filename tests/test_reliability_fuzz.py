@@ -26,8 +26,8 @@ from hypothesis import strategies as st
 from test_vlm import GOOD, KEY, Server
 
 from specrefine.cli import main as cli_main
-from specrefine.errors import MazeError
-from specrefine.mazes import Maze, load_maze
+from specrefine.core.errors import MazeError
+from specrefine.core.mazes import Maze, load_maze
 
 TINY = ["-w", "1", "-d", "1", "--rollouts", "2", "--episodes", "2"]
 LIMIT_S = 60  # per example: far above a tiny run, far below a hang
@@ -214,7 +214,7 @@ def test_edited_replay_lines_give_a_result_or_one_line(recording, tmp_path_facto
 # --- issue 29: every command, random argument vectors and random bytes as files -----------------------------
 # Each `python -m specrefine.*` command with a command line and `specrefine refine` (above), run in-process under a
 # time limit: exit 0, or exit 2 with exactly one line on stderr (log records go to their own stream and hold no
-# traceback).  Options that would start long work get tiny values; `python -m specrefine.render` takes no
+# traceback).  Options that would start long work get tiny values; `python -m specrefine.pictures.render` takes no
 # arguments and rewrites the shipped maze pictures, so it is left out.  Three examples per command by default.
 from importlib import import_module  # noqa: E402
 
@@ -227,7 +227,7 @@ JUNK = st.one_of(st.sampled_from(["--bogus", "-x", "", "--", "nan", "-1", "0", "
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """A finished one-cell sweep: its table and its cell's run folder (result.json, run.json)."""
-    from specrefine import sweep
+    from specrefine.runs import sweep
 
     out = tmp_path_factory.mktemp("finished")
     assert sweep.main(["--mazes", "u_chain_1", "--methods", "ours", "--proposers", "geometric", "--seeds", "0",
@@ -298,10 +298,11 @@ def command_argv(name: str, files: dict):
     return build()
 
 
-COMMANDS = {"sweep": "specrefine.sweep", "calibrate": "specrefine.calibrate", "failures": "specrefine.failures",
-            "comparison": "specrefine.comparison", "figures": "specrefine.figures",
-            "repair_claims": "specrefine.repair_claims", "train": "specrefine.train",
-            "notebook": "specrefine.notebook", "bench": "specrefine.bench.__main__"}
+COMMANDS = {"sweep": "specrefine.runs.sweep", "calibrate": "specrefine.runs.calibrate",
+            "failures": "specrefine.experiments.failures", "comparison": "specrefine.experiments.comparison",
+            "figures": "specrefine.experiments.figures", "repair_claims": "specrefine.experiments.repair_claims",
+            "train": "specrefine.sim.train", "notebook": "specrefine.runs.notebook",
+            "bench": "specrefine.bench.__main__"}
 
 
 def run_command(module: str, argv: list[str]) -> tuple[int, str, str]:

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
-from specrefine.graph import TaskGraph
-from specrefine.mazes import benchmark_mazes, load_maze
-from specrefine.regions import Box, Disc
-from specrefine.render import render_graph_diagram, render_task, save_png, to_png
-from specrefine.spec import maze_task
+from specrefine.core.graph import TaskGraph
+from specrefine.core.mazes import benchmark_mazes, load_maze
+from specrefine.core.regions import Box, Disc
+from specrefine.core.spec import maze_task
+from specrefine.pictures.render import render_graph_diagram, render_task, save_png, to_png
 
 
 def decode(png: bytes) -> np.ndarray:

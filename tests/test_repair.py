@@ -9,9 +9,9 @@ from __future__ import annotations
 import pytest
 from test_refine_search import TableEvaluator, _Arrive, _chain_graph, _Query
 
-from specrefine.graph import check_refines
+from specrefine.core.graph import check_refines
+from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
-from specrefine.regions import Box, Disc
 
 
 class CorridorEvaluator(TableEvaluator):

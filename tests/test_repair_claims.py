@@ -1,5 +1,5 @@
-"""specrefine.repair_claims on synthetic tables: the paired verdicts, the paper's claims with ours-repair, partial
-presets and the descriptive counts."""
+"""specrefine.experiments.repair_claims on synthetic tables: the paired verdicts, the paper's claims with ours-repair,
+partial presets and the descriptive counts."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import json
 import pytest
 from test_comparison import row, write_csv
 
-from specrefine import repair_claims as rc
-from specrefine.comparison import MULTI_ROOM_MAZES
-from specrefine.mazes import benchmark_mazes
+from specrefine.core.mazes import benchmark_mazes
+from specrefine.experiments import repair_claims as rc
+from specrefine.experiments.comparison import MULTI_ROOM_MAZES
 
 MODERATE = "imperfect:moderate"
 
@@ -23,7 +23,7 @@ def grid_rows(success, proposer=MODERATE, seeds=rc.SEEDS):
 
 
 def entries_of(rows, proposer=MODERATE):
-    from specrefine import comparison as cmp
+    from specrefine.experiments import comparison as cmp
 
     cells, failed = cmp.table_cells(rows, "point")
     return {e["claim"]: e for e in [rc.paired_claim(cells, failed, proposer, MULTI_ROOM_MAZES, "multi-room"),

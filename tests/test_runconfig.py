@@ -8,8 +8,8 @@ from dataclasses import asdict, fields
 import pytest
 
 from specrefine.cli import build_parser, main
-from specrefine.pipeline import refine_maze
-from specrefine.runconfig import DEFAULTS, RunConfig
+from specrefine.runs.config import DEFAULTS, RunConfig
+from specrefine.runs.pipeline import refine_maze
 
 
 def test_the_paper_settings_are_the_defaults_of_the_cli():

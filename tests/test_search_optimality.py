@@ -15,9 +15,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from specrefine.graph import TaskGraph, check_refines
+from specrefine.core.graph import TaskGraph, check_refines
+from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig, shortest_path
-from specrefine.regions import Box, Disc
 
 WALLS = Box(1000, 1000, 1001, 1001)
 N_ROLLOUTS = 32

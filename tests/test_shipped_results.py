@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.pipeline import refine_maze
+from specrefine.runs.pipeline import refine_maze
 
 RESULTS = Path(__file__).resolve().parent.parent / "data" / "results"
 CELLS = [("results.csv", "u_maze__point__ours__geometric__s3"),

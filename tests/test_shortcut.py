@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 from test_refine_search import FakeResult
 
-from specrefine.graph import TaskGraph, check_refines
+from specrefine.core.graph import TaskGraph, check_refines
+from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
 from specrefine.refine.shortcut import add_shortcuts, shortcuts
-from specrefine.regions import Box, Disc
 
 WALL = Box(3.5, 0.1, 4.5, 5.0)  # a wall just north of the line y = 0, around x = 4
 

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 import torch
 
-from specrefine.errors import SpecrefineError
-from specrefine.mazes import parse_maze
-from specrefine.reach_env import GoalReachEnv
-from specrefine.sim import BatchedSim
+from specrefine.core.errors import SpecrefineError
+from specrefine.core.mazes import parse_maze
+from specrefine.sim.reach_env import GoalReachEnv
+from specrefine.sim.simulator import BatchedSim
 
 CORRIDOR = parse_maze("#####\n#S.G#\n#####", "corridor")
 
@@ -116,7 +116,7 @@ def test_torchrl_env_partial_reset_and_termination():
 def test_chained_goals_continue_without_reset_until_the_last():
     from dataclasses import replace
 
-    from specrefine.agents import AGENTS
+    from specrefine.core.agents import AGENTS
 
     env = GoalReachEnv("point", 2, seed=0, nthread=1, task=replace(AGENTS["point"].reach_task, goals_per_episode=2))
     td = env.reset()
@@ -136,7 +136,7 @@ def test_chained_goals_continue_without_reset_until_the_last():
 def test_ant_spawned_at_its_footprint_radius_does_not_touch_a_wall():
     import mujoco
 
-    from specrefine.sim import build_model, footprint_radius
+    from specrefine.sim.simulator import build_model, footprint_radius
 
     maze = parse_maze("###\n#S#\n#G#\n###", name="t").for_agent("ant")
     model = build_model("ant", maze)
@@ -160,7 +160,7 @@ def test_ant_spawned_at_its_footprint_radius_does_not_touch_a_wall():
 def test_tilt_cost_charges_an_ant_on_its_side():
     from dataclasses import replace
 
-    from specrefine.agents import AGENTS
+    from specrefine.core.agents import AGENTS
 
     rewards = {}
     for tilt in (0.0, 0.5):
@@ -180,7 +180,7 @@ def test_tilt_cost_charges_an_ant_on_its_side():
 def test_goal_radius_draws_each_goals_own_radius_and_success_uses_it():
     from dataclasses import replace
 
-    from specrefine.agents import AGENTS
+    from specrefine.core.agents import AGENTS
 
     task = replace(AGENTS["point"].reach_task, goals_per_episode=3, goal_radius=(0.5, 1.6))
     env = GoalReachEnv("point", 64, seed=0, nthread=1, task=task)

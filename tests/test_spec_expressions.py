@@ -8,11 +8,11 @@ import json
 import pytest
 
 from specrefine.cli import main
-from specrefine.errors import MazeError, SpecError, SpecrefineError
-from specrefine.graph import TaskGraph
-from specrefine.mazes import load_maze, parse_maze
-from specrefine.spec import SpecSyntaxError, chain_text, maze_spec_text, maze_task, parse_spec
-from specrefine.sweep import COLUMNS, Cell, _append, grid, read_table, run_sweep, summarise
+from specrefine.core.errors import MazeError, SpecError, SpecrefineError
+from specrefine.core.graph import TaskGraph
+from specrefine.core.mazes import load_maze, parse_maze
+from specrefine.core.spec import SpecSyntaxError, chain_text, maze_spec_text, maze_task, parse_spec
+from specrefine.runs.sweep import COLUMNS, Cell, _append, grid, read_table, run_sweep, summarise
 
 # a b c subgoals, one goal; every region reachable
 TEXT = """\
@@ -230,7 +230,7 @@ def test_rows_go_into_an_older_table_in_its_own_columns(tmp_path):
 
 
 def test_sweep_rejects_a_bad_spec_before_running(tmp_path, capsys):
-    from specrefine.sweep import main as sweep_main
+    from specrefine.runs.sweep import main as sweep_main
 
     code = sweep_main(["--mazes", "two_doors", "--methods", "dirl", "--seeds", "0", "--specs", "a -> z -> G",
                        "--out", str(tmp_path)])

@@ -1,14 +1,14 @@
-"""specrefine.spec and specrefine.graph: compilation, maze tasks, JSON round trip, check_refines."""
+"""specrefine.core.spec and specrefine.core.graph: compilation, maze tasks, JSON round trip, check_refines."""
 
 import json
 
 import pytest
 
-from specrefine.errors import InvalidRefinement, SpecError, SpecrefineError
-from specrefine.graph import TaskGraph, Violation, assert_refines, check_refines, path_graph
-from specrefine.mazes import load_maze
-from specrefine.regions import Box, Disc, Union, is_subset
-from specrefine.spec import avoiding, choose, compile_spec, maze_spec, maze_task, reach, seq
+from specrefine.core.errors import InvalidRefinement, SpecError, SpecrefineError
+from specrefine.core.graph import TaskGraph, Violation, assert_refines, check_refines, path_graph
+from specrefine.core.mazes import load_maze
+from specrefine.core.regions import Box, Disc, Union, is_subset
+from specrefine.core.spec import avoiding, choose, compile_spec, maze_spec, maze_task, reach, seq
 
 START = Box(-1, -1, 0, 0)
 A, B, C, D = Box(0, 0, 1, 1), Box(2, 0, 3, 1), Box(0, 2, 1, 3), Box(4, 4, 5, 5)

@@ -9,14 +9,14 @@ import pytest
 
 import specrefine
 from specrefine.cli import main
-from specrefine.errors import MazeError
-from specrefine.mazes import Maze, load_maze
-from specrefine.standard_maps import D4RL_GOALS, gymnasium_maps
-from specrefine.sweep import grid, read_table, run_sweep
-from specrefine.sweep import main as sweep_main
+from specrefine.core.errors import MazeError
+from specrefine.core.mazes import Maze, load_maze
+from specrefine.core.standard_maps import D4RL_GOALS, gymnasium_maps
+from specrefine.runs.sweep import grid, read_table, run_sweep
+from specrefine.runs.sweep import main as sweep_main
 
 FAST = ["--rollouts", "8", "--episodes", "16"]
-# start and goal cells (row, col) every shipped map must give (module docstring of specrefine.standard_maps)
+# start and goal cells (row, col) every shipped map must give (module docstring of specrefine.core.standard_maps)
 EXPECTED = {
     "U_MAZE": ((1, 1), (3, 1)), "EMPTY_MAZE": ((1, 1), (3, 1)), "MEDIUM_MAZE": ((1, 1), (6, 6)),
     "LARGE_MAZE": ((1, 1), (7, 9)), "OPEN": ((1, 1), (3, 5)), "OPEN_DIVERSE_G": ((1, 1), (3, 5)),

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.policy import load_policy
-from specrefine.sweep import COLUMNS, cell_log, grid, read_table, run_sweep, summarise
+from specrefine.runs.sweep import COLUMNS, cell_log, grid, read_table, run_sweep, summarise
+from specrefine.sim.policy import load_policy
 
 TINY = dict(agent="point", rollouts=8, episodes=16)
 
@@ -82,7 +82,7 @@ def test_failed_cell_is_recorded_and_retried(tmp_path, capsys):
 
 
 def test_sweep_resumes_after_kill_without_redoing_finished_cells(tmp_path):
-    cmd = [sys.executable, "-m", "specrefine.sweep", "--mazes", "u_maze", "--methods", "dirl",
+    cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl",
            "--seeds", "0", "1", "2", "3",
            "--rollouts", "8", "--episodes", "16", "--workers", "1", "--out", str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
@@ -137,8 +137,8 @@ def test_ray_backend_runs_two_cells_on_a_local_head(tmp_path):
 def test_a_sweep_runs_every_cell_with_the_policy_it_is_given(tmp_path, capsys):
     import json
 
-    from specrefine.policy import POLICY_DIR, load_policy
-    from specrefine.sweep import main
+    from specrefine.runs.sweep import main
+    from specrefine.sim.policy import POLICY_DIR, load_policy
 
     policy = tmp_path / "my_point.pt"
     shutil.copy(POLICY_DIR / "point.pt", policy)
@@ -158,13 +158,25 @@ def test_a_sweep_runs_every_cell_with_the_policy_it_is_given(tmp_path, capsys):
     assert not (tmp_path / "other" / "results.csv").exists()
 
 
-def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path):
-    """scripts/pinned_sweep.sh: the sweep runs from a worktree at CODE (not the checkout) and its rows reach SHIPPED."""
+def _git(root, *args) -> str:
+    return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True).stdout.strip()
+
+
+@pytest.mark.parametrize("layout", ["HEAD", "flat"])
+def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path, layout):
+    """scripts/pinned_sweep.sh: the sweep runs from a worktree at CODE (not the checkout) and its rows reach SHIPPED,
+    also for a commit from before the sub-package layout (its flat ``specrefine.sweep``: grids pinned to old code)."""
     root = Path(__file__).parents[1]
     if not (root / ".git").exists():
         pytest.skip("not a git checkout")
+    code = "HEAD"
+    if layout == "flat":  # the parent of the commit that moved sweep.py into runs/
+        moved = _git(root, "log", "-1", "--format=%H", "--diff-filter=D", "--", "specrefine/sweep.py")
+        code = _git(root, "rev-parse", "--verify", "-q", f"{moved}^") if moved else ""
+        if not code:
+            pytest.skip("no commit with the flat layout in this clone")
     tree, shipped = tmp_path / "tree", tmp_path / "shipped" / "t.csv"
-    env = {**os.environ, "CODE": "HEAD", "OUT": str(tmp_path / "out"), "SHIPPED": str(shipped), "TREE": str(tree),
+    env = {**os.environ, "CODE": code, "OUT": str(tmp_path / "out"), "SHIPPED": str(shipped), "TREE": str(tree),
            "PYTHON": sys.executable}
     try:
         proc = subprocess.run(["bash", str(root / "scripts" / "pinned_sweep.sh"), "--mazes", "u_maze", "--methods",
@@ -172,17 +184,16 @@ def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path):
                               env=env, capture_output=True, text=True, timeout=600)
         assert proc.returncode == 0, proc.stderr[-2000:]
         assert f"in {tree}" in proc.stdout
+        assert (tree / "specrefine" / "runs" / "sweep.py").exists() == (layout == "HEAD")
         (row,) = read_table(shipped)
         assert row["status"] == "ok" and row["maze"] == "u_maze"
-        head = subprocess.run(["git", "-C", str(tree), "rev-parse", "HEAD"], capture_output=True, text=True).stdout
-        assert head == subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
-                                      text=True).stdout
+        assert _git(tree, "rev-parse", "HEAD") == _git(root, "rev-parse", f"{code}^{{commit}}")
     finally:
         subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tree)], capture_output=True)
 
 
 def test_w_d_k_are_grid_axes_and_the_paper_values_keep_their_ids(tmp_path):
-    from specrefine.sweep import Cell, _append, pending
+    from specrefine.runs.sweep import Cell, _append, pending
 
     cells = grid(["u_maze"], ["ours", "symbolic", "dirl"], ["geometric"], [0], w=[3, 5], k=[5, 10])
     ids = sorted(c.id for c in cells)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import torch
 
-from specrefine.curves import read_log
-from specrefine.errors import SpecrefineError
-from specrefine.policy import GoalPolicy, PolicyError, load_policy, save_policy
-from specrefine.policy_eval import evaluate_reach
-from specrefine.train import Config, Trainer, main, make_config
+from specrefine.core.errors import SpecrefineError
+from specrefine.sim.curves import read_log
+from specrefine.sim.policy import GoalPolicy, PolicyError, load_policy, save_policy
+from specrefine.sim.policy_eval import evaluate_reach
+from specrefine.sim.train import Config, Trainer, main, make_config
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def test_tiny_training_run_improves_success(tiny_run):
 
 
 def test_training_curve_has_the_ppo_diagnostics_panels(tiny_run, tmp_path):
-    from specrefine.curves import plot_curve
+    from specrefine.sim.curves import plot_curve
 
     out, _ = tiny_run
     rows = read_log(out / "log.jsonl")
@@ -114,7 +114,7 @@ def test_shipped_point_policy_loads():
 
 
 def test_chained_goal_evaluation_accounts_for_every_episode():
-    from specrefine.policy_eval import evaluate_chain
+    from specrefine.sim.policy_eval import evaluate_chain
 
     res = evaluate_chain(load_policy("point"), episodes=64, goals=4, seed=3)
     arrived = [res["episodes"]] + res["reached"][:-1]  # episodes that set out for each goal
@@ -146,8 +146,9 @@ def test_every_config_field_is_a_documented_option(capsys):
 
 
 def test_notebook_imports_from_train_still_work():
-    """Notebook 01 imports the evaluation and its figures from specrefine.train; they live in policy_eval, curves."""
-    from specrefine import curves, policy_eval, train
+    """Notebook 01 imports the evaluation and its figures from specrefine.sim.train; they live in policy_eval,
+    curves."""
+    from specrefine.sim import curves, policy_eval, train
 
     for name in ("evaluate_chain", "evaluate_reach", "summary", "success_by_distance"):
         assert getattr(train, name) is getattr(policy_eval, name)
@@ -184,7 +185,7 @@ def test_a_bad_switch_radius_is_one_line(capsys, tmp_path):
 
 
 def test_a_policy_file_records_its_observation_frame(tmp_path):
-    from specrefine.policy import GoalPolicy, load_policy, save_policy
+    from specrefine.sim.policy import GoalPolicy, load_policy, save_policy
 
     world = load_policy("ant")
     heading = GoalPolicy("ant", observation_frame="heading")

@@ -20,9 +20,11 @@ from pathlib import Path
 
 import pytest
 
-from specrefine.errors import ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
-from specrefine.graph import check_refines
-from specrefine.mazes import load_maze, parse_maze
+from specrefine.core.errors import ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
+from specrefine.core.graph import check_refines
+from specrefine.core.mazes import load_maze, parse_maze
+from specrefine.core.regions import Disc
+from specrefine.core.spec import maze_task
 from specrefine.proposers import (
     CandidateFeedback,
     EdgeQuery,
@@ -33,8 +35,6 @@ from specrefine.proposers import (
     split_messages,
 )
 from specrefine.proposers.schema import parse_graph
-from specrefine.regions import Disc
-from specrefine.spec import maze_task
 from specrefine.vlm import LiteLLMClient, ReplayClient, request_hash
 
 KEY = "sk-test-DUMMY-5ecret-0123456789abcdef"
@@ -371,7 +371,7 @@ def test_graph_reply_becomes_task_graph(maze):
     assert check_refines(g, original) == []  # this reply happens to be a true refinement
     bad = json.loads(graph_reply(maze))
     bad["edges"].append({"u": "G", "v": "S"})
-    from specrefine.errors import ProposalRejected
+    from specrefine.core.errors import ProposalRejected
 
     with pytest.raises(ProposalRejected, match="cycle"):
         parse_graph(json.dumps(bad), maze, original)

@@ -39,7 +39,7 @@ def test_wheel_runs_refine_outside_the_checkout(tmp_path):
     work.mkdir()
     # only the installed copy on the path: the checkout (and the editable install, whose finder comes last) lose
     env = {**os.environ, "PYTHONPATH": str(site)}
-    probe = ("import specrefine, specrefine.paths as p; from specrefine.proposers import system_message; "
+    probe = ("import specrefine, specrefine.core.paths as p; from specrefine.proposers import system_message; "
              "assert 'Specification language' in system_message()['content']; "
              "print(specrefine.__file__); print(p.prompt_dir()); print(p.data_dir())")
     where = subprocess.run([sys.executable, "-c", probe], cwd=work, env=env, capture_output=True, text=True,

@@ -7,11 +7,11 @@ import sys
 import warnings
 from pathlib import Path
 
-from ..agents import AGENTS
-from ..argtypes import OneLineParser, bounded_int, out_path, positive_float
-from ..errors import SpecrefineError
-from ..methods import METHODS
-from ..runconfig import DEFAULTS, maze_problem, proposer_arg
+from ..core.agents import AGENTS
+from ..core.argtypes import OneLineParser, bounded_int, out_path, positive_float
+from ..core.errors import SpecrefineError
+from ..runs.config import DEFAULTS, maze_problem, proposer_arg
+from ..runs.methods import METHODS
 from . import __doc__ as package_doc
 
 

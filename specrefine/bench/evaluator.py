@@ -2,7 +2,7 @@
 
 :func:`bench_evaluator` returns one dict (the subcommand prints it as ONE JSON line).
 ``env_steps_per_s`` is measured through the evaluator's real code path
-(:meth:`specrefine.evaluate.Evaluator.evaluate`: start sampling, policy in the loop, observation,
+(:meth:`specrefine.evaluation.evaluator.Evaluator.evaluate`: start sampling, policy in the loop, observation,
 batched physics, region checks, bookkeeping), counting every simulated environment step.  In the
 same run it measures the raw ceiling of the same MuJoCo model: ``mujoco.rollout`` stepping the same
 batch with random controls, as one long call (``raw_rollout_steps_per_s``) and one call per
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..agents import get_agent
-from ..mazes import load_maze
+from ..core.agents import get_agent
+from ..core.mazes import load_maze
 
 
 def open_room(agent: str, cells: int | None = None):
@@ -34,7 +34,7 @@ def open_room(agent: str, cells: int | None = None):
     Rollouts of an untrained (or trained) policy neither hit walls nor reach G within the horizon, so
     every batch runs full length: the loop's steady-state cost, not early exits, is measured.
     """
-    from ..mazes import parse_maze
+    from ..core.mazes import parse_maze
 
     cells = cells or get_agent(agent).bench_room_cells
     rows = ["#" * cells] + ["#" + "." * (cells - 2) + "#" for _ in range(cells - 2)] + ["#" * cells]
@@ -55,7 +55,7 @@ def _cpu_name() -> str:
 
 
 def _policy(agent: str):
-    from ..policy import POLICY_DIR, GoalPolicy, load_policy
+    from ..sim.policy import POLICY_DIR, GoalPolicy, load_policy
 
     path = POLICY_DIR / f"{agent}.pt"
     if path.exists():
@@ -102,7 +102,7 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
     import mujoco
     import torch
 
-    from ..evaluate import Evaluator
+    from ..evaluation.evaluator import Evaluator
 
     torch.set_num_threads(torch_threads)
     maze = open_room(agent) if scenario == "open" else load_maze(scenario).for_agent(agent)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
-from ..runconfig import DEFAULTS
+from ..runs.config import DEFAULTS
 
 COLUMNS = ["maze", "agent", "method", "proposer", "seed", "evaluation", "success_rate", "success_ci_low",
            "success_ci_high", "predicted_success", "predicted_ci_low", "predicted_ci_high", "evaluations",
@@ -49,7 +49,7 @@ def _order(seed: int) -> tuple[str, ...]:
 
 
 def _run(maze, seed, evaluation, agent, method, proposer, episodes) -> dict:
-    from ..pipeline import refine_maze
+    from ..runs.pipeline import refine_maze
 
     out = Path(tempfile.mkdtemp(prefix="bench_refine_"))
     try:

@@ -6,7 +6,7 @@ Both run in this process, one after the other, on the same batched env (``GoalRe
 settings differ.  The reference is TorchRL's ``sota-implementations/ppo`` MuJoCo config: 2048 frames
 per batch, minibatch 64, 10 epochs (one torch thread too: with 2 threads on this shared 2-core machine
 a 64-sample PPO step took 508 ms instead of 17 ms, which would make the comparison meaningless).
-Ours: ``specrefine.train.make_config`` (large minibatches, few epochs, one torch thread).
+Ours: ``specrefine.sim.train.make_config`` (large minibatches, few epochs, one torch thread).
 :func:`bench_train` returns one dict (the subcommand prints it as one JSON line); the figure is the median
 over the measured batches (the first batch of each run is warm-up and not counted).
 """
@@ -25,8 +25,8 @@ def reference_overrides() -> dict:
 
 
 def measure(agent: str, batches: int, **overrides) -> dict:
-    from ..curves import read_log
-    from ..train import Trainer, make_config
+    from ..sim.curves import read_log
+    from ..sim.train import Trainer, make_config
 
     cfg = make_config(agent, checkpoint_every_s=1e9, **overrides)
     cfg.frames = cfg.frames_per_batch * (batches + 1)

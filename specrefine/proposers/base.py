@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..evaluate import EvaluationFacts
-from ..graph import TaskGraph
-from ..regions import Region
+from ..core.graph import TaskGraph
+from ..core.regions import Region
+from ..evaluation.evaluator import EvaluationFacts
 from .schema import region_json
 
 

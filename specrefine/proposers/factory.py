@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SpecrefineError
+from ..core.errors import SpecrefineError
 from ..vlm import LiteLLMClient, ReplayClient
 from .base import Proposer
 from .geometric import GeometricProposer, RandomProposer

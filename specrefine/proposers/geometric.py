@@ -17,9 +17,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..agents import get_agent
-from ..graph import TaskGraph
-from ..regions import CompiledRegion, Disc, Region
+from ..core.agents import get_agent
+from ..core.graph import TaskGraph
+from ..core.regions import CompiledRegion, Disc, Region
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, Proposer, _jsonable, graph_score
 from .schema import region_json
 

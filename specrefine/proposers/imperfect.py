@@ -40,8 +40,8 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from ..errors import SpecrefineError
-from ..regions import Box, Disc
+from ..core.errors import SpecrefineError
+from ..core.regions import Box, Disc
 from ..vlm import VLMClient
 from .geometric import GeometricProposer, reach_cells
 from .schema import region_json
@@ -347,7 +347,7 @@ def _near_line_cost(maze, a, b):
 
 def _falsely_opened(maze, a, b):
     """The maze with the thin wall cell nearest the straight line a-b opened (or the maze, if none)."""
-    from ..mazes import Maze
+    from ..core.mazes import Maze
 
     thin = [(r, c) for r in range(1, maze.rows - 1) for c in range(1, maze.cols - 1)
             if maze.grid[r][c] == "#" and ((maze.is_free(r - 1, c) and maze.is_free(r + 1, c))

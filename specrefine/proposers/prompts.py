@@ -2,7 +2,7 @@
 
 Templates use ``$name`` placeholders and ``[[image:NAME]]`` markers.  Every fact a prompt states
 about the agent, the regions or the evaluation comes from the code that does it: the agent entry
-(:mod:`specrefine.agents`) and the evaluator.
+(:mod:`specrefine.core.agents`) and the evaluator.
 """
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from string import Template
 
 import numpy as np
 
-from ..agents import get_agent
-from ..errors import SpecrefineError
-from ..evaluate import EvaluationFacts
-from ..graph import TaskGraph
-from ..paths import prompt_dir
-from ..regions import Region, is_subset
+from ..core.agents import get_agent
+from ..core.errors import SpecrefineError
+from ..core.graph import TaskGraph
+from ..core.paths import prompt_dir
+from ..core.regions import Region, is_subset
+from ..evaluation.evaluator import EvaluationFacts
 from ..vlm.messages import build_content
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, graph_score
 from .schema import region_json

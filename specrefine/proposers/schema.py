@@ -2,7 +2,7 @@
 
 :func:`parse_split` reads an edge split (an ordered list of waypoint regions) and
 :func:`parse_graph` a whole task graph (the one-shot baseline).  A bad reply raises
-:class:`~specrefine.errors.ProposalRejected` with a one-line reason.
+:class:`~specrefine.core.errors.ProposalRejected` with a one-line reason.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ import networkx as nx
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
-from ..errors import ProposalRejected
-from ..graph import TaskGraph, infer_parents
-from ..regions import Box, Disc, Region, union
+from ..core.errors import ProposalRejected
+from ..core.graph import TaskGraph, infer_parents
+from ..core.regions import Box, Disc, Region, union
 
 _TYPE_ALIASES = {"circle": "disc", "disk": "disc", "ball": "disc", "rectangle": "box", "rect": "box",
                  "square": "box", "aabb": "box"}

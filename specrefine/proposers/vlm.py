@@ -8,9 +8,9 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 
-from ..errors import ProposalRejected
-from ..graph import TaskGraph
-from ..regions import Region
+from ..core.errors import ProposalRejected
+from ..core.graph import TaskGraph
+from ..core.regions import Region
 from ..vlm import BadReply, ReplayClient, VLMClient
 from .base import CandidateFeedback, EdgeQuery, GraphFeedback, GraphQuery, Proposer, _jsonable
 from .prompts import graph_messages, render_prompt, split_messages

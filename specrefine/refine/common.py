@@ -6,12 +6,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from ..regions import Region
-from ..results import unreached
+from ..core.regions import Region
+from ..core.results import unreached
 
 
 class SubtaskEvaluator(Protocol):
-    """What the refinement algorithms need from `specrefine.evaluate.Evaluator` (tests may stub it)."""
+    """What the refinement algorithms need from `specrefine.evaluation.evaluator.Evaluator` (tests may stub it)."""
 
     n: int
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..paper import PAPER
-from ..regions import Region
+from ..core.paper import PAPER
+from ..core.regions import Region
 from .common import Leg, SubtaskEvaluator, estimate_legs
 from .vertex import refine_chain
 

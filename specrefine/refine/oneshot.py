@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..graph import check_refines
-from ..paper import PAPER
+from ..core.graph import check_refines
+from ..core.paper import PAPER
 from .search import SearchResult, shortest_path
 
 
@@ -79,11 +79,11 @@ def _edge_success(result: SearchResult) -> dict:
 
 def _picture(maze, evaluator, graph, result):
     """The graph on the map with rollouts of its best path (from the graph's initial set)."""
-    from ..render import render_task, to_png
+    from ..pictures.render import render_task, to_png
 
     if not result.path or len(result.path) < 2:
         return to_png(render_task(maze, graph))
-    from ..evaluate import path_legs
+    from ..evaluation.evaluator import path_legs
 
     n = min(evaluator.n, 32)
     legs = path_legs(graph, result.path)

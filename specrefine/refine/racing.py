@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..results import merge_edge_results, wilson_ci
+from ..core.results import merge_edge_results, wilson_ci
 from .common import evaluate_all
 
 STAGE_SEED_OFFSET = 3_000_017  # not the search's seed, the measurement's or the calibration's

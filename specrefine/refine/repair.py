@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..graph import TaskGraph
+from ..core.graph import TaskGraph
 from .common import SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import SplitCandidate, SplitOutcome, split_legs
 

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..graph import TaskGraph, assert_refines
-from ..paper import PAPER
+from ..core.graph import TaskGraph, assert_refines
+from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import edge_split
 from .racing import Racing

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..graph import TaskGraph
+from ..core.graph import TaskGraph
 
 SEGMENT_SAMPLES = 64  # points checked along a shortcut's straight segment
 

@@ -16,7 +16,7 @@ from functools import partial
 
 import numpy as np
 
-from ..regions import Box, Disc, Region
+from ..core.regions import Box, Disc, Region
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, evaluate_all, start_of
 from .racing import Racing
 

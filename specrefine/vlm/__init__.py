@@ -3,7 +3,7 @@
 What is asked (prompts) and how answers become proposals live in :mod:`specrefine.proposers`.
 """
 
-from ..errors import ProposalRejected, ReplayMiss, VLMConfigError, VLMError, VLMUnavailable
+from ..core.errors import ProposalRejected, ReplayMiss, VLMConfigError, VLMError, VLMUnavailable
 from .client import LiteLLMClient
 from .messages import (
     MAX_REPLY_CHARS,

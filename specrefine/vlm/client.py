@@ -22,7 +22,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ..errors import VLMConfigError, VLMError, VLMUnavailable
+from ..core.errors import VLMConfigError, VLMError, VLMUnavailable
 from .messages import MAX_REPLY_CHARS, TOO_LONG, VLMClient, one_line, request_hash
 from .recording import RECORD_VERSION, Recorder, default_record_path
 

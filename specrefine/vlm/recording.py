@@ -13,8 +13,8 @@ import logging
 import re
 from pathlib import Path
 
-from ..errors import ReplayMiss, SpecrefineError, VLMConfigError
-from ..paths import data_dir, regular_file
+from ..core.errors import ReplayMiss, SpecrefineError, VLMConfigError
+from ..core.paths import data_dir, regular_file
 from .messages import (
     MAX_REPLY_CHARS,
     TOO_LONG,

@@ -1,0 +1,1 @@
+"""Estimating subtasks and paths: the rollout evaluator, the specification monitor, the compositional policy."""

@@ -1,0 +1,257 @@
+"""The compositional policy a run outputs, as an object for an ordinary Gymnasium loop.
+
+It holds the refined path (one leg per edge of the chosen path of the refined graph: the goal region
+I(v), the avoid set O(u, v) and v's fixed goal point, if any), the goal-conditioned policy and the
+goal-switching rule of :meth:`specrefine.evaluation.evaluator.Evaluator.run_compositional`:
+
+* at ``reset`` every leg gets its goal point: the vertex's fixed point, else a point drawn uniformly
+  in its goal region at least ``clearance`` from walls and hazards (``Evaluator.sample_free``, the
+  evaluator's own rule and code);
+* at every decision the agent's position is checked first: while it lies in the current leg's goal
+  region the policy moves on to the next leg (several at once if the regions overlap); then the goal
+  policy is fed the current leg's goal point (the last leg's once all are done).
+
+``act`` takes a Gymnasium-Robotics maze observation (the dict of ``PointMaze_*-v3`` /
+``AntMaze_*-v5``): the agent's xy is ``achieved_goal``; ``observation`` is qpos and qvel of the
+point mass (x, y, vx, vy) or qpos without x, y and qvel of the Ant (27 values: build AntMaze with
+``include_cfrc_ext_in_observation=False``), from which the torso's heading is read (quaternion at
+``observation[1:5]``).  It builds this package's policy observation from them exactly as
+:meth:`specrefine.sim.simulator.BatchedSim.observe` does, and returns the control this package's simulator
+would apply (clipped to [-1, 1]; for the point mass, to the unit disc).
+
+``env_dt`` (seconds between ``act`` calls) keeps this package's control period
+(``Agent.timestep * Agent.frame_skip``, 0.05 s): PointMaze steps 0.01 s (frame_skip 1), so the policy
+decides on every 5th call and holds its action in between; AntMaze steps 0.05 s, one decision per call.
+
+Saved as ``RUN_DIR/policy.json`` (atomically): the legs, the maze, the horizon and the goal policy by
+reference (the checkpoint the run used, ``shipped`` or an absolute path, with its fingerprint: no copy of
+300 kB per sweep cell); loading reads JSON and ``torch.load(weights_only=True)`` only, and refuses a
+checkpoint whose fingerprint is not the recorded one (retrained since the run).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..core.agents import get_agent
+from ..core.errors import PolicyError, SpecrefineError
+from ..core.mazes import Maze
+from ..core.regions import CompiledRegion, Region, from_dict
+
+FORMAT, VERSION = "specrefine-compositional-policy", 1
+POLICY_JSON = "policy.json"
+SWITCHING_RULE = ("legs in path order; at each decision, while the agent's xy is inside the current leg's goal "
+                  "region, advance to the next leg; the goal policy is fed the current leg's goal point (fixed "
+                  "vertex point, else drawn at reset uniformly in the goal region at least clearance from walls)")
+
+
+@dataclass(frozen=True)
+class Leg:
+    vertex: str
+    goal: Region
+    avoid: Region
+    point: tuple[float, float] | None
+
+
+class CompositionalPolicy:
+    """``reset(observation)`` / ``act(observation) -> action`` along a run's refined path (module docstring)."""
+
+    def __init__(self, agent: str, maze: Maze, legs: list[Leg], goal_policy, horizon: int,
+                 env_dt: float | None = None):
+        from .evaluator import Evaluator
+
+        if not legs:
+            raise SpecrefineError("a compositional policy needs at least one leg (the run found no path)")
+        spec = get_agent(agent)
+        self.agent, self.maze, self.legs, self.goal_policy, self.horizon = agent, maze, list(legs), goal_policy, horizon
+        self.control_period = spec.timestep * spec.frame_skip
+        self.match_env_dt(env_dt)
+        self._sampler = Evaluator(maze, agent, goal_policy, n=1)  # the evaluator's goal-point rule and clearance
+        self.clearance = self._sampler.clearance
+        self._goals = [CompiledRegion(leg.goal) for leg in self.legs]
+        self._avoids = [CompiledRegion(leg.avoid) for leg in self.legs]
+        self.reset()
+
+    def match_env_dt(self, env_dt: float | None) -> None:
+        """``act`` is called every ``env_dt`` seconds: decide every ``hold`` calls (None: every call)."""
+        self.env_dt = None if env_dt is None else float(env_dt)
+        self.hold = 1 if env_dt is None else max(1, round(self.control_period / self.env_dt))
+
+    # --- the loop ------------------------------------------------------------------------------
+    def reset(self, observation=None, *, seed=None) -> None:
+        """Start an episode: draw the goal points (``seed``: an int or a numpy Generator) and take leg 0."""
+        rng = np.random.default_rng(seed)
+        sample = self._sampler.sample_free
+        self.goal_points = np.array([leg.point if leg.point is not None else sample(leg.goal, 1, rng)[0]
+                                     for leg in self.legs], dtype=float)
+        self.leg, self.decisions_in_leg, self._calls, self._action = 0, 0, 0, None
+        if observation is not None:
+            self.update(observation)
+
+    def act(self, observation) -> np.ndarray:
+        """The control for this environment step (a new decision every ``hold`` calls)."""
+        if self._calls % self.hold == 0 or self._action is None:
+            self.update(observation)
+            goal = self.goal_points[min(self.leg, len(self.legs) - 1)]
+            obs = policy_observation(self.agent, observation, goal, getattr(self.goal_policy, "observation_frame",
+                                                                            "world"))
+            self._action = self._control(np.asarray(self._act(obs[None]), dtype=np.float64)[0])
+            self.decisions_in_leg += 1
+        self._calls += 1
+        return self._action.copy()
+
+    @property
+    def done(self) -> bool:
+        """Every leg's goal region has been reached."""
+        return self.leg >= len(self.legs)
+
+    @property
+    def timed_out(self) -> bool:
+        """The current leg has used its ``horizon`` decisions (the evaluator's per-leg time limit)."""
+        return not self.done and self.decisions_in_leg >= self.horizon
+
+    def touching(self, xy) -> bool:
+        """The agent at ``xy`` touches the current leg's avoid set (closer than ``clearance``)."""
+        if self.done:
+            return False
+        return bool(self._avoids[self.leg].below(np.asarray(xy, dtype=float).reshape(1, 2), self.clearance)[0])
+
+    def update(self, observation) -> None:
+        """Move on past every leg whose goal region holds the agent now (``act`` does this at each decision)."""
+        point = agent_xy(observation).reshape(1, 2)
+        while not self.done and self._goals[self.leg].contains(point)[0]:
+            self.leg += 1
+            self.decisions_in_leg = 0
+
+    def _act(self, obs):
+        return self.goal_policy.act(obs) if hasattr(self.goal_policy, "act") else self.goal_policy(obs)
+
+    def _control(self, action: np.ndarray) -> np.ndarray:
+        action = np.clip(action, -1.0, 1.0)
+        if get_agent(self.agent).action_in_disc:
+            action = action / max(float(np.linalg.norm(action)), 1.0)
+        return action
+
+    # --- files -----------------------------------------------------------------------------------
+    @classmethod
+    def load(cls, run_dir, env_dt: float | None = None) -> CompositionalPolicy:
+        """The policy saved in ``run_dir`` (``policy.json`` + its goal policy); problems are one PolicyError line."""
+        path = Path(run_dir) / POLICY_JSON
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise PolicyError(f"{path}: no compositional policy (not a finished run folder, or the run found no "
+                              "path)") from None
+        except (OSError, ValueError) as exc:
+            raise PolicyError(f"{path}: unreadable ({type(exc).__name__})") from None
+        if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("version") != VERSION:
+            raise PolicyError(f"{path}: not a specrefine compositional policy (format {FORMAT} v{VERSION})")
+        try:
+            maze = Maze(data["maze"], tuple(data["maze_grid"]), float(data["cell_size"]))
+            legs = [Leg(leg["vertex"], from_dict(leg["goal"]), from_dict(leg["avoid"]),
+                        None if leg["point"] is None else tuple(float(v) for v in leg["point"]))
+                    for leg in data["legs"]]
+            goal_policy = _load_goal_policy(data["agent"], data["goal_policy"])
+            return cls(data["agent"], maze, legs, goal_policy, int(data["horizon"]), env_dt=env_dt)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise PolicyError(f"{path}: malformed ({type(exc).__name__}: {str(exc)[:80]})") from None
+
+    def to_dict(self, goal_policy_record: dict) -> dict:
+        return {"format": FORMAT, "version": VERSION, "agent": self.agent, "maze": self.maze.name,
+                "maze_grid": list(self.maze.grid), "cell_size": self.maze.cell_size, "horizon": self.horizon,
+                "control_period": self.control_period, "clearance": self.clearance, "switching": SWITCHING_RULE,
+                "legs": [{"vertex": leg.vertex, "goal": leg.goal.to_dict(), "avoid": leg.avoid.to_dict(),
+                          "point": None if leg.point is None else list(leg.point)} for leg in self.legs],
+                "goal_policy": goal_policy_record}
+
+
+def save_run_policy(run_dir, maze: Maze, agent: str, graph, path: list[str], evaluator) -> Path | None:
+    """Write ``run_dir/policy.json`` for ``path`` of ``graph`` as ``evaluator`` runs it (its goal policy and horizon).
+
+    ``maze`` at the agent's scale.  The goal policy is recorded by reference: the checkpoint the run used
+    (``run_dir/run.json``'s ``policy``: ``shipped`` or a path, made absolute) and its fingerprint, or the
+    scripted :class:`~specrefine.sim.policy.PointController`'s gains.  Nothing is written (None) when the run
+    found no path or its goal policy is neither (a stand-in evaluator's callable).
+    """
+    run_dir = Path(run_dir)
+    record = _goal_policy_record(run_dir, getattr(evaluator, "policy", None))
+    if not path or len(path) < 2 or record is None:
+        return None
+    legs = [Leg(v, graph.region(v), graph.avoid(u, v),
+                None if graph.goal_point(v) is None else tuple(float(x) for x in graph.goal_point(v)))
+            for u, v in zip(path, path[1:], strict=False)]
+    policy = CompositionalPolicy(agent, maze, legs, evaluator.policy, int(evaluator.horizon))
+    data = policy.to_dict(record) | {"path": list(path)}
+    from ..core.runfolder import write_atomic
+
+    target = run_dir / POLICY_JSON
+    write_atomic(target, json.dumps(data, indent=1))
+    return target
+
+
+def _goal_policy_record(run_dir: Path, goal_policy) -> dict | None:
+    from ..core.runfolder import RECORD
+    from ..sim.policy import GoalPolicy, PointController
+
+    if isinstance(goal_policy, PointController):
+        return {"scripted": {"gain": goal_policy.gain, "vmax": goal_policy.vmax, "kv": goal_policy.kv},
+                "fingerprint": goal_policy.fingerprint}
+    if not isinstance(goal_policy, GoalPolicy):
+        return None
+    try:
+        checkpoint = json.loads((run_dir / RECORD).read_text()).get("policy", "shipped")
+    except (OSError, ValueError, AttributeError):
+        checkpoint = "shipped"
+    checkpoint = "shipped" if checkpoint in (None, "shipped") else str(Path(checkpoint).resolve())
+    return {"checkpoint": checkpoint, "fingerprint": goal_policy.fingerprint}
+
+
+def _load_goal_policy(agent: str, record: dict):
+    from ..sim.policy import PointController, load_policy
+
+    if "scripted" in record:
+        policy = PointController(**{k: float(v) for k, v in record["scripted"].items()})
+    else:
+        policy = load_policy(agent if record["checkpoint"] == "shipped" else Path(record["checkpoint"]))
+    if getattr(policy, "agent", agent) != agent or policy.fingerprint != record.get("fingerprint"):
+        raise PolicyError(f"goal policy {record.get('checkpoint', 'scripted')}: fingerprint {policy.fingerprint}, "
+                          f"the run used {record.get('fingerprint')} (retrained or replaced since the run)")
+    return policy
+
+
+# --- observations ------------------------------------------------------------------------------------
+def agent_xy(observation) -> np.ndarray:
+    """The agent's (x, y) from a Gymnasium-Robotics maze observation (its ``achieved_goal``)."""
+    return np.asarray(observation["achieved_goal"], dtype=float).reshape(2)
+
+
+def policy_observation(agent: str, observation, goal, frame: str = "world") -> np.ndarray:
+    """This package's policy observation (``BatchedSim.observe`` in ``frame``) from a Gymnasium-Robotics maze
+    observation."""
+    from ..sim.simulator import free_body_observation
+
+    spec = get_agent(agent)
+    body = np.asarray(observation["observation"], dtype=float).ravel()
+    rel = (np.asarray(goal, dtype=float).reshape(2) - agent_xy(observation))[None]
+    if spec.planar:  # PointMaze: (x, y, vx, vy) -> velocity, goal - xy
+        if body.size != 4:
+            raise SpecrefineError(f"a PointMaze observation has 4 values (x, y, vx, vy), got {body.size}")
+        return np.concatenate([body[2:4], rel[0]]).astype(np.float32)
+    if body.size != spec.obs_dim - 2:  # AntMaze: qpos[2:] (13) + qvel (14)
+        raise SpecrefineError(f"an {agent} observation needs {spec.obs_dim - 2} values (qpos without x, y, and qvel; "
+                              f"contact forces off), got {body.size}")
+    nq = body.size - spec.act_dim - 6  # qpos without x, y: z, quaternion, joints; then qvel: 6 + joints
+    return free_body_observation(body[None, :nq], body[None, nq:], rel, frame)[0]
+
+
+def torso_flipped(agent: str, observation) -> bool:
+    """The Ant's torso points below the horizon (never, for a planar agent)."""
+    from ..sim.simulator import torso_up
+
+    if get_agent(agent).planar:
+        return False
+    return bool(torso_up(np.asarray(observation["observation"], dtype=float)[1:5][None])[0] < 0.0)

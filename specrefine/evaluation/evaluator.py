@@ -1,0 +1,576 @@
+"""Subtask evaluation: estimate, by batched rollouts of the goal policy, how often a subtask succeeds.
+
+``Evaluator.evaluate(start, goal, avoid)`` estimates the probability that the goal-conditioned
+policy, started from ``start`` (uniform in a region where the agent fits: ``spawn_radius`` from
+walls, for the Ant the reach of its legs; or resampled end states of a preceding edge), reaches
+``goal`` before entering ``avoid`` and before flipping, within ``horizon`` control steps. Entering
+means touching: ``avoid.signed_distance(xy) < clearance`` where ``Evaluator.clearance`` = the
+agent's body radius + MuJoCo's contact margin (pass the same ``Evaluator.clearance`` to
+:func:`specrefine.evaluation.monitor.satisfies`). The policy's goal point is ``goal_point`` if given, else a
+point sampled uniformly from ``goal`` per rollout, at least ``clearance`` from walls where the
+region allows (the paper's "representative waypoint randomly sampled from the inclusion set of the
+subtask's goal vertex"); :meth:`Evaluator.goal_point_rule` says this in words for the VLM.
+
+All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
+:class:`~specrefine.sim.simulator.BatchedSim` (one per batch size, built lazily and reused); a rollout that
+has finished is frozen (zero action, excluded from the checks, its trajectory padded with its last
+point) and the loop stops once all have finished.
+
+Reproducible: the seed fixes start states, goal points and (through them) the deterministic policy
+and physics, so the same seed gives the same numbers: bit for bit when the same call runs again on
+one machine (or is read back from the cache); through another batch shape (``evaluate_many``, the
+compaction of finished rollouts), thread count or CPU, the same successes (barring a rollout that
+ends within rounding of a boundary), with floats equal to a tolerance. Results are cached in memory
+and, with ``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the
+canonical JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon,
+seed, agent, maze, clearance, code version), written atomically (a run interrupted midway keeps
+every entry it finished); an unreadable or mismatching entry is ignored with a warning and
+recomputed.
+
+``run_compositional`` runs a compositional policy (a sequence of legs, the goal switching when a
+leg's goal region is reached) end to end, through the same loop.  Result types live in
+:mod:`specrefine.core.results`, the monitor in :mod:`specrefine.evaluation.monitor`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+from collections import OrderedDict
+from contextlib import contextmanager
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..core.agents import get_agent
+from ..core.errors import PolicyError, SpecrefineError
+from ..core.mazes import Maze
+from ..core.paper import PAPER
+from ..core.regions import CompiledRegion, Region
+from ..core.results import (
+    AVOID,
+    FLIPPED,
+    SUCCESS,
+    TIMEOUT,
+    UNFINISHED,
+    CompositionalResult,
+    EdgeResult,
+    StartStates,
+    unreached,
+    wilson_ci,
+)
+
+log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
+
+CACHE_VERSION = 1
+
+
+@dataclass(frozen=True)
+class EvaluationFacts:
+    """What the evaluator does, as a prompt tells it to a VLM: read from the code, never restated by hand.
+
+    The goal point of a subtask whose goal vertex has no fixed point is drawn uniformly inside the
+    goal region, at least ``clearance`` from walls where the region allows (``Evaluator.sample_free``);
+    success is the agent's centre entering the goal region before touching the avoid set (coming
+    within ``clearance`` of it), before flipping and within ``horizon`` control steps.
+    """
+
+    agent: str
+    clearance: float  # m
+    horizon: int  # control steps per subtask
+    control_period: float  # s per control step
+    rollouts: int  # per subtask evaluation
+
+    @property
+    def horizon_seconds(self) -> float:
+        return self.horizon * self.control_period
+
+    @classmethod
+    def default(cls, agent: str, maze: Maze, rollouts: int = PAPER.rollouts) -> EvaluationFacts:
+        """The facts of an ``Evaluator(maze, agent, ...)`` with default settings, without building one."""
+        from ..sim.simulator import build_model, contact_margin
+
+        spec = get_agent(agent)
+        clearance = spec.body_radius + contact_margin(build_model(agent, maze))
+        return cls(agent, clearance, spec.default_horizon, spec.timestep * spec.frame_skip, rollouts)
+
+
+def _region_key(region: Region) -> dict:
+    return region.to_dict()
+
+
+# --- the evaluator --------------------------------------------------------------------------------
+class Evaluator:
+    """N batched rollouts of a goal policy per subtask, with counters and a cache.
+
+    maze: the maze at the agent's scale (``maze.for_agent(agent)``); regions passed to the methods are
+    in its metres.  policy: a :class:`~specrefine.sim.policy.GoalPolicy` or any callable obs -> actions in
+    [-1, 1] (an object with ``.act(obs)`` is called that way; a ``fingerprint`` attribute identifies
+    it in cache keys; without one, results are cached in memory only).
+    """
+
+    MIN_BATCH = 8  # running rollouts are compacted into batches of 8, 16, 32, ... (never below 8)
+    MEMO_SIZE = 512  # results kept in memory (least recently used dropped; the disk cache keeps everything)
+
+    def __init__(self, maze: Maze, agent: str, policy, n: int = PAPER.rollouts, horizon: int | None = None,
+                 seed: int = 0, cache_dir=None, nthread: int | None = None):
+        from ..sim.simulator import build_model, contact_margin, footprint_radius
+
+        spec = get_agent(agent)
+        if abs(maze.cell_size - spec.cell_size) > 1e-9:
+            raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
+                                  f"{spec.cell_size:g} m: pass maze.for_agent({agent!r})")
+        self.maze, self.agent, self.policy = maze, agent, policy
+        self.n, self.seed, self.nthread = int(n), seed, nthread
+        self.horizon = int(horizon) if horizon is not None else spec.default_horizon
+        self.agent_radius = float(spec.body_radius)  # the agent entry's (and BatchedSim's) body radius
+        self._model = model = build_model(agent, maze)  # shared by the sims of every batch size
+        #: contacts become active at this gap (MuJoCo geom margins), so touching a wall = closer than this
+        self.contact_margin = contact_margin(model)
+        #: the avoid test: a rollout enters O(e) when O(e).signed_distance(xy) < clearance
+        self.clearance = self.agent_radius + self.contact_margin
+        #: fresh starts (default pose) keep this far from walls: the body radius, or the legs' reach if larger
+        self.spawn_radius = max(self.clearance, footprint_radius(model) + self.contact_margin)
+        self.cache_dir = Path(cache_dir) if cache_dir is not None else None
+        self.evaluations = 0  # subtask evaluations actually simulated
+        self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
+        self.cache_hits = 0
+        self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
+        #: environment steps of the evaluations read from cache_dir that this process never simulated (an earlier
+        #: run of the same folder did): each counted once, so sim_steps + cached_steps is the same for a run done
+        #: in one go and one resumed after a kill
+        self.cached_steps = 0
+        self._simulated: set[str] = set()
+        self._steps_counted: set[str] = set()
+        self._act = policy.act if hasattr(policy, "act") else policy
+        self.observation_frame = getattr(policy, "observation_frame", "world")
+        self._sims: dict[int, object] = {}
+        self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
+        self._compiled: dict[Region, CompiledRegion] = {}
+        self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
+        grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
+        self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
+
+    # --- plumbing ------------------------------------------------------------------------------
+    @property
+    def control_period(self) -> float:
+        """Seconds per control step."""
+        spec = get_agent(self.agent)
+        return spec.timestep * spec.frame_skip
+
+    def facts(self) -> EvaluationFacts:
+        """What this evaluator does, in the terms a prompt states it (see :class:`EvaluationFacts`)."""
+        return EvaluationFacts(self.agent, self.clearance, self.horizon, self.control_period, self.n)
+
+    @property
+    def body_radius(self) -> float:
+        """Former name of :attr:`clearance` (torso + contact margin), kept for older notebooks."""
+        return self.clearance
+
+    def sim(self, batch: int | None = None):
+        """The BatchedSim of ``batch`` rows (default: ``n``; built on first use, then reused)."""
+        from ..sim.simulator import BatchedSim
+
+        batch = int(batch or self.n)
+        if batch not in self._sims:
+            self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread, model=self._model)
+        return self._sims[batch]
+
+    def compiled(self, region: Region) -> CompiledRegion:
+        c = self._compiled.get(region)
+        if c is None:
+            if len(self._compiled) > 256:
+                self._compiled.clear()
+            c = self._compiled[region] = CompiledRegion(region)
+        return c
+
+    @property
+    def policy_fingerprint(self) -> str | None:
+        fp = getattr(self.policy, "fingerprint", None)
+        return str(fp) if fp is not None else None
+
+    def sample_free(self, region: Region, k: int, rng: np.random.Generator, clearance: float | None = None
+                    ) -> np.ndarray:
+        """``k`` points uniform in ``region`` at least ``clearance`` (default: ``self.clearance``) from walls.
+
+        Falls back to plain uniform samples if the region has (almost) no such points.
+        """
+        clearance = self.clearance if clearance is None else clearance
+        chunks, got = [], 0
+        for _ in range(64):
+            pts = region.sample(max(2 * (k - got), 16), rng)
+            ok = pts[~self._walls.below(pts, clearance)]
+            chunks.append(ok[: k - got])
+            got += len(chunks[-1])
+            if got >= k:
+                return np.concatenate(chunks)
+        log.warning("region %s has almost no room for the agent's body; sampling it plainly", region.to_dict())
+        return np.concatenate(chunks + [region.sample(k - got, rng)])
+
+    def spawn_points(self, region: Region, k: int, rng: np.random.Generator) -> np.ndarray:
+        """Fresh start positions in ``region``: clear of walls by ``spawn_radius`` where the region allows it."""
+        if self.spawn_radius > self.clearance and not self._has_room(region, self.spawn_radius, rng):
+            return self.sample_free(region, k, rng)  # a tight start region: the body still fits, the legs may not
+        return self.sample_free(region, k, rng, self.spawn_radius)
+
+    def _has_room(self, region: Region, clearance: float, rng: np.random.Generator) -> bool:
+        probe = region.sample(256, np.random.default_rng(rng.integers(2**32)))
+        return bool((~self._walls.below(probe, clearance)).mean() > 0.01)
+
+    def _key(self, kind: str, start, legs, n: int, seed, fp: str | None) -> tuple[str, str]:
+        if isinstance(start, StartStates):
+            start_key = {"states": start.digest(), "m": len(start)}
+        else:
+            start_key = _region_key(start)
+        fp = fp or f"id:{id(self.policy)}"
+        legs_key = [[_region_key(g), _region_key(a), None if p is None else [float(v) for v in np.ravel(p)]]
+                    for g, a, p in legs]
+        body = {"v": CACHE_VERSION, "kind": kind, "agent": self.agent, "maze": self._maze_digest,
+                "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
+                "seed": seed if isinstance(seed, int) else repr(seed), "r": self.clearance,
+                "spawn": self.spawn_radius}
+        text = json.dumps(body, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:40], text
+
+    def _cache_path(self, key: str) -> Path | None:
+        if self.cache_dir is None:
+            return None
+        return self.cache_dir / key[:2] / f"{key}.npz"
+
+    def _load(self, key: str, text: str) -> EdgeResult | None:
+        path = self._cache_path(key)
+        if path is None or not path.exists():
+            return None
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if str(z["key"]) != text:
+                    raise ValueError("key mismatch")
+                success = z["success"].astype(bool)
+                n = len(success)
+                end = StartStates(z["end_states"].astype(np.float64), z["end_xy"].astype(np.float64))
+                res = EdgeResult(p=float(success.mean()) if n else 0.0, ci=wilson_ci(int(success.sum()), n), n=n,
+                                 successes=int(success.sum()), success=success, trajectories=z["trajectories"],
+                                 lengths=z["lengths"].astype(np.int64), end_states=end, steps=int(z["steps"]),
+                                 cached=True, outcome=z["outcome"].astype(np.int8))
+                if len(res.lengths) != n or len(res.trajectories) != n or len(end) != res.successes:
+                    raise ValueError("inconsistent arrays")
+                return res
+        except Exception as e:  # corrupt, truncated, foreign: never crash, recompute
+            log.warning("ignoring unreadable cache entry %s: %s: %s", path, type(e).__name__, e)
+            return None
+
+    def _store(self, key: str, text: str, res: EdgeResult) -> None:
+        path = self._cache_path(key)
+        if path is None:
+            return
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, key=np.array(text), success=res.success, trajectories=res.trajectories,
+                                    lengths=res.lengths, end_states=res.end_states.states, end_xy=res.end_states.xy,
+                                    steps=np.array(res.steps), outcome=res.outcome)
+            os.replace(tmp, path)
+        except OSError as e:
+            log.warning("could not write cache entry %s: %s", path, e)
+
+    # --- public API ----------------------------------------------------------------------------
+    MAX_EPISODES = 2048  # evaluate_many simulates at most this many episodes side by side
+
+    def evaluate(self, start: Region | StartStates, goal: Region, avoid: Region, goal_point=None, seed=None,
+                 n: int | None = None) -> EdgeResult:
+        """Success probability of the subtask start -> goal avoiding ``avoid`` (see the module docstring)."""
+        return self.evaluate_many([(start, goal, avoid, goal_point)], seed=seed, n=n)[0]
+
+    def fresh_copy(self, cache_dir=None) -> Evaluator:
+        """The same evaluator (maze, agent, policy, n, horizon, seed) with zero counters and its own cache."""
+        return Evaluator(self.maze, self.agent, self.policy, n=self.n, horizon=self.horizon, seed=self.seed,
+                         cache_dir=cache_dir, nthread=self.nthread)
+
+    def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
+        """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
+
+        The same successes as one ``evaluate`` call each (every subtask is seeded on its own), in far
+        fewer, larger simulator steps; trajectories agree to float tolerance (the policy sees another
+        batch shape).
+        """
+        n = int(n or self.n)
+        seed = self.seed if seed is None else seed
+        fp = self.policy_fingerprint  # hashed once per call (it hashes the weights); None: no disk cache
+        results: list[EdgeResult | None] = [None] * len(subtasks)
+        todo: dict[str, tuple] = {}  # key -> (text, task, positions)
+        for i, (start, goal, avoid, goal_point) in enumerate(subtasks):
+            legs = [(goal, avoid, goal_point)]
+            key, text = self._key("edge", start, legs, n, seed, fp)
+            if key in todo:  # asked twice in one batch: simulated once, the second is a cache hit
+                todo[key][2].append(i)
+            elif (hit := self._lookup(key, text, disk=fp is not None)) is not None:
+                results[i] = hit
+            elif isinstance(start, StartStates) and len(start) == 0:
+                # nothing reached the start: p = 0, nothing run
+                results[i] = unreached(start.states.shape[1] if start.states.ndim == 2 else 0)
+            else:
+                todo[key] = (text, (start, legs, n, seed), [i])
+        batch = max(1, self.MAX_EPISODES // n)
+        pending = list(todo.items())
+        for lo in range(0, len(pending), batch):
+            chunk = pending[lo:lo + batch]
+            for (key, (text, _, positions)), out in zip(chunk, self._rollout_many([t for _, (_, t, _) in chunk])):
+                res = _edge_result(out, n)
+                self.evaluations += 1
+                self._simulated.add(key)
+                self._remember(key, res)
+                if fp is not None:
+                    self._store(key, text, res)
+                results[positions[0]] = res
+                for i in positions[1:]:
+                    self.cache_hits += 1
+                    results[i] = replace(res, cached=True)
+        return results
+
+    def _lookup(self, key: str, text: str, disk: bool) -> EdgeResult | None:
+        hit = self._memo.get(key)
+        if hit is not None:
+            self._memo.move_to_end(key)
+        elif disk and (hit := self._load(key, text)) is not None:
+            self.disk_hits += 1
+            if key not in self._simulated and key not in self._steps_counted:
+                self._steps_counted.add(key)
+                self.cached_steps += hit.steps
+            self._remember(key, replace(hit, cached=False))
+        if hit is None:
+            return None
+        self.cache_hits += 1
+        return replace(hit, cached=True)
+
+    def _remember(self, key: str, res: EdgeResult) -> None:
+        for a in (res.success, res.trajectories, res.lengths, res.outcome, res.end_states.states, res.end_states.xy):
+            a.flags.writeable = False  # shared with the cache: read-only
+        self._memo[key] = res
+        while len(self._memo) > self.MEMO_SIZE:
+            self._memo.popitem(last=False)
+
+    def evaluate_edge(self, graph, u: str, v: str, start: Region | StartStates | None = None, seed=None,
+                      n: int | None = None) -> EdgeResult:
+        """``evaluate`` on the graph edge u -> v (start defaults to I(u); goal point = v's point, if any)."""
+        return self.evaluate(graph.region(u) if start is None else start, graph.region(v), graph.avoid(u, v),
+                             goal_point=graph.goal_point(v), seed=seed, n=n)
+
+    def run_compositional(self, start: Region | StartStates, legs, n: int | None = None, seed=None
+                          ) -> CompositionalResult:
+        """Run the compositional policy: legs ``[(goal, avoid, goal_point | None), ...]`` end to end.
+
+        Each episode starts in ``start`` and pursues leg 0's goal point; on reaching a leg's goal region it
+        switches to the next leg (fresh ``horizon`` steps per leg).  It fails on entering the current leg's
+        avoid set, flipping, or running out of a leg's horizon.
+        """
+        n = int(n or self.n)
+        seed = self.seed if seed is None else seed
+        legs = [tuple(leg) if len(leg) == 3 else (leg[0], leg[1], None) for leg in legs]
+        if not legs:
+            raise SpecrefineError("run_compositional needs at least one leg")
+        out = self._rollout(start, legs, n, seed)
+        success = out["legs_done"] == len(legs)
+        k = int(success.sum())
+        return CompositionalResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                                   legs_done=out["legs_done"], trajectories=out["trajectories"], lengths=out["lengths"],
+                                   steps=out["steps"], outcome=out["outcome"], n_legs=len(legs))
+
+    run_path = run_compositional  # the former name (notebooks written against it)
+
+    def run_graph_path(self, graph, path: list[str], n: int | None = None, seed=None) -> CompositionalResult:
+        """``run_compositional`` along a vertex path of a task graph, from I(path[0])."""
+        return self.run_compositional(graph.region(path[0]), path_legs(graph, path), n=n, seed=seed)
+
+    # --- the hot loop --------------------------------------------------------------------------
+    def _rollout(self, start, legs, n: int, seed) -> dict:
+        return self._rollout_many([(start, legs, n, seed)])[0]
+
+    def _rollout_many(self, tasks: list[tuple]) -> list[dict]:
+        """Run several ``(start, legs, n, seed)`` tasks side by side in one batch; one result dict per task."""
+        # small-batch inference is fastest on one torch thread; more threads only contend with MuJoCo's
+        with _torch_threads(1):
+            return self._rollout_batches(tasks)
+
+    def _start_rows(self, sim, rows: np.ndarray, start, n: int, rng: np.random.Generator) -> None:
+        if isinstance(start, StartStates):
+            if len(start) == 0:
+                raise SpecrefineError("empty start distribution (no successful rollouts to start from)")
+            sim.reset(states=start.states[rng.integers(len(start), size=n)], idx=rows)
+        else:
+            sim.reset(xy=self.spawn_points(start, n, rng), rng=rng, idx=rows)
+
+    def _rollout_batches(self, tasks: list[tuple]) -> list[dict]:
+        """Run every task's n episodes through its legs; the core loop behind ``evaluate`` and ``run_compositional``.
+
+        Episodes of all tasks live in rows of one BatchedSim (each task seeded on its own, so a task's
+        start states and goal points do not depend on its neighbours).  When at most half of the rows
+        are still running, the running ones are moved (full physics states, bit-exact) into a smaller
+        BatchedSim (a power of two, at least ``MIN_BATCH``), so finished rollouts stop costing physics.
+        """
+        counts = np.array([n for _, _, n, _ in tasks])
+        first = np.concatenate([[0], np.cumsum(counts)])
+        N, n_legs = int(first[-1]), np.array([len(legs) for _, legs, _, _ in tasks])
+        L = int(n_legs.max())
+        task_of = np.repeat(np.arange(len(tasks)), counts)
+        L_of = n_legs[task_of]
+        sim = self.sim(-(-N // self.MIN_BATCH) * self.MIN_BATCH)
+        goal_pts = np.zeros((L, N, 2))
+        goal_id = np.zeros((len(tasks), L), dtype=np.int64)  # (task, leg) -> index into goals / avoids
+        avoid_id = np.zeros((len(tasks), L), dtype=np.int64)
+        goals, avoids = [], []
+        for j, (start, legs, n, seed) in enumerate(tasks):
+            rng = np.random.default_rng(seed)
+            rows = np.arange(first[j], first[j + 1])
+            self._start_rows(sim, rows, start, n, rng)
+            for k, (goal, avoid, point) in enumerate(legs):
+                goal_pts[k, rows] = np.broadcast_to(np.asarray(point, dtype=float).reshape(2), (n, 2)) \
+                    if point is not None else self.sample_free(goal, n, rng)
+                goal_id[j, k] = _index_of(goals, self.compiled(goal))
+                avoid_id[j, k] = _index_of(avoids, self.compiled(avoid))
+        if sim.n > N:  # padding rows: copies of row 0, never checked
+            sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
+        H, r = self.horizon, self.clearance
+        T = L * H + 1
+        traj = np.empty((N, T, 2), dtype=np.float32)
+        leg = np.zeros(N, dtype=np.int64)
+        t_leg = np.zeros(N, dtype=np.int64)
+        active = np.ones(N, dtype=bool)
+        lengths = np.full(N, T, dtype=np.int64)
+        outcome = np.full(N, UNFINISHED, dtype=np.int8)
+        end_states = np.zeros((N, sim.state_dim))
+        end_xy = np.zeros((N, 2))
+        episode = np.concatenate([np.arange(N), np.full(sim.n - N, -1)])  # episode held by each sim row (-1: padding)
+        row = np.arange(N)  # sim row of each episode (-1: not in the sim any more)
+        xy, flipped = sim.xy[:N], sim.flipped[:N]
+        traj[:, 0] = xy
+        steps = np.zeros(len(tasks), dtype=np.int64)  # rows held by each task's episodes, per step
+        padding_steps = 0
+
+        def classify(sel, ids, regions, test):
+            """test(region, points) for the episodes ``sel``, grouped by the region each one is in."""
+            out = np.zeros(len(sel), dtype=bool)
+            for i in np.unique(ids):
+                m = ids == i
+                out[m] = test(regions[i], xy[sel[m]])
+            return out
+
+        def check(t: int) -> None:
+            """Classify the running episodes at time t (after the step that led there)."""
+            idx = np.flatnonzero(active)
+            for _ in range(L + 1):  # a point may lie in several consecutive goals: advance through all of them
+                if not len(idx):
+                    break
+                task, k = task_of[idx], leg[idx]
+                bad = classify(idx, avoid_id[task, k], avoids, lambda a, p: a.below(p, r)) | flipped[idx]
+                reached = ~bad & classify(idx, goal_id[task, k], goals, lambda g, p: g.contains(p))
+                if bad.any():
+                    b = idx[bad]
+                    outcome[b] = np.where(flipped[b], FLIPPED, AVOID)
+                    active[b] = False
+                    lengths[b] = t + 1
+                g = idx[reached]
+                leg[g] += 1
+                t_leg[g] = 0
+                done = g[leg[g] == L_of[g]]
+                if len(done):
+                    outcome[done] = SUCCESS
+                    active[done] = False
+                    lengths[done] = t + 1
+                    end_states[done] = sim.get_state()[row[done]]
+                    end_xy[done] = xy[done]
+                idx = g[leg[g] < L_of[g]]
+
+        check(0)
+        import torch
+
+        with torch.inference_mode():
+            for t in range(1, T):
+                running = int(active.sum())
+                if not running:
+                    break
+                size = max(self.MIN_BATCH, 1 << (running - 1).bit_length())
+                if size <= sim.n // 2:  # compact: move the running episodes into a smaller batch
+                    ids = np.flatnonzero(active)
+                    states = sim.get_state()[row[ids]]
+                    states = np.concatenate([states, np.repeat(states[:1], size - len(ids), axis=0)])
+                    sim = self.sim(size)
+                    sim.reset(states=states)
+                    episode = np.concatenate([ids, np.full(size - len(ids), -1)])
+                    row[:] = -1
+                    row[ids] = np.arange(len(ids))
+                live = episode >= 0
+                ep = np.where(live, episode, episode[0])
+                obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep], self.observation_frame)
+                act = np.asarray(self._act(obs), dtype=np.float64)
+                if not np.isfinite(act).all():  # MuJoCo would warn per step and write MUJOCO_LOG.TXT into the cwd
+                    raise PolicyError("the policy acts with NaN or infinite values on these observations: "
+                                      "retrain it or restore its checkpoint")
+                act[~(live & active[ep])] = 0.0  # finished rollouts stay still
+                sim.step(act)
+                steps += np.bincount(task_of[episode[live]], minlength=len(tasks))
+                padding_steps += int((~live).sum())
+                xy[episode[live]] = sim.xy[live]
+                flipped[episode[live]] = sim.flipped[live]
+                traj[:, t] = xy
+                t_leg[active] += 1
+                check(t)
+                late = active & (t_leg >= H)
+                if late.any():
+                    outcome[late] = TIMEOUT
+                    active[late] = False
+                    lengths[late] = t + 1
+        self.sim_steps += int(steps.sum()) + padding_steps
+        if len(tasks) == 1:
+            steps[0] += padding_steps
+        return [self._task_output(slice(first[j], first[j + 1]), traj, lengths, leg, outcome, end_states, end_xy,
+                                  int(steps[j])) for j in range(len(tasks))]
+
+    @staticmethod
+    def _task_output(rows: slice, traj, lengths, leg, outcome, end_states, end_xy, steps: int) -> dict:
+        lengths = lengths[rows]
+        n = len(lengths)
+        used = int(lengths.max(initial=1))
+        pad = np.minimum(np.arange(used)[None, :], lengths[:, None] - 1)
+        return {"legs_done": leg[rows], "trajectories": traj[rows][np.arange(n)[:, None], pad], "lengths": lengths,
+                "outcome": outcome[rows], "end_states": end_states[rows], "end_xy": end_xy[rows], "steps": steps}
+
+
+def _edge_result(out: dict, n: int) -> EdgeResult:
+    success = out["legs_done"] == 1
+    k = int(success.sum())
+    return EdgeResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,
+                      trajectories=out["trajectories"], lengths=out["lengths"],
+                      end_states=StartStates(out["end_states"][success], out["end_xy"][success]),
+                      steps=out["steps"], outcome=out["outcome"])
+
+
+def _index_of(items: list, item) -> int:
+    """Position of ``item`` (by identity) in ``items``, appending it if new."""
+    for i, x in enumerate(items):
+        if x is item:
+            return i
+    items.append(item)
+    return len(items) - 1
+
+
+def path_legs(graph, path: list[str]) -> list[tuple[Region, Region, np.ndarray | None]]:
+    """Legs ``(I(v), O(u, v), point(v))`` for consecutive vertices of a path in a task graph."""
+    return [(graph.region(v), graph.avoid(u, v), graph.goal_point(v)) for u, v in zip(path, path[1:], strict=False)]
+
+
+@contextmanager
+def _torch_threads(k: int):
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(k)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
+
+

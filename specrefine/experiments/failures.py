@@ -1,0 +1,132 @@
+"""Where a refined path loses its episodes: per leg, how many fail and how, with and without the inner walls.
+
+A long chain of subtasks fails when any leg fails, so an end-to-end rate below the goal says little by
+itself.  This re-runs a finished run's selected path (its ``result.json``) on fresh episodes and counts,
+for every leg, the episodes that ended there (flipped, touched the avoid set, ran out of time), with the
+turn the agent makes where the leg starts.  Run again on the same maze with every inner wall removed
+(same coordinates, outer wall kept), the comparison separates failures the walls cause (a leg caught
+on a corner) from failures of the policy on open floor (a flip in a sharp turn)::
+
+    python -m specrefine.experiments.failures runs/X/result.json --episodes 300 --seed 77 --out failures.json
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import Counter
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import SpecrefineError
+from ..core.results import OUTCOMES
+
+
+def open_floor(maze):
+    """The maze with every wall cell off the border made free (same grid, same coordinates)."""
+    last_r, last_c = maze.rows - 1, maze.cols - 1
+    grid = tuple("".join("." if ch == "#" and 0 < r < last_r and 0 < c < last_c else ch for c, ch in enumerate(row))
+                 for r, row in enumerate(maze.grid))
+    return replace(maze, name=f"{maze.name}_open", grid=grid)
+
+
+def turn_angles(points) -> list[float | None]:
+    """Degrees the path turns where each leg starts (None for the first leg)."""
+    p = np.asarray(points, dtype=float)
+    out: list[float | None] = [None]
+    for k in range(1, len(p) - 1):
+        a, b = p[k] - p[k - 1], p[k + 1] - p[k]
+        out.append(float(np.degrees(np.arctan2(abs(a[0] * b[1] - a[1] * b[0]), a @ b))))
+    return out
+
+
+def leg_table(run, n_legs: int) -> list[dict]:
+    """Per leg: episodes that started it and how the ones that ended on it ended (CompositionalResult)."""
+    rows = []
+    for k in range(n_legs):
+        started = int((run.legs_done >= k).sum())
+        ended = Counter(OUTCOMES[o] for o in run.outcome[(run.legs_done == k) & ~run.success].tolist())
+        rows.append({"leg": k, "started": started, **{o: ended.get(o, 0) for o in ("flipped", "avoid", "timeout")}})
+    return rows
+
+
+def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> dict:
+    """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures."""
+    from ..core.graph import TaskGraph
+    from ..evaluation.evaluator import Evaluator, path_legs
+    from ..runs.experiment import setup
+
+    if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
+        raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
+    agent = result["agent"]
+    exp = setup(result["maze"], agent=agent, seed=seed, policy=policy)
+    try:
+        graph = TaskGraph.from_dict(result["graph"])
+        path, legs = result["path"], path_legs(graph, result["path"])
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
+    start = graph.region(path[0])
+    centres = [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
+    turns = turn_angles(centres)
+    lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
+    out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
+           "legs": [{"leg": k, "from": path[k], "to": path[k + 1], "turn_deg": turns[k], "length_m": lengths[k]}
+                    for k in range(len(legs))]}
+    bare = open_floor(exp.maze)
+    variants = {"walls": (exp.evaluator, legs),
+                "no_inner_walls": (Evaluator(bare, agent, exp.policy, n=exp.evaluator.n, seed=seed),
+                                   [(goal, bare.walls, point) for goal, _avoid, point in legs])}
+    for name, (evaluator, variant_legs) in variants.items():
+        run = evaluator.run_compositional(start, variant_legs, n=episodes, seed=seed)
+        counts = Counter(OUTCOMES[o] for o in run.outcome.tolist())
+        out[name] = {"success": run.successes, "rate": run.p, "ci": list(run.ci), "outcomes": dict(counts),
+                     "per_leg": leg_table(run, len(legs))}
+    return out
+
+
+def summary(report: dict) -> str:
+    lines = [f"{report['maze']} ({report['agent']}, {report['episodes']} episodes, seed {report['seed']}):"]
+    for name in ("walls", "no_inner_walls"):
+        r = report[name]
+        lo, hi = r["ci"]
+        lines.append(f"  {name:15s} success {r['rate']:.3f} [{lo:.3f}, {hi:.3f}]  outcomes {r['outcomes']}")
+    lines.append("  leg  turn  length  failures with walls / without (flipped+avoid+timeout)")
+    for leg, a, b in zip(report["legs"], report["walls"]["per_leg"], report["no_inner_walls"]["per_leg"]):
+        fa, fb = (a["flipped"] + a["avoid"] + a["timeout"]), (b["flipped"] + b["avoid"] + b["timeout"])
+        turn = "   -" if leg["turn_deg"] is None else f"{leg['turn_deg']:4.0f}"
+        lines.append(f"  {leg['leg']:3d}  {turn}  {leg['length_m']:5.1f}   {fa:3d} ({a['flipped']}+{a['avoid']}+"
+                     f"{a['timeout']}) / {fb:3d} ({b['flipped']}+{b['avoid']}+{b['timeout']})")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    from ..core.argtypes import OneLineParser, bounded_int, out_path
+    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+
+    p = OneLineParser(prog="python -m specrefine.experiments.failures", description=__doc__.split("\n\n")[0])
+    p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
+    p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
+    p.add_argument("--seed", type=bounded_int("seed"), default=77,
+                   help="seed of the fresh episodes (not the run's own)")
+    p.add_argument("--policy", default="shipped", help="'shipped' or a policy checkpoint")
+    p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
+    args = p.parse_args(argv)
+    try:
+        if args.out is not None:
+            writable_parent(args.out)  # before the re-run, not after it
+        result = read_result(args.result)
+        maze = recorded_maze(args.result, result["maze"])
+        report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy)
+        if args.out is not None:
+            write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+    except SpecrefineError as e:
+        print(f"{p.prog}: error: {e}", file=sys.stderr)
+        return 2
+    print(summary(report))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,210 @@
+"""The paper's Figures 4-6 from a sweep table (``specrefine.runs.sweep``'s results.csv).
+
+Each figure shows mean and population standard deviation over seeds (``np.std``, as in
+the paper) and names the proposer on every panel: results from the offline proposers
+are labelled as such and never as a VLM's.
+"""
+
+from __future__ import annotations
+
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..core.runfolder import save_figure, write_atomic  # noqa: E402
+from ..pictures.render import PngFigure  # noqa: E402
+from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS  # noqa: E402  (colours: each method's registry entry)
+from ..runs.sweep import summarise  # noqa: E402
+
+METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
+CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
+EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
+_UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")
+
+
+def proposer_label(proposer: str, rows=()) -> str:
+    vlm = any(r.get("proposer") == proposer and r.get("proposer_is_vlm") for r in rows)
+    if proposer in ("geometric", "random"):
+        return f"proposer: {proposer} (offline, not a VLM)"
+    if proposer == "imperfect" or proposer.startswith("imperfect:"):
+        return f"proposer: {proposer} (offline error model, not a VLM)"
+    return f"proposer: {proposer}" + (" (VLM)" if vlm else "")
+
+
+def _proposers(rows) -> list[str]:
+    return sorted({r["proposer"] for r in rows if r.get("status") == "ok" and r["proposer"] != "none"})
+
+
+def _select(summary, maze, method, proposer):
+    prop = proposer if method in PROPOSER_METHODS else "none"
+    return next((s for s in summary if s["maze"] == maze and s["method"] == method and s["proposer"] == prop), None)
+
+
+def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    """Success (or graph size, metric='vertices') per task per method, one panel per proposer.
+
+    ``proposers``: the panels (default: every proposer in ``rows``). ``legend_outside``: the legend right of
+    the panels (for many methods or long panel titles, which the legend above the first panel would cover).
+    """
+    summary = summarise(rows)
+    tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
+    proposers = proposers or _proposers(rows) or ["none"]
+    fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
+                             squeeze=False, FigureClass=PngFigure)
+    width = 0.8 / len(methods)
+    for ax, proposer in zip(axes[:, 0], proposers):
+        for i, method in enumerate(methods):
+            stats = [_select(summary, t, method, proposer) for t in tasks]
+            mean = [s[f"{metric}_mean"] if s else np.nan for s in stats]
+            std = [s[f"{metric}_std"] if s else 0 for s in stats]
+            x = np.arange(len(tasks)) + (i - (len(methods) - 1) / 2) * width
+            ax.bar(x, mean, width, yerr=std, capsize=2, label=method, color=METHOD_COLOURS[method])
+        ax.set_xticks(np.arange(len(tasks)), tasks, rotation=15)
+        ax.set_ylabel("success rate" if metric == "success" else "task-graph vertices")
+        if metric == "success":
+            ax.set_ylim(0, 1.05)
+        ax.set_title(proposer_label(proposer, rows), fontsize=10)
+        ax.grid(axis="y", alpha=0.3)
+    if legend_outside:
+        axes[0, 0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    else:  # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
+        axes[0, 0].legend(ncol=len(methods), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
+                          frameon=False, borderaxespad=0.2)
+    fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
+                 if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
+                 fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def figure6(rows, tasks=None, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    return figure4(rows, tasks, metric="vertices", methods=methods, proposers=proposers,
+                   legend_outside=legend_outside)
+
+
+def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
+    """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer.
+
+    ``legend_outside``: one legend right of the last panel instead of one in each (for many methods).
+    """
+    summary = summarise(rows)
+    proposers = proposers or _proposers(rows) or ["none"]
+    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
+                             FigureClass=PngFigure)
+    for ax, proposer in zip(axes[0], proposers):
+        for method in methods:
+            for subgoals, style in ((False, "-"), (True, "--")):
+                prop = proposer if method in PROPOSER_METHODS else "none"
+                pts = _rooms(summary, method, prop, subgoals)
+                if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
+                    pts += [p for p in _rooms(summary, method, prop, False) if p[0] == 1]
+                if not pts:
+                    continue
+                pts.sort()
+                r, mu, sd = map(np.array, zip(*pts))
+                ax.errorbar(r, mu, yerr=sd, ls=style, marker="o", capsize=3, color=METHOD_COLOURS[method],
+                            label=f"{method} ({'with' if subgoals else 'no'} subgoals)")
+        ax.set_xlabel("rooms")
+        ax.set_ylabel("success rate")
+        ax.set_ylim(0, 1.05)
+        ax.set_xticks(range(1, 6))
+        ax.grid(alpha=0.3)
+        ax.set_title(proposer_label(proposer, rows), fontsize=10)
+        if not legend_outside:
+            ax.legend(fontsize=7)
+    if legend_outside:  # gathered from every panel: a proposer's panel may have no runs yet
+        handles = {label: h for ax in axes[0] for h, label in zip(*ax.get_legend_handles_labels())}
+        if handles:
+            axes[0, -1].legend(handles.values(), handles.keys(), fontsize=7, loc="upper left",
+                               bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.suptitle("Figure 5: U-chain of 1-5 rooms (mean ± std over seeds)")
+    fig.tight_layout()
+    return fig
+
+
+def _rooms(summary, method, proposer, subgoals):
+    out = []
+    for s in summary:
+        m = _UCHAIN.match(s["maze"])
+        if m and bool(m.group(2)) == subgoals and s["method"] == method and s["proposer"] == proposer:
+            out.append((int(m.group(1)), s["success_mean"], s["success_std"]))
+    return out
+
+
+def markdown_table(rows, by=("maze", "method", "proposer")) -> str:
+    """Mean ± population std of success (and graph size) over seeds, as a markdown table."""
+    lines = ["| maze | method | proposer | runs | success (mean ± std) | graph vertices |", "|---|---|---|---|---|---|"]
+    for s in summarise(rows, by):
+        lines.append(f"| {s['maze']} | {s['method']} | {s['proposer']} | {s['runs']} | "
+                     f"{s['success_mean']:.3f} ± {s['success_std']:.3f} | {s['vertices_mean']:.1f} |")
+    return "\n".join(lines)
+
+
+def calibration_figure(tables: dict):
+    """Measured success against the calibrated prediction, one marker per run, with both intervals.
+
+    ``tables``: label -> rows with ``success_rate``, ``success_ci_low/high`` (optional) and
+    ``predicted_success``, ``predicted_ci_low/high`` (e.g. ``python -m specrefine.runs.calibrate``'s table).
+    A run is covered when its measured rate lies inside ``predicted_ci``; the legend gives the count per table.
+    """
+    from ..runs.calibrate import coverage
+
+    fig, ax = plt.subplots(figsize=(6.4, 6.0), FigureClass=PngFigure)
+    for (label, rows), marker in zip(tables.items(), "osD^v<>"):
+        rows = [r for r in rows if r.get("predicted_ci_low") not in (None, "")]
+        if not rows:
+            continue
+        pred = np.array([float(r["predicted_success"]) for r in rows])
+        meas = np.array([float(r["success_rate"]) for r in rows])
+        lo, hi = (np.array([float(r[k]) for r in rows]) for k in ("predicted_ci_low", "predicted_ci_high"))
+        inside, total = coverage(rows)
+        ax.vlines(pred, lo, hi, color="0.75", lw=0.8, zorder=1)
+        covered = (lo <= meas) & (meas <= hi)
+        ax.scatter(pred[covered], meas[covered], marker=marker, s=14, label=f"{label}: {inside}/{total} covered",
+                   zorder=2)
+        ax.scatter(pred[~covered], meas[~covered], marker=marker, s=22, facecolors="none", edgecolors="#c62828",
+                   zorder=3)
+    ax.plot([0, 1], [0, 1], color="0.4", lw=0.8, ls="--")
+    ax.set_xlim(-0.02, 1.02)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("predicted success (held-out posterior mean); grey: 95 % predictive interval")
+    ax.set_ylabel("measured success (fresh episodes)")
+    ax.set_title("Calibration: measured success vs the prediction (red rings: outside predicted_ci)", fontsize=10)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
+def main(argv=None) -> int:
+    from pathlib import Path
+
+    from ..core.argtypes import OneLineParser, out_path
+    from ..core.errors import SpecrefineError
+    from ..core.runfolder import ensure_dir
+    from ..runs.sweep import read_checked_table
+
+    p = OneLineParser(prog="python -m specrefine.experiments.figures", description="Figures 4-6 from a sweep table")
+    p.add_argument("table", help="results.csv written by specrefine.runs.sweep")
+    p.add_argument("--out", type=out_path, default=None,
+                   help="folder for figure4/5/6.png and summary.md (default: the table's)")
+    args = p.parse_args(argv)
+    try:
+        rows = read_checked_table(args.table)
+        out = ensure_dir(args.out or Path(args.table).parent)
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
+    for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
+        fig = make(rows)
+        save_figure(fig, out / f"{name}.png", dpi=110)
+        plt.close(fig)
+    write_atomic(out / "summary.md", markdown_table(rows) + "\n")
+    print(f"{len(rows)} rows -> {out}/figure4.png, figure5.png, figure6.png, summary.md")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,172 @@
+"""One refinement run's configuration: :class:`RunConfig`, with the paper's defaults written once.
+
+Every field is documented, and the documentation is the command line: :func:`add_run_options` turns the fields
+into ``specrefine refine``'s options (flags, defaults, help, bounds), as ``train.Config`` does for training,
+and ``python -m specrefine.runs.sweep`` takes its ``-w/-d/-k`` grid axes from the same fields.  ``result.json``
+records the configuration a run ran with under ``"config"``.
+
+    from specrefine.runs.config import RunConfig
+    from specrefine.runs.pipeline import refine_maze
+    refine_maze("u_maze", RunConfig(method="symbolic", k=10), out="runs/k10")
+
+Library defaults elsewhere (``setup``'s rollouts, ``SearchConfig``'s w, d and k, a sweep cell's rollouts and
+episodes, ...) read :data:`DEFAULTS`.  At import time this module reads only :mod:`specrefine.core.argtypes` (the
+registries behind the choices and help are read when a parser is built), so any layer may import it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
+
+from ..core.argtypes import bounded_int
+from ..core.paper import PAPER
+
+
+def option(default, help, *, flags: tuple[str, ...] = (), type: Callable | None = None,
+           choices: Callable[[], Iterable[str]] | None = None, shown: str | None = None, metavar: str | None = None):
+    """A documented field: ``help`` (a string, or a function returning one when the parser is built), the command
+    line's ``flags`` (default ``--field-name``), its argparse ``type``, ``choices`` (a function: read when the parser
+    is built, so a registry's later entries are in it) and how the default is ``shown`` in the help."""
+    meta = dict(help=help, flags=flags, type=type, choices=choices, shown=shown, metavar=metavar)
+    return field(default=default, metadata=meta)
+
+
+def _agents() -> list[str]:
+    from ..core.agents import AGENTS
+
+    return list(AGENTS)
+
+
+def _methods() -> list[str]:
+    from .methods import METHODS
+
+    return list(METHODS)
+
+
+def _methods_help() -> str:
+    from .methods import METHODS
+
+    return "; ".join(f"{name}: {m.description}" for name, m in METHODS.items())
+
+
+def _proposers_help() -> str:
+    from ..proposers.factory import PROPOSERS
+
+    return "who proposes edge splits: " + ", ".join(f"{p.usage} ({p.description})" for p in PROPOSERS.values())
+
+
+def _evaluations() -> list[str]:
+    from ..refine.search import EVALUATIONS
+
+    return list(EVALUATIONS)
+
+
+def policy_arg(text: str) -> str:
+    """'shipped' and 'scripted' as they are; a checkpoint path as ``str(Path(text))`` (the form run.json records)."""
+    return text if text in ("shipped", "scripted") else str(Path(text))
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """Every argument of one refinement run (the maze and the output folder aside); defaults are the paper's."""
+
+    agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
+    method: str = option("ours", _methods_help, choices=_methods)
+    proposer: str = option("geometric", _proposers_help)
+    spec: str | None = option(None, "the task as an expression over the maze's letters: a..z its subgoal regions, G "
+                                    "the goal, S implicit; '->' sequence, '|' choice (binds tighter), parentheses; "
+                                    "must end in G; e.g. '(a | b) -> c -> G'", metavar="EXPR",
+                              shown="the maze's '; spec:' line, else its chain a -> b -> ... -> G")
+    seed: int = option(0, "random seed for rollouts and proposers", type=bounded_int("seed"))
+    rollouts: int = option(PAPER.rollouts, "rollouts per subtask evaluation", type=bounded_int("rollouts"))
+    episodes: int = option(PAPER.episodes, "fresh end-to-end episodes to measure the final policy on the original task",
+                           type=bounded_int("episodes"))
+    policy: str = option("shipped", "policy checkpoint: a path, 'shipped' (data/policies/AGENT.pt) or 'scripted' "
+                                    "(the point mass's straight-line controller)", type=policy_arg,
+                         shown="the shipped data/policies/AGENT.pt")
+    w: int = option(PAPER.w, "candidate edge splits per VLM query (at most 20)", flags=("-w",),
+                    type=bounded_int("w"))
+    d: int = option(PAPER.d, "VLM query rounds per edge split (at most 10)", flags=("-d",), type=bounded_int("d"))
+    k: int = option(PAPER.k, "subsets sampled per vertex refinement (at most 100)", flags=("-k",),
+                    type=bounded_int("k"))
+    evaluation: str | None = option(None, "fixed: every subtask estimate on --rollouts rollouts (the paper); "
+                                          "adaptive: the vertex refinement's candidates in stages, stopping those "
+                                          "that cannot be chosen (same full budget for what is chosen; far fewer "
+                                          "simulator steps)", choices=_evaluations,
+                                    shown="the agent's: fixed for point, adaptive for ant")
+
+    def resolved(self) -> RunConfig:
+        """This configuration with ``evaluation`` filled in: None becomes the agent's ``default_evaluation``."""
+        from ..core.agents import get_agent
+
+        return replace(self, evaluation=self.evaluation or get_agent(self.agent).default_evaluation)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_namespace(cls, args: argparse.Namespace) -> RunConfig:
+        """The configuration of parsed options (those :func:`add_run_options` added)."""
+        return cls(**{f.name: getattr(args, f.name) for f in fields(cls) if hasattr(args, f.name)})
+
+
+DEFAULTS = RunConfig()  # the paper's settings: read them here rather than writing the numbers again
+
+
+def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[str, Callable] | None = None,
+                    many: Iterable[str] = (), suffix: str = "") -> None:
+    """One option per :class:`RunConfig` field (or per field in ``names``), with its flags, default, help and bounds.
+
+    ``types``: argparse types that replace a field's own (the CLI checks proposer strings itself); ``many``: fields
+    that take several values (``nargs="+"``, default a one-element list: a sweep's grid axes); ``suffix``: appended
+    to every help text.
+    """
+    types, many = types or {}, set(many)
+    chosen = {f.name: f for f in fields(RunConfig)}
+    for name in names if names is not None else chosen:
+        f = chosen[name]
+        meta = f.metadata
+        text = meta["help"]() if callable(meta["help"]) else meta["help"]
+        shown = meta["shown"] if meta["shown"] is not None else f.default
+        kwargs = dict(default=[f.default] if name in many else f.default, help=f"{text}{suffix} (default: {shown})")
+        if name in many:
+            kwargs["nargs"] = "+"
+        argtype = types.get(name, meta["type"])
+        if argtype is not None:
+            kwargs["type"] = argtype
+        if meta["choices"] is not None:
+            kwargs["choices"] = list(meta["choices"]())
+        if meta["metavar"] is not None:
+            kwargs["metavar"] = meta["metavar"]
+        parser.add_argument(*(meta["flags"] or ("--" + name.replace("_", "-"),)), dest=name, **kwargs)
+
+
+# --- argument checks that need the registries (argtypes holds those that need nothing) -----------------
+def proposer_arg(text: str) -> str:
+    """An argparse type: any proposer the library accepts (its one parser, ``proposers.factory.parse_proposer``)."""
+    from ..core.errors import SpecrefineError
+    from ..proposers.factory import parse_proposer
+
+    try:
+        parse_proposer(text)
+    except SpecrefineError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def maze_problem(mazes) -> str | None:
+    """The first maze argument (a name, a file, or ``MAZE=SPEC``) that does not load, as one line (None: all do)."""
+    from ..core.errors import SpecrefineError
+    from ..core.mazes import load_maze
+    from ..core.spec import maze_task
+
+    for arg in mazes:
+        maze, _, spec = str(arg).partition("=")
+        try:
+            maze_task(load_maze(maze), spec.strip() or None)
+        except SpecrefineError as exc:
+            return str(exc)
+    return None

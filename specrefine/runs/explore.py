@@ -1,0 +1,81 @@
+"""Look back at a recorded search: the graph at any step, a picture per step, a slider.
+
+A search's step log (``steps.jsonl`` next to ``result.json``, or ``SearchResult.steps``)
+records every expansion, evaluation, generated and accepted refinement; accepted ones
+carry a snapshot of the graph, so any step can be redrawn without rerunning anything.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..core.graph import TaskGraph
+
+EVENT_TEXT = {
+    "expand": "close {vertex} (cost {cost:.2f})",
+    "evaluate": "evaluate {edge[0]} -> {edge[1]}: p = {p:.2f}",
+    "split-generated": "edge split proposed for {edge[0]} -> {edge[1]} ({n_candidates} candidates)",
+    "vertex-generated": "vertex subset for {vertex}: p {p_current:.2f} -> {p_best:.2f}",
+    "refine-accept": "ACCEPT {kind} on {edge[0]} -> {edge[1]} (cost {cost:.2f} < {c_progress:.2f} - tau {tau:.2f})",
+    "refine-declined": "decline {kind} on {edge[0]} -> {edge[1]} (cost {cost:.2f} vs {c_progress:.2f} - tau {tau:.2f})",
+    "done": "done: path {path}, predicted success {predicted_success:.2f}",
+}
+
+
+def load_steps(path) -> list[dict]:
+    return [json.loads(line) for line in Path(path).read_text().splitlines() if line.strip()]
+
+
+def graph_at(steps: list[dict], input_graph: TaskGraph, i: int) -> TaskGraph:
+    """The task graph as it was after step ``i``."""
+    for step in reversed(steps[: i + 1]):
+        if step.get("event") == "refine-accept" and "graph" in step:
+            return TaskGraph.from_dict(step["graph"])
+    return input_graph
+
+
+def describe(step: dict) -> str:
+    detail = dict(step)
+    if "candidates" in detail:
+        detail["n_candidates"] = len(detail["candidates"])
+    try:
+        return f"step {step['step']}: " + EVENT_TEXT[step["event"]].format(**detail)
+    except (KeyError, IndexError, TypeError, ValueError):
+        return f"step {step.get('step')}: {step.get('event')}"
+
+
+def draw_step(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: int = 640):
+    from ..pictures.render import render_task
+
+    step = steps[i]
+    graph = graph_at(steps, input_graph, i)
+    edge = step.get("edge")
+    highlight = [edge[0], edge[1]] if edge and all(v in graph for v in edge) else step.get("path")
+    fig = render_task(maze, graph, path=highlight, title=describe(step), size_px=size_px, legend=False)
+    fig.axes[0].text(0.01, 0.01, f"open {step.get('open', [])}   closed {step.get('closed', [])}",
+                     transform=fig.axes[0].transAxes, fontsize=8, va="bottom",
+                     bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "none"})
+    return fig
+
+
+def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int = 640):
+    """An ipywidgets slider that redraws the search at each recorded step."""
+    import ipywidgets as widgets
+    import matplotlib.pyplot as plt
+    from IPython.display import display
+
+    out = widgets.Output()
+    slider = widgets.IntSlider(value=len(steps) - 1, min=0, max=len(steps) - 1, description="step",
+                               continuous_update=False, layout=widgets.Layout(width="90%"))
+
+    def show(change=None):
+        with out:
+            out.clear_output(wait=True)
+            fig = draw_step(maze, steps, input_graph, slider.value, size_px)
+            display(fig)
+            plt.close(fig)
+
+    slider.observe(show, names="value")
+    show()
+    return widgets.VBox([slider, out])

@@ -1,0 +1,188 @@
+"""Every refinement method in one registry: its search, whether it asks a proposer, what it is, its colour.
+
+:data:`METHODS` maps a method's name to its :class:`Method`; ``specrefine refine --method``, the sweep's
+``--methods``, the pipeline's dispatch (:func:`run_search`) and the figures' colours all read it.  A new method is
+its module (a function ``search(job: SearchJob) -> SearchResult``) and one :func:`register_method` call; a
+variant of ours is one entry with :func:`ours_variant` (what it changes in ``SearchConfig``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from ..core.agents import get_agent
+from ..core.errors import SpecrefineError
+from .queries import candidate_picture, edge_query_builder
+
+if TYPE_CHECKING:  # an annotation only: runconfig reads the registry for its choices
+    from .config import RunConfig
+
+KNOBS = ("w", "d", "k")  # the search settings of RunConfig a method may read
+
+
+@dataclass(frozen=True)
+class SearchJob:
+    """What a method's search gets: the run's configuration and the task it refines."""
+
+    config: RunConfig  # resolved: evaluation is "fixed" or "adaptive"
+    graph: object  # the original task graph (TaskGraph)
+    evaluator: object  # SubtaskEvaluator
+    proposer: object | None  # a Proposer, for methods that ask one
+    maze: object  # the Maze at the agent's scale
+    on_step: Callable[[dict], None] | None = None  # each search step, as it happens (steps.jsonl)
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    search: Callable[[SearchJob], object]  # -> refine.SearchResult
+    description: str  # one line for --help
+    asks_proposer: bool = True
+    colour: str = "#757575"  # in the figures
+    knobs: tuple[str, ...] = KNOBS  # which of w, d, k its search reads (a sweep varies only those)
+
+
+METHODS: dict[str, Method] = {}
+
+
+def register_method(name: str, search: Callable[[SearchJob], object], description: str, *,
+                    asks_proposer: bool = True, colour: str = "#757575", knobs: tuple[str, ...] = KNOBS) -> Method:
+    """Make ``name`` a method everywhere (``--method``, the sweep, the figures)."""
+    unknown = set(knobs) - set(KNOBS)
+    if unknown:
+        raise ValueError(f"knobs must be among {KNOBS}, got {sorted(unknown)}")
+    method = Method(name, search, description, asks_proposer, colour, tuple(knobs))
+    METHODS[name] = method
+    return method
+
+
+def get_method(name: str) -> Method:
+    try:
+        return METHODS[name]
+    except KeyError:
+        raise SpecrefineError(f"unknown method {name!r}: use one of {', '.join(METHODS)}") from None
+
+
+class _View(Mapping):
+    """A live read-only view of the registry: name -> ``get(method)`` for the methods ``keep`` accepts."""
+
+    def __init__(self, get, keep=lambda m: True):
+        self._get, self._keep = get, keep
+
+    def __getitem__(self, name):
+        method = METHODS.get(name)
+        if method is None or not self._keep(method):
+            raise KeyError(name)
+        return self._get(method)
+
+    def __iter__(self):
+        return (name for name, m in METHODS.items() if self._keep(m))
+
+    def __len__(self):
+        return sum(1 for _ in self)
+
+
+#: the methods that ask a proposer (``method in PROPOSER_METHODS``; iterating gives their names)
+PROPOSER_METHODS = _View(lambda m: m.description, keep=lambda m: m.asks_proposer)
+METHOD_COLOURS = _View(lambda m: m.colour)
+
+
+def run_search(config: RunConfig, graph, evaluator, proposer, maze, on_step=None):
+    """The search of ``config.method`` on ``graph`` -> ``SearchResult``."""
+    method = get_method(config.method)
+    return method.search(SearchJob(config.resolved(), graph, evaluator, proposer, maze, on_step))
+
+
+# --- the built-in methods ------------------------------------------------------------------------
+def dirl(job: SearchJob):
+    from ..refine import shortest_path
+
+    return shortest_path(job.graph, job.evaluator, seed=job.config.seed)
+
+
+def symbolic(job: SearchJob):
+    from ..refine import RefinementSearch, SearchConfig
+
+    c = job.config
+    cfg = SearchConfig(k=c.k, edge_refinement=False, seed=c.seed, evaluation=c.evaluation)
+    return RefinementSearch(job.graph, job.evaluator, config=cfg, on_step=job.on_step).run()
+
+
+def ours_variant(**changes) -> Callable[[SearchJob], object]:
+    """Algorithm 3 with ``changes`` to its SearchConfig (``shortcut_reach="policy"``: the agent's goal range)."""
+
+    def search(job: SearchJob):
+        from ..refine import RefinementSearch, SearchConfig
+
+        c, variant = job.config, dict(changes)
+        if variant.get("shortcut_reach") == "policy":  # as far as the policy was trained to reach a goal
+            variant["shortcut_reach"] = get_agent(c.agent).reach_task.goal_max
+        cfg = SearchConfig(**{"w": c.w, "d": c.d, "k": c.k, "seed": c.seed, "evaluation": c.evaluation, **variant})
+        images = getattr(job.proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
+        query_for = edge_query_builder(job.maze, c.agent, job.evaluator.facts(), images=images)
+        return RefinementSearch(job.graph, job.evaluator, proposer=job.proposer, config=cfg, on_step=job.on_step,
+                                query_for=query_for, picture=candidate_picture(job.maze) if images else None).run()
+
+    return search
+
+
+def vlm_oneshot(job: SearchJob, budget: tuple[int, int] | None = None):
+    from ..refine.oneshot import oneshot
+
+    c = job.config
+    return oneshot(job.graph, job.evaluator, job.proposer, maze=job.maze, agent=c.agent, w=c.w, rounds=c.d,
+                   seed=c.seed, on_step=job.on_step, budget=budget)
+
+
+def vlm_oneshot_matched(job: SearchJob):
+    return vlm_oneshot(job, budget=budget_of_ours(job))
+
+
+def budget_of_ours(job: SearchJob) -> tuple[int, int]:
+    """(proposer calls, subtask evaluations) that ``ours`` spends on this task and seed (run here, on its own cache)."""
+    from ..proposers import make_proposer
+
+    evaluator = job.evaluator
+    cache = evaluator.cache_dir.parent / "budget_cache" if evaluator.cache_dir is not None else None
+    twin = evaluator.fresh_copy(cache_dir=cache)
+    proposer = make_proposer(job.proposer.spec, seed=job.config.seed)
+    METHODS["ours"].search(replace(job, evaluator=twin, proposer=proposer, on_step=None))
+    return proposer.proposer_calls, twin.evaluations + twin.disk_hits
+
+
+# the paper's Sec. 5.1, plus controls (every control removes one thing from ours) and what goes beyond the paper
+register_method("ours", ours_variant(), "Alg. 3: Dijkstra-order search with proposer edge splits and vertex subsets",
+                colour="#1565c0")
+register_method("ours-novertex", ours_variant(vertex_refinement=False, split_tuning=False),
+                "control: ours without vertex refinement anywhere (neither the search's vertex subsets nor "
+                "Algorithm 2 inside an edge split)", colour="#64b5f6")
+register_method("ours-nosearchvertex", ours_variant(vertex_refinement=False),
+                "control: ours without the search's own vertex subsets (an edge split still tunes its later "
+                "candidates with Algorithm 2)", colour="#90caf9")
+register_method("ours-notune", ours_variant(split_tuning=False),
+                "control: ours with an edge split's later candidates evaluated as proposed (no Algorithm 2 inside "
+                "the split, Alg. 1 line 10)", colour="#4db6ac")
+register_method("ours-nofeedback", ours_variant(split_feedback=False),
+                "control: ours with an edge split's later round asked afresh, without the earlier candidates' "
+                "results", colour="#80cbc4")
+register_method("ours-d1", ours_variant(d=1),
+                "the paper's d = 1: no later round in an edge split (its samples, feedback and tuning)",
+                colour="#00897b", knobs=("w", "k"))
+register_method("ours-repair", ours_variant(repair=True),
+                "beyond the paper: ours, and when no split candidate succeeds end to end, its failing legs are split "
+                "once more before it is judged (refine/repair.py)", colour="#6a1b9a")
+register_method("ours-shortcut", ours_variant(shortcut_reach="policy"),
+                "beyond the paper: ours, then shortcut edges over the found path's waypoints (one long leg where it "
+                "beats several short ones; refine/shortcut.py)", colour="#283593")
+register_method("vlm-oneshot", vlm_oneshot,
+                "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w",
+                colour="#ef6c00", knobs=("w", "d"))
+register_method("vlm-oneshot-matched", vlm_oneshot_matched,
+                "control: one-shot best-of-N, spending what ours spent (proposer calls, subtask evaluations) on the "
+                "same task and seed", colour="#ffb74d")
+register_method("symbolic", symbolic, "baseline: the search with vertex subsets only", asks_proposer=False,
+                colour="#8d6e63", knobs=("k",))
+register_method("dirl", dirl, "baseline: no refinement, Dijkstra on the input graph", asks_proposer=False,
+                colour="#9e9e9e", knobs=())

@@ -1,0 +1,172 @@
+"""``specrefine official RUN_DIR``: a finished run's compositional policy in the official Gymnasium-Robotics env.
+
+The environment is ``PointMaze_UMaze-v3`` (point mass) or ``AntMaze_UMaze-v5`` (Ant) made with the
+run's own maze as ``maze_map`` (walls 1, everything else 0: hazards are free floor there), so any maze
+runs, standard or not; ``env_id`` names the registered environment whose map has the same walls when
+there is one.  The environment keeps its own model, reset and step; it is made with
+``continuing_task=True, reset_target=False`` (never terminates and never moves its goal on reaching
+it: the task is judged here, not by its reward) and a ``max_episode_steps`` that never cuts an episode
+before the run's own time limit.  AntMaze is made with ``include_cfrc_ext_in_observation=False`` (the
+27 values this package's policy observes).
+
+Each episode: ``reset(options={"reset_cell": a start cell S (uniform over them), "goal_cell": the first
+goal cell})`` (the environment adds its own uniform noise of +-0.25 cell to both), then
+:class:`~specrefine.evaluation.compositional.CompositionalPolicy` ``act`` per step.  An episode ends, as in the
+evaluator, when the agent touches the current leg's avoid set (closer than the run's clearance), flips
+(Ant), has reached every leg's goal region, or uses a leg's ``horizon`` decisions.  Its xy at every
+environment step is then judged by this package's monitor on the ORIGINAL task (``result.json``'s
+``input_graph``: walls and hazards avoided, the original goal reached); a flipped Ant fails.
+
+``RUN_DIR/official.json`` (written atomically): ``env_id``, ``episodes``, ``success_rate``,
+``success_ci`` (95 % Wilson), ``sim_success_rate`` / ``sim_success_ci`` / ``sim_episodes`` (the run's
+own measurement in this package's simulator), ``outcomes``, ``seed`` and the settings used.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
+from ..core.errors import SpecrefineError
+from ..core.results import wilson_ci
+from ..core.standard_maps import to_gymnasium
+
+OFFICIAL_JSON = "official.json"
+#: agent -> (registered environment family, version, extra keyword arguments)
+ENVIRONMENTS = {"point": ("PointMaze", "v3", {}), "ant": ("AntMaze", "v5", {"include_cfrc_ext_in_observation": False})}
+
+
+def _gymnasium():
+    """gymnasium with the Gymnasium-Robotics environments registered (its import notice on stderr swallowed)."""
+    with contextlib.redirect_stderr(io.StringIO()):
+        import gymnasium
+        import gymnasium_robotics
+
+        gymnasium.register_envs(gymnasium_robotics)
+    return gymnasium
+
+
+def env_id(maze, agent: str) -> str:
+    """The registered id whose map has the maze's walls (e.g. ``AntMaze_Large-v5``), else the base id used."""
+    gym = _gymnasium()
+    family, version, _ = ENVIRONMENTS[agent]
+    walls = to_gymnasium(maze)
+    for name, spec in gym.registry.items():
+        if name.startswith(f"{family}_") and name.endswith(f"-{version}") and "Dense" not in name:
+            their = spec.kwargs.get("maze_map")
+            if their is not None and [[int(c == 1) for c in row] for row in their] == walls:
+                return name
+    return f"{family}_UMaze-{version} (maze_map of the run's maze {maze.name})"
+
+
+def make_env(maze, agent: str, max_episode_steps: int):
+    """The official environment on ``maze``'s walls (see the module docstring)."""
+    gym = _gymnasium()
+    family, version, extra = ENVIRONMENTS[agent]
+    return gym.make(f"{family}_UMaze-{version}", maze_map=to_gymnasium(maze), continuing_task=True,
+                    reset_target=False, max_episode_steps=max_episode_steps, **extra)
+
+
+def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
+    """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``."""
+    from ..evaluation.evaluator import _torch_threads
+    from ..core.graph import TaskGraph
+    from ..evaluation.monitor import satisfies
+
+    t0 = time.time()
+    run_dir = Path(run_dir)
+    result = _read_result(run_dir)
+    policy = CompositionalPolicy.load(run_dir)
+    agent, maze = policy.agent, policy.maze
+    if agent not in ENVIRONMENTS:
+        raise SpecrefineError(f"{run_dir}: no official Gymnasium-Robotics environment for the {agent}")
+    try:
+        original = TaskGraph.from_dict(result["input_graph"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SpecrefineError(f"{run_dir / 'result.json'}: no usable input_graph ({type(exc).__name__})") from None
+    probe = make_env(maze, agent, 1)
+    policy.match_env_dt(probe.unwrapped.model.opt.timestep * _inner(probe).frame_skip)
+    probe.close()
+    max_steps = len(policy.legs) * policy.horizon * policy.hold + 1
+    env = make_env(maze, agent, max_steps)
+    starts, goal = maze.cells("S"), maze.cells("G")[0]
+    rng = np.random.default_rng(seed)
+    success, outcomes = [], {}
+    with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
+        for episode in range(episodes):
+            options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
+            obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
+            traj, outcome = _episode(env, policy, obs, rng)
+            ok = outcome != "flipped" and bool(satisfies(original, traj[None], clearance=policy.clearance)[0])
+            success.append(ok)
+            outcomes[outcome] = outcomes.get(outcome, 0) + 1
+    env.close()
+    k, n = int(np.sum(success)), len(success)
+    data = {"env_id": env_id(maze, agent), "episodes": n, "success_rate": k / n if n else 0.0,
+            "success_ci": list(wilson_ci(k, n)), "sim_success_rate": result.get("success_rate"),
+            "sim_success_ci": result.get("success_ci"), "sim_episodes": result.get("episodes"),
+            "outcomes": outcomes, "seed": seed, "agent": agent, "maze": maze.name,
+            "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
+                         "horizon_per_leg": policy.horizon, "legs": len(policy.legs), "max_episode_steps": max_steps,
+                         "continuing_task": True, "reset_target": False, "clearance": policy.clearance},
+            "wall_seconds": time.time() - t0}
+    target = run_dir / OFFICIAL_JSON
+    tmp = target.with_name(f".{OFFICIAL_JSON}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")
+    os.replace(tmp, target)
+    return data
+
+
+def _episode(env, policy: CompositionalPolicy, obs, rng) -> tuple[np.ndarray, str]:
+    """One episode to its end (module docstring): the xy of every step and how it ended."""
+    policy.reset(obs, seed=rng)
+    xy = [agent_xy(obs)]
+    while True:
+        if policy.touching(xy[-1]):
+            return np.array(xy), "avoid"
+        if torso_flipped(policy.agent, obs):
+            return np.array(xy), "flipped"
+        policy.update(obs)
+        if policy.done:
+            return np.array(xy), "success"
+        if policy.timed_out:
+            return np.array(xy), "timeout"
+        obs, *_ = env.step(policy.act(obs).astype(np.float32))
+        xy.append(agent_xy(obs))
+
+
+def _inner(env):
+    """The MuJoCo env inside a Gymnasium-Robotics maze env (its frame_skip)."""
+    maze_env = env.unwrapped
+    return getattr(maze_env, "point_env", None) or maze_env.ant_env
+
+
+def _read_result(run_dir: Path) -> dict:
+    path = run_dir / "result.json"
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder") from None
+    except (OSError, ValueError) as exc:
+        raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
+    if not isinstance(data, dict):
+        raise SpecrefineError(f"{path}: not a run result")
+    return data
+
+
+def summary(data: dict) -> str:
+    lo, hi = data["success_ci"]
+    line = (f"official {data['env_id']}: success on the original task {data['success_rate']:.3f} "
+            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes)")
+    if data.get("sim_success_rate") is not None:
+        slo, shi = data["sim_success_ci"]
+        line += (f"\nthis package's simulator: {data['sim_success_rate']:.3f} (95% CI {slo:.3f}-{shi:.3f}, "
+                 f"{data['sim_episodes']} episodes)")
+    return line

@@ -1,0 +1,553 @@
+"""Experiment sweeps: a grid of (maze [x spec] x method x proposer x seed) runs -> one tidy CSV table.
+
+Each cell is one ``refine_maze`` run (the CLI's code path) in its own output directory
+``OUT/cells/<cell id>/``; its row is appended to ``OUT/results.csv`` as soon as it
+finishes.  Rerunning a sweep skips cells that already have a row with status ``ok``
+(resume after a kill), retries failed ones, and keeps each cell's evaluation cache, so
+an interrupted cell restarts from what it had evaluated.  A cell's warnings and log records (a proposer's
+rejected candidates, a region with little room) go to its own ``OUT/cells/<cell id>/log.txt``, not to the
+sweep's stderr, where two workers' lines would interleave around the progress bar.
+
+A cell's ``spec`` (``--specs``, or ``MAZE=SPEC`` in ``--mazes``) is the task as a spec expression
+(``specrefine refine --spec``); empty = the maze's own task.  It is part of the cell id only when
+given, so the ids of default-task cells (and the rows of older tables, which lack the ``spec``
+column) stay valid; rows are appended in the columns of the table they go into.
+
+The search settings ``w``, ``d`` and ``k`` (``-w 3 5 -k 5 10``; defaults and bounds from
+:class:`specrefine.runs.config.RunConfig`) are grid axes too: a method gets one cell per combination of the
+settings it reads (``methods.Method.knobs``).  A cell with the paper's values keeps the id it always had; any
+other value is named in the id (``...__s0__w5``) and recorded in the ``w``, ``d``, ``k`` columns (a table from
+before them reads as the paper's values; cells with other values are refused into it).
+
+A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
+``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
+ids and tables stay valid).  ``OUT/sweep.json`` records each cell's ``rollouts`` and ``episodes`` (not part
+of the id): a rerun into the same ``OUT`` with other values is refused (exit 2) rather than silently
+keeping rows measured with the old ones.  A row counts as done only when its status is ``ok`` and its
+numbers are all there (a row cut short by a kill is redone), and at the end the table holds one row per
+cell (the last ``ok`` one, else the last failure).  Ctrl-C ends the sweep with one line and exit 130,
+keeping every finished row; pool workers die with the sweep's process.  Exit 1 when every cell failed.
+
+Backends: ``local`` (a process pool sized to the machine) and ``ray`` (the same cells as
+Ray tasks on a cluster: ``--backend ray --address HOST:PORT``).  With Ray, Ctrl-C cancels the cells
+still queued or running (``ray.cancel(force=True)``); a sweep killed outright cannot, and leaves its tasks
+to Ray's own clean-up of a job whose driver died (not tested here).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import hashlib
+import itertools
+import json
+import logging
+import math
+import os
+import signal
+import sys
+import threading
+import time
+import traceback
+import warnings
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from tqdm.auto import tqdm
+
+from ..core.agents import AGENTS
+from ..core.argtypes import OneLineParser, bounded_int, out_path
+from ..core.errors import SpecrefineError, SweepError
+from .methods import METHODS, PROPOSER_METHODS
+from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
+from ..core.runfolder import replacing, write_atomic
+from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
+
+COLUMNS = [
+    "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
+    "success_rate", "success_ci_low", "success_ci_high", "episodes", "predicted_success", "path_success_rate",
+    "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
+    "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
+    "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
+    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k",
+]
+#: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
+#: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
+#: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header.
+
+
+@dataclass(frozen=True)
+class Cell:
+    maze: str  # a shipped maze's name, or the absolute path of any other maze file (see maze_ref)
+    agent: str
+    method: str
+    proposer: str  # "none" for methods that use no proposer
+    seed: int
+    rollouts: int = DEFAULTS.rollouts
+    episodes: int = DEFAULTS.episodes
+    spec: str = ""  # the task as a spec expression; "" = the maze's own task
+    evaluation: str = "fixed"  # "fixed" (the paper's protocol) or "adaptive" (specrefine.refine.racing)
+    policy: str = "shipped"  # the goal-conditioned policy: "shipped" (data/policies/AGENT.pt) or a checkpoint path
+    w: int = DEFAULTS.w
+    d: int = DEFAULTS.d
+    k: int = DEFAULTS.k
+
+    @property
+    def id(self) -> str:
+        prop = self.proposer.replace(":", "-").replace("/", "-")
+        name = self.maze
+        if Path(name).is_absolute():  # a file outside data/mazes: unique by its path
+            name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
+        name = name.replace(":", "-")  # a standard map 'gr:NAME' -> 'gr-NAME' (a folder name on every system)
+        task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
+        tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
+        tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
+                        if getattr(self, knob) != getattr(DEFAULTS, knob))  # the paper's w, d, k: the id they had
+        return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
+
+    def config(self) -> RunConfig:
+        """What ``refine_maze`` runs for this cell."""
+        return RunConfig(agent=self.agent, method=self.method, seed=self.seed, rollouts=self.rollouts,
+                         episodes=self.episodes, spec=self.spec or None, evaluation=self.evaluation,
+                         proposer="geometric" if self.proposer == "none" else self.proposer, policy=self.policy,
+                         w=self.w, d=self.d, k=self.k)
+
+
+def spec_slug(spec: str) -> str:
+    """A spec expression as a file-name-safe id part: '(a | b) -> G' -> 'Pa-or-bQ-then-G'."""
+    text = "".join(spec.split())
+    for old, new in (("->", "-then-"), ("|", "-or-"), ("(", "P"), (")", "Q")):
+        text = text.replace(old, new)
+    return text
+
+
+def maze_ref(arg: str) -> str:
+    """What a cell runs: a shipped maze (a name, or a path to the file in data/mazes) by its name; any other
+    existing file by its absolute path; anything else as given (loading it reports the error)."""
+    from ..core.mazes import MAZE_DIR
+
+    path = Path(arg)
+    if not path.exists():
+        return arg
+    resolved = path.resolve()
+    shipped = MAZE_DIR / f"{path.stem}.maze"
+    return path.stem if shipped.exists() and shipped.resolve() == resolved else str(resolved)
+
+
+def split_maze_arg(arg: str) -> tuple[str, str]:
+    """'MAZE' -> (MAZE, ''); 'MAZE=SPEC' -> (MAZE, SPEC): a per-maze spec on the command line."""
+    maze, _, spec = arg.partition("=")
+    return maze, spec.strip()
+
+
+def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
+         agent: str = "point", rollouts: int = DEFAULTS.rollouts, episodes: int = DEFAULTS.episodes,
+         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped",
+         w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,)
+         ) -> list[Cell]:
+    """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
+
+    ``w``, ``d``, ``k``: the values of each search setting; a method gets one cell per combination of the settings
+    it reads (``methods.Method.knobs``: dirl none, symbolic k only), the others at the paper's defaults.
+
+    ``evaluation``: None = the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
+
+    ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
+    ``MAZE=SPEC`` runs that spec only.
+    """
+    from ..core.agents import get_agent
+
+    evaluation = evaluation or get_agent(agent).default_evaluation
+    axes = {"w": list(w), "d": list(d), "k": list(k)}
+    cells = []
+    for arg in mazes:
+        maze, own = split_maze_arg(str(arg))
+        for spec in [own] if own else [s or "" for s in specs]:
+            for method in methods:
+                props = list(proposers) if method in PROPOSER_METHODS else ["none"]
+                for proposer in props:
+                    for seed in seeds:
+                        for knobs in _knob_values(method, axes):
+                            cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
+                                              spec, evaluation, policy, **knobs))
+    return cells
+
+
+def _knob_values(method: str, axes: dict[str, list[int]]) -> list[dict[str, int]]:
+    """Each combination of the values of the settings ``method`` reads (an unknown method: all of them); the
+    settings it does not read stay at the paper's defaults."""
+    reads = METHODS[method].knobs if method in METHODS else KNOBS
+    values = [axes[knob] if knob in reads else [getattr(DEFAULTS, knob)] for knob in KNOBS]
+    return [dict(zip(KNOBS, combo)) for combo in dict.fromkeys(itertools.product(*values))]
+
+
+def run_cell(cell: Cell, out_root: str) -> dict:
+    """Run one cell; never raises: a failure becomes a row with status 'error'."""
+    from .pipeline import refine_maze
+
+    row = {**asdict(cell), "cell": cell.id}
+    out = Path(out_root) / "cells" / cell.id
+    try:
+        with cell_log(out / "log.txt"):
+            result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
+    except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
+        last = traceback.format_exception_only(type(exc), exc)[-1].strip()
+        return {**row, "status": "error", "error": last[:300]}
+    return result_row(result.data, row) | {"proposer_is_vlm": result.data["proposer_is_vlm"]
+                                           if cell.proposer != "none" else False}
+
+
+@contextlib.contextmanager
+def cell_log(path: Path):
+    """The package's log records and Python warnings raised inside the block are appended to ``path`` (a rerun
+    adds to it), not printed."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    logger = logging.getLogger("specrefine")
+    handler = logging.FileHandler(path, encoding="utf-8")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+
+    def to_file(message, category, filename, lineno, file=None, line=None):
+        handler.stream.write(warnings.formatwarning(message, category, filename, lineno, line))
+        handler.flush()
+
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = to_file
+            yield
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+        handler.close()
+
+
+def result_row(data: dict, row: dict | None = None) -> dict:
+    """A results-table row (``COLUMNS``) from a run's ``result.json`` dict; ``row`` fields take precedence."""
+    row = dict(row or {})
+    lo, hi = data["success_ci"]
+    row.update({k: data[k] for k in COLUMNS if k in data and k not in row})
+    row.update(status="ok", error="", success_ci_low=lo, success_ci_high=hi)
+    if "predicted_ci" in data:
+        row.update(predicted_ci_low=data["predicted_ci"][0], predicted_ci_high=data["predicted_ci"][1])
+    return row
+
+
+def is_done(row: dict) -> bool:
+    """An ``ok`` row with all its numbers (typed as by ``read_table``)."""
+    return row.get("status") == "ok" and all(
+        isinstance(row.get(k), (int, float)) and not isinstance(row.get(k), bool) for k in _NUMBERS)
+
+
+def _drop_cut_row(path: Path) -> None:
+    """A last row cut off by a kill (no newline at its end) is removed: it was not done, and ending it instead
+    could leave an open quote that would swallow every row after it."""
+    with path.open("rb+") as fh:
+        data = fh.read()
+        if data and not data.endswith(b"\n"):
+            fh.truncate(data.rfind(b"\n") + 1)
+
+
+def _append(path: Path, row: dict) -> None:
+    new = not path.exists() or path.stat().st_size == 0
+    columns = COLUMNS
+    if not new:  # an older table (without the later columns, e.g. spec) keeps its own header
+        with path.open(newline="") as fh:
+            columns = next(csv.reader(fh), None) or COLUMNS
+        if row.get("spec") and "spec" not in columns:
+            raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
+        if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
+            raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
+        if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
+            raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
+        if any(row.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob) for knob in KNOBS) \
+                and "w" not in columns:
+            raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
+    if not new:
+        _drop_cut_row(path)
+    with path.open("a", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        if new:
+            writer.writeheader()
+        writer.writerow({k: " ".join(str(row.get(k, "")).split()) if k == "error" else row.get(k, "")
+                         for k in columns})  # one line per row: a cut row is then always the last line
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def pending(cells: list[Cell], table: Path) -> list[Cell]:
+    done = {r["cell"] for r in read_table(table) if is_done(r)}
+    return [c for c in cells if c.id not in done]
+
+
+def compact(table: Path) -> None:
+    """One row per cell: its last done row, else its last row; first-appearance order, the table's own header."""
+    if not table.exists():
+        return
+    columns, raw = _raw_rows(table)
+    if not columns:
+        return
+    keep: dict[str, dict] = {}
+    for row in raw:
+        old = keep.get(row["cell"])
+        if old is None or is_done(_typed(row)) or not is_done(_typed(old)):
+            keep[row["cell"]] = row
+    if len(keep) == len(raw):
+        return
+    with replacing(table, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(keep.values())
+
+
+PARAMS = ("rollouts", "episodes", "policy")  # what a cell's rows depend on beyond its id
+
+
+def check_params(cells: list[Cell], out_root: Path) -> None:
+    """Refuse cells whose id ``OUT`` already holds with other ``PARAMS`` (``OUT/sweep.json``, or for older
+    tables the rows' ``rollouts_per_evaluation``); record the new cells' parameters."""
+    record = out_root / "sweep.json"
+    known = json.loads(record.read_text())["cells"] if record.exists() else {}
+    for row in read_table(out_root / "results.csv"):
+        if row.get("cell") not in known and isinstance(row.get("rollouts_per_evaluation"), float):
+            known[row["cell"]] = {"rollouts": int(row["rollouts_per_evaluation"])}
+    for cell in cells:
+        old = known.get(cell.id, {})
+        diff = [f"--{k} {old[k]}" for k in PARAMS if k in old and old[k] != getattr(cell, k)]
+        if diff:
+            raise SweepError(f"{out_root} holds cell {cell.id} run with {' '.join(diff)}; rerun with those values "
+                             f"or use another --out")
+    known.update({c.id: {k: getattr(c, k) for k in PARAMS} for c in cells})
+    write_atomic(record, json.dumps({"cells": known}, indent=1, sort_keys=True))
+
+
+def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
+              address: str | None = None, retries: int = 1) -> Path:
+    """Run every pending cell, appending rows to OUT/results.csv; returns the table's path.
+
+    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters.
+    """
+    from ..core.runfolder import ensure_dir
+
+    out_root = ensure_dir(out_root)
+    table = out_root / "results.csv"
+    check_params(cells, out_root)
+    try:
+        for attempt in range(retries + 1):
+            todo = pending(cells, table)
+            if not todo:
+                break
+            runner = _run_ray if backend == "ray" else _run_local
+            for row in tqdm(runner(todo, str(out_root), workers, address), total=len(todo),
+                            desc=f"sweep ({backend}, try {attempt + 1})"):
+                _append(table, row)
+    finally:
+        compact(table)
+    return table
+
+
+def _run_local(cells, out_root, workers, _address):
+    workers = workers or max(1, (os.cpu_count() or 1))
+    if workers == 1:
+        for cell in cells:
+            yield run_cell(cell, out_root)
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),),
+                               mp_context=_mp_context())
+    finished = False
+    try:
+        futures = {pool.submit(run_cell, cell, out_root): cell for cell in cells}
+        for fut in as_completed(futures):
+            yield _row_of(fut, futures[fut])
+        finished = True
+    finally:
+        if not finished:  # interrupted: no waiting for running cells
+            _stop(pool)
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _row_of(fut, cell: Cell) -> dict:
+    try:
+        return fut.result()
+    except BrokenProcessPool:  # a worker was killed (out of memory?) or crashed: the cell failed, the sweep goes on
+        return {**asdict(cell), "cell": cell.id, "status": "error",
+                "error": "the worker process running this cell died (killed or crashed)"}
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        proc.terminate()
+    for proc in procs:
+        proc.join(timeout=5)
+
+
+def _mp_context():
+    """fork where there is one (Linux's default before Python 3.14): a worker's parent is then the sweep itself."""
+    import multiprocessing
+
+    return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+
+
+def _worker_init(parent: int):
+    """A pool worker: Ctrl-C is the parent's to handle, and the worker ends when its parent (the sweep) is gone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True, name="sweep-parent").start()
+    import torch
+
+    torch.set_num_threads(1)
+
+
+def _exit_with_parent(parent: int, every: float = 0.5) -> None:
+    while os.getppid() == parent:
+        time.sleep(every)
+    os._exit(1)  # orphaned: the sweep that started this worker was killed
+
+
+def _run_ray(cells, out_root, _workers, address):
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    remote = ray.remote(num_cpus=1)(run_cell)
+    refs = [remote.remote(cell, out_root) for cell in cells]
+    try:
+        while refs:
+            ready, refs = ray.wait(refs, num_returns=1)
+            yield ray.get(ready[0])
+    finally:
+        for ref in refs:  # Ctrl-C or an error: the cells still queued or running must not go on without the sweep
+            with contextlib.suppress(Exception):
+                ray.cancel(ref, force=True)
+
+
+def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]:
+    """Mean and population std (np.std's, as in the paper) of success over seeds, per group (``mean_std``)."""
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        if r.get("status") == "ok":
+            if r.get("spec") and "maze" in by:  # a task other than the maze's own is its own group
+                r = {**r, "maze": f"{r['maze']} [{r['spec']}]"}
+            tuned = [f"{knob}={r[knob]}" for knob in KNOBS
+                     if knob not in by and r.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob)]
+            if tuned and "method" in by:  # so is a method run with other w, d or k than the paper's
+                r = {**r, "method": f"{r['method']} [{', '.join(tuned)}]"}
+            groups.setdefault(tuple(r[k] for k in by), []).append(r)
+    out = []
+    for key, rs in sorted(groups.items()):
+        s_mean, s_std = mean_std([r["success_rate"] for r in rs])
+        v_mean, v_std = mean_std([r["graph_vertices"] for r in rs])
+        out.append({**dict(zip(by, key)), "runs": len(rs), "success_mean": s_mean, "success_std": s_std,
+                    "vertices_mean": v_mean, "vertices_std": v_std, "seeds": sorted(int(r["seed"]) for r in rs)})
+    return out
+
+
+def mean_std(values, ddof: int = 0) -> tuple[float, float]:
+    """Mean and standard deviation (population by default, np.std's) that do not depend on the values' order.
+
+    A float sum rounds differently in another order: the same four runs listed by seed in two orders gave
+    0.9875 and 0.98749999999999993, printed 0.988 and 0.987. math.fsum is exactly rounded, so equal runs give
+    equal numbers whichever order their rows come in."""
+    v = [float(x) for x in values]
+    mean = math.fsum(v) / len(v)
+    if len(v) <= ddof:
+        return mean, 0.0
+    return mean, math.sqrt(math.fsum((x - mean) ** 2 for x in v) / (len(v) - ddof))
+
+
+def _check_specs(cells: list[Cell]) -> str | None:
+    """The first bad (maze, spec) pair's or unknown standard map's one-line message, before any cell runs
+    (None: all fine)."""
+    from ..core.mazes import load_maze
+    from ..core.spec import maze_task
+    from ..core.standard_maps import PREFIX
+
+    for maze in sorted({c.maze for c in cells if c.maze.startswith(PREFIX)}):
+        try:
+            load_maze(maze)
+        except SpecrefineError as exc:
+            return str(exc)
+    for maze, spec in sorted({(c.maze, c.spec) for c in cells if c.spec}):
+        try:
+            maze_task(load_maze(maze), spec)
+        except SpecrefineError as exc:
+            return f"{maze}: {exc}"
+    return None
+
+
+def _check_policy(policy: str, agent: str) -> str | None:
+    """One line if ``policy`` is not a usable checkpoint for ``agent`` (before any cell runs)."""
+    from .experiment import load_goal_policy
+
+    if policy == "shipped":
+        return None
+    try:
+        load_goal_policy(agent, policy)
+    except SpecrefineError as exc:
+        return f"--policy {exc}"
+    return None
+
+
+def main(argv=None) -> int:
+    from ..core.mazes import benchmark_mazes
+    from .pipeline import METHODS
+
+    p = OneLineParser(prog="python -m specrefine.runs.sweep", description=__doc__.split("\n")[0])
+    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
+                   help="maze names or files, or gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE); MAZE=SPEC runs "
+                        "that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
+    p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
+                   help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
+                        "'' = the maze's own task; default: the maze's own task)")
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"])
+    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
+    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
+    p.add_argument("--agent", default="point", choices=list(AGENTS))
+    add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
+    add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
+                                               "of w, d, k it reads)")
+    p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
+                   help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
+                        "when adaptive) (default: fixed for point, adaptive for ant)")
+    p.add_argument("--policy", default="shipped",
+                   help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
+                        "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")
+    p.add_argument("--out", type=out_path, default="runs/sweep")
+    p.add_argument("--backend", choices=["local", "ray"], default="local",
+                   help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
+                        "Ray) (default: local)")
+    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
+    p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
+    args = p.parse_args(argv)
+    cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
+                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
+                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
+    bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
+    if bad:
+        return _fail(bad, 2)
+    t0 = time.time()
+    try:
+        table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
+    except SpecrefineError as exc:
+        return _fail(str(exc), 2)
+    except KeyboardInterrupt:
+        return _fail(f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun the same "
+                     f"command to resume", 130)
+    done = {r["cell"] for r in read_table(table) if is_done(r)}
+    failed = sum(c.id not in done for c in cells)
+    print(f"{len(cells)} cells -> {table} ({failed} failed) in {time.time() - t0:.0f} s")
+    return 1 if cells and failed == len(cells) else 0
+
+
+def _fail(message: str, code: int) -> int:
+    print(f"python -m specrefine.runs.sweep: error: {message}", file=sys.stderr)
+    return code
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,120 @@
+"""Open-floor evaluation of a goal policy: reach one goal, or a chain of goals, with no maze around.
+
+    python -m specrefine.sim.train --agent ant --evaluate data/policies/ant.pt --episodes 500
+    python -m specrefine.sim.train --agent ant --evaluate ant --chain 8 --goal-range 3 5   # goals in a row
+
+Episodes start at the origin in the default pose; goals lie at a uniform distance in the agent's reach
+range (``specrefine.core.agents``' ``reach_task``) unless given.  The figures of these results are in
+:mod:`specrefine.sim.curves`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from ..core.agents import get_agent
+from ..core.results import wilson_ci
+from .policy import GoalPolicy
+from .simulator import BatchedSim, sample_goals
+
+
+def _frame(policy) -> str:
+    return getattr(policy, "observation_frame", "world")  # a scripted controller has none
+
+
+def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
+    """The evaluation setup: episodes at the origin in the default pose, one goal each in [lo, hi] m."""
+    task = get_agent(policy.agent).reach_task
+    lo = task.goal_min if lo is None else lo
+    hi = task.goal_max if hi is None else hi
+    rng = np.random.default_rng(seed)
+    sim = BatchedSim(policy.agent, None, episodes, nthread=nthread)
+    sim.reset(xy=np.zeros((episodes, 2)), rng=rng)
+    return task, lo, hi, rng, sim, horizon or sim.default_horizon, sample_goals(sim.xy, lo, hi, rng)
+
+
+def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = None, hi: float | None = None,
+                   seed: int = 0, horizon: int | None = None, nthread: int | None = None) -> dict:
+    """Deterministic policy, open floor, goals at uniform distance in [lo, hi]: success within the horizon."""
+    task, lo, hi, rng, sim, horizon, goals = _open_floor(policy, episodes, lo, hi, seed, horizon, nthread)
+    dist0 = np.linalg.norm(goals - sim.xy, axis=1)
+    active = np.ones(episodes, dtype=bool)
+    success, flipped = np.zeros(episodes, bool), np.zeros(episodes, bool)
+    steps = np.full(episodes, horizon)
+    traj = np.zeros((episodes, horizon + 1, 2))
+    traj[:, 0] = sim.xy
+    for t in range(horizon):
+        sim.step(np.where(active[:, None], policy.act(sim.observe(goals, _frame(policy))), 0.0))
+        xy = sim.xy
+        traj[:, t + 1] = np.where(active[:, None], xy, traj[:, t])
+        hit = active & (np.linalg.norm(goals - xy, axis=1) < task.success_radius)
+        flip = active & sim.flipped & ~hit
+        success |= hit
+        flipped |= flip
+        steps[hit | flip] = t + 1
+        active &= ~(hit | flip)
+        if not active.any():
+            break
+    sim.close()
+    k = int(success.sum())
+    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goal_range_m": [lo, hi], "horizon": horizon,
+            "success_radius_m": task.success_radius, "success_rate": k / episodes,
+            "success_ci95": wilson_ci(k, episodes), "flip_rate": float(flipped.mean()),
+            "mean_steps_success": float(steps[success].mean()) if k else None,
+            "distance": dist0, "success": success, "flipped": flipped, "steps": steps, "trajectories": traj,
+            "goals": goals}
+
+
+def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
+                   hi: float | None = None, seed: int = 0, horizon: int | None = None) -> dict:
+    """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
+
+    This is how a compositional policy uses the goal policy (the next subtask starts from a moving
+    state); per goal it reports how many episodes got there and how many flipped on the way.
+    """
+    task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
+    index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
+    alive = np.ones(episodes, dtype=bool)
+    reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
+    with torch.inference_mode():
+        while alive.any():
+            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal, _frame(policy))), 0.0))
+            t += 1
+            flip = alive & sim.flipped
+            np.add.at(flips, index[flip], 1)
+            alive &= ~flip
+            hit = alive & (np.linalg.norm(sim.xy - goal, axis=1) < task.success_radius)
+            np.add.at(reached, index[hit], 1)
+            index[hit] += 1
+            t[hit] = 0
+            goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
+            alive &= index < goals
+            late = alive & (t >= horizon)
+            np.add.at(timeouts, index[late], 1)
+            alive &= ~late
+    sim.close()
+    k = int(reached[-1])
+    return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
+            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
+            "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
+            "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
+
+
+def success_by_distance(result: dict, bins: int = 8) -> list[dict]:
+    lo, hi = result["goal_range_m"]
+    edges = np.linspace(lo, hi, bins + 1)
+    rows = []
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        m = (result["distance"] >= a) & (result["distance"] < b if b < hi else result["distance"] <= b)
+        k, n = int(result["success"][m].sum()), int(m.sum())
+        rows.append({"from_m": round(float(a), 3), "to_m": round(float(b), 3), "n": n,
+                     "success_rate": k / n if n else None, "ci95": wilson_ci(k, n)})
+    return rows
+
+
+def summary(result: dict) -> dict:
+    keep = ("agent", "episodes", "seed", "goal_range_m", "horizon", "success_radius_m", "success_rate",
+            "success_ci95", "flip_rate", "mean_steps_success")
+    return {k: result[k] for k in keep} | {"by_distance": success_by_distance(result)}
+
