@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 
 from .errors import SpecrefineError
 
-#: what a free-joint body's observation is expressed in (``sim.BatchedSim.observe``); a policy file records its own
+#: what a free-joint body's observation is expressed in (``simulator.BatchedSim.observe``);
+#: a policy file records its own
 OBSERVATION_FRAMES = ("world", "heading")
 
 

@@ -1,4 +1,4 @@
-"""The paper's settings, written once. A run's defaults (``runconfig.RunConfig``) and the algorithms called directly
+"""The paper's settings, written once. A run's defaults (``runs.config.RunConfig``) and the algorithms called directly
 both read them here; this module imports nothing, so every layer may."""
 
 from __future__ import annotations

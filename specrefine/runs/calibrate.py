@@ -128,8 +128,8 @@ def predict_run(run, maze_dir=None) -> dict:
 
 #: What makes two rows the same run, and what a table without the column ran with: tables older than a column ran
 #: the maze's own task, the paper's fixed protocol (the only one before ``evaluation`` existed), 32 rollouts,
-#: 200 episodes and the shipped policy (the defaults of ``specrefine.runs.sweep`` and ``specrefine.bench``). The policy is
-#: named by its fingerprint where the row has one, else by the ``policy`` column.
+#: 200 episodes and the shipped policy (the defaults of ``specrefine.runs.sweep`` and ``specrefine.bench``). The policy
+#: is named by its fingerprint where the row has one, else by the ``policy`` column.
 RUN_IDENTITY = {"maze": None, "agent": None, "method": None, "proposer": None, "seed": None, "spec": "",
                 "evaluation": "fixed", "rollouts_per_evaluation": "32", "episodes": "200", "policy": "shipped"}
 
@@ -196,7 +196,8 @@ def checked_run(run, maze_dir=None):
 
 def table_rows(table) -> list[dict]:
     """The rows of a predictions table (any CSV with success_rate and predicted_ci_low/high) that have an interval;
-    a table that does not parse, or holds no such row, is a one-line :class:`~specrefine.core.errors.SpecrefineError`."""
+    a table that does not parse, or holds no such row, is a one-line
+    :class:`~specrefine.core.errors.SpecrefineError`."""
     from ..core.errors import SpecrefineError
     from ..core.tables import read_checked_table
 

@@ -70,8 +70,8 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     expression over the maze's letters (``"(a | b) -> c -> G"``, see ``specrefine.core.spec.parse_spec``),
     None = the maze's own task (its ``; spec:`` line, else its chain).
     """
-    from ..evaluation.evaluator import Evaluator
     from ..core.spec import maze_task
+    from ..evaluation.evaluator import Evaluator
 
     get_agent(agent)
     maze = (maze if isinstance(maze, Maze) else load_maze(maze)).for_agent(agent)

@@ -16,7 +16,7 @@ from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
 from .queries import candidate_picture, edge_query_builder
 
-if TYPE_CHECKING:  # an annotation only: runconfig reads the registry for its choices
+if TYPE_CHECKING:  # an annotation only: runs.config reads the registry for its choices
     from .config import RunConfig
 
 KNOBS = ("w", "d", "k")  # the search settings of RunConfig a method may read

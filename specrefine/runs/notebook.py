@@ -99,8 +99,8 @@ def _check_value(name: str, value, rule: str) -> None:
 
     from ..core.agents import AGENTS
     from ..core.argtypes import LIMITS, bounded_int
-    from .pipeline import METHODS
     from .config import proposer_arg
+    from .pipeline import METHODS
 
     if rule in LIMITS:
         if isinstance(value, bool) or not isinstance(value, int):

@@ -33,10 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
 from ..core.standard_maps import to_gymnasium
+from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
 
 OFFICIAL_JSON = "official.json"
 #: agent -> (registered environment family, version, extra keyword arguments)
@@ -76,8 +76,8 @@ def make_env(maze, agent: str, max_episode_steps: int):
 
 def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
     """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``."""
-    from ..evaluation.evaluator import _torch_threads
     from ..core.graph import TaskGraph
+    from ..evaluation.evaluator import _torch_threads
     from ..evaluation.monitor import satisfies
 
     t0 = time.time()

@@ -16,18 +16,18 @@ from pathlib import Path
 
 import numpy as np
 
-from .calibrate import predict
-from ..evaluation.compositional import save_run_policy
 from ..core.errors import SpecrefineError
 from ..core.graph import check_refines
-from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
-from ..evaluation.monitor import measure
-from .progress import RunProgress
-from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
-from ..refine.search import EVALUATIONS
-from .config import RunConfig
 from ..core.runfolder import replacing, write_atomic
 from ..core.spec import maze_spec_text
+from ..evaluation.compositional import save_run_policy
+from ..evaluation.monitor import measure
+from ..refine.search import EVALUATIONS
+from .calibrate import predict
+from .config import RunConfig
+from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
+from .progress import RunProgress
+from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
 
 MEASURE_SEED_OFFSET = 1_000_003  # final measurement never reuses the search's rollouts
 
@@ -68,10 +68,10 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     ``out`` holds this run only (:mod:`specrefine.core.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
     """
-    from .experiment import setup
     from ..core.mazes import Maze, load_maze
     from ..core.runfolder import claim, write_record
     from ..core.spec import maze_task
+    from .experiment import setup
 
     t0 = time.time()
     if policy_path is not None:

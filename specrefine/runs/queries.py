@@ -12,8 +12,8 @@ def edge_query_builder(maze, agent, facts=None, *, images: bool = True):
     ``facts``: the evaluator's ``facts()``, what the prompt says about the evaluation (default: an
     evaluator with default settings on ``maze``). ``images=False``: no picture (``image_png`` None).
     """
-    from ..proposers import EdgeQuery
     from ..pictures.render import render_task, to_png
+    from ..proposers import EdgeQuery
 
     def picture(graph, u, v, result):
         if not images:

@@ -61,10 +61,10 @@ from tqdm.auto import tqdm
 from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
-from .methods import METHODS, PROPOSER_METHODS
-from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
 from ..core.runfolder import replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
+from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
+from .methods import METHODS, PROPOSER_METHODS
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",

@@ -67,7 +67,7 @@ class GoalPolicy(nn.Module):
             raise PolicyError(f"observation frame {observation_frame!r}; expected one of "
                               f"{', '.join(OBSERVATION_FRAMES)}")
         self.agent = agent
-        #: what ``sim.BatchedSim.observe`` must hand this policy ("world": every policy before the heading frame)
+        #: what ``simulator.BatchedSim.observe`` must hand this policy ("world": every policy before the heading frame)
         self.observation_frame = observation_frame
         self.obs_dim, self.act_dim = (obs_dim, act_dim) if obs_dim else OBS_ACT_DIMS[agent]
         self.norm = Normalizer(self.obs_dim)

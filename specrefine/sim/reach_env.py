@@ -32,7 +32,7 @@ class GoalReachEnv(EnvBase):
                  frame: str = "world"):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
         self.sim = BatchedSim(agent, None, n, nthread=nthread)
-        self.frame = frame  # the observation frame of the policy being trained (sim.BatchedSim.observe)
+        self.frame = frame  # the observation frame of the policy being trained (simulator.BatchedSim.observe)
         self.task = task or get_agent(agent).reach_task
         self.rng = np.random.default_rng(seed)
         self.goals = np.zeros((n, 2))
