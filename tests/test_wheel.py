@@ -21,7 +21,8 @@ def _copy_sources(dst: Path) -> None:
         target = dst / name
         target.parent.mkdir(parents=True, exist_ok=True)
         if src.is_dir():
-            shutil.copytree(src, target, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "pictures"))
+            skip = ("__pycache__", "*.pyc") + (("pictures",) if name == "data/mazes" else ())  # not the sub-package
+            shutil.copytree(src, target, ignore=shutil.ignore_patterns(*skip))
         else:
             shutil.copy2(src, target)
 
