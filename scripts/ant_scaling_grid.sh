@@ -15,3 +15,4 @@ part() {  # NAME, then the sweep's method and proposer arguments
 for seed in 0 1 2; do part ours_geometric --seeds $seed --methods ours --proposers geometric:max_waypoints=48; done
 part oneshot --seeds 0 1 2 --methods vlm-oneshot --proposers geometric:max_waypoints=48 imperfect:moderate
 for seed in 0 1 2; do part imperfect --seeds $seed --methods ours ours-repair --proposers imperfect:moderate; done
+part repair_geometric --seeds 0 1 2 --methods ours-repair --proposers geometric:max_waypoints=48  # part 4, added 22:59 UTC before any cell of it ran

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -23,7 +24,7 @@ def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2"):
 
 def test_every_method_is_listed_once_with_what_it_is():
     asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
-              "ours-repair", "ours-shortcut", "vlm-oneshot", "vlm-oneshot-matched"}
+              "ours-repair", "ours-repair-tuned", "ours-shortcut", "vlm-oneshot", "vlm-oneshot-matched"}
     assert set(METHODS) == asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) == asking
 
 
@@ -89,6 +90,21 @@ def test_repair_keeps_a_split_that_ours_never_keeps(tmp_path):
     assert plain["refinements"] == 0 and plain["success_rate"] == 0.0
     assert any(s["event"] == "split-repaired" and s["legs_repaired"] >= 1 for s in steps)
     assert repaired["refinements"] >= 1 and repaired["refines_input"] is True and repaired["success_rate"] > 0.0
+
+
+def test_repair_tuned_tunes_the_repaired_chain_and_nothing_else(tmp_path):
+    """The same cell: ours-repair-tuned repairs as ours-repair does, then Algorithm 2 tunes the repaired chain (its
+    product never falls: the chain as repaired is the DP's fallback, estimated from the same cache)."""
+    _, plain = run(tmp_path, "ours-repair", "imperfect:moderate")
+    tuned_data, tuned = run(tmp_path, "ours-repair-tuned", "imperfect:moderate")
+    first = [s for s in plain if s["event"] == "split-repaired"][0]
+    assert [s for s in tuned if s["event"] == "split-repaired"][0] == first  # the repair itself is unchanged
+    tunings = [s for s in tuned if s["event"] == "split-repair-tuned"]
+    assert tunings and not any(s["event"] == "split-repair-tuned" for s in plain)
+    for s in tunings:
+        assert len(s["p_after"]) == len(s["p_before"]) == len(s["waypoints"]) + 1
+        assert math.prod(s["p_after"]) >= math.prod(s["p_before"]) - 1e-12
+    assert tuned_data["refines_input"] is True
 
 
 def test_matched_one_shot_spends_what_ours_spent(tmp_path):

@@ -31,7 +31,7 @@ import numpy as np
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
-from .edge_split import edge_split
+from .edge_split import SplitCandidate, edge_split
 from .racing import Racing
 from .repair import cheapest, repair
 from .shortcut import add_shortcuts, shortcuts
@@ -56,6 +56,7 @@ class SearchConfig:
     seed: int = 0
     evaluation: str = "fixed"  # "fixed": every estimate on n rollouts (the paper); "adaptive": racing.py
     repair: bool = False  # beyond the paper: split a candidate's failing legs before it is judged (repair.py)
+    repair_tuning: bool = False  # beyond the paper: Algorithm 2 on a repaired chain before it is judged
     shortcut_reach: float | None = None  # beyond the paper: shortcut edges up to this long on the path (shortcut.py)
 
     def __post_init__(self):
@@ -249,7 +250,20 @@ class RefinementSearch:
                      waypoints=[x.to_dict() for x in repaired.waypoints]) if repaired else \
             dict(p_after=None, legs_repaired=0, waypoints=None)
         self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities, **after)
+        if repaired is not None and self.cfg.repair_tuning and repaired.p > 0.0:
+            repaired = self._tune_repaired(u, v, repaired)
         return repaired
+
+    def _tune_repaired(self, u, v, candidate):
+        """Algorithm 2 on the repaired chain's waypoints, as Algorithm 1 tunes its later-round candidates."""
+        g = self.graph
+        choice = refine_chain(self.evaluator, self.f.arrivals[u], list(candidate.waypoints), g.region(v),
+                              [g.avoid(u, v)] * (len(candidate.waypoints) + 1), self.cfg.k, self.rng,
+                              g.goal_point(v), racing=self.racing)
+        self._log("split-repair-tuned", edge=[u, v], p_before=candidate.probabilities,
+                  p_after=[r.p for r in choice.results], waypoints=[x.to_dict() for x in choice.regions])
+        return SplitCandidate(choice.regions, choice.results, candidate.round, tuned=True,
+                              repaired=candidate.repaired)
 
     def _gen_vertex(self, u, v, w) -> Refinement | None:
         self.vertex_generated += 1

@@ -173,6 +173,9 @@ register_method("ours-d1", ours_variant(d=1),
 register_method("ours-repair", ours_variant(repair=True),
                 "beyond the paper: ours, and when no split candidate succeeds end to end, its failing legs are split "
                 "once more before it is judged (refine/repair.py)", colour="#6a1b9a")
+register_method("ours-repair-tuned", ours_variant(repair=True, repair_tuning=True),
+                "beyond the paper: ours-repair, and a repaired chain is tuned by Algorithm 2 (vertex subsets) before "
+                "it is judged", colour="#ab47bc")
 register_method("ours-shortcut", ours_variant(shortcut_reach="policy"),
                 "beyond the paper: ours, then shortcut edges over the found path's waypoints (one long leg where it "
                 "beats several short ones; refine/shortcut.py)", colour="#283593")
