@@ -117,3 +117,19 @@ def test_the_core_imports_neither_mujoco_nor_torch_nor_matplotlib():
     proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.strip() == "[]"
+
+
+def test_one_figure_convention_no_pyplot():
+    """Every figure is a ``pictures.render.PngFigure`` (no pyplot: no global backend or state, nothing to close)."""
+    users = []
+    for path in PACKAGE.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            else:
+                continue
+            if any(n.startswith("matplotlib.pyplot") or n == "matplotlib.use" for n in names):
+                users.append(str(path.relative_to(PACKAGE)))
+    assert users == []

@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.runfolder import save_figure, write_atomic
-from ..pictures.render import PngFigure
+from ..pictures.render import subplots
 from ..runs.sweep import is_done, mean_std
-from .figures import METHOD_COLOURS, figure4, figure5, plt, proposer_label  # plt: with the figures' backend
+from .figures import METHOD_COLOURS, figure4, figure5, proposer_label
 
 COMPARISON_METHODS = ["ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
                       "vlm-oneshot", "vlm-oneshot-matched"]
@@ -333,8 +333,7 @@ def error_level_figure(rows, methods=COMPARISON_METHODS, levels=ERROR_LEVELS, ex
     """End-to-end success against proposer error level, one panel per U-chain length (no subgoals): per method,
     the mean over seeds with a 95 % t-interval band over ``levels``, and ``extra`` as a separate marker."""
     cells, _ = table_cells(rows, agent)
-    fig, axes = plt.subplots(1, len(rooms), figsize=(3.4 * len(rooms), 4.2), sharey=True, squeeze=False,
-                             FigureClass=PngFigure)
+    fig, axes = subplots(1, len(rooms), figsize=(3.4 * len(rooms), 4.2), sharey=True, squeeze=False)
     x_extra = len(levels) - 0.4
     counts = []
     for ax, n in zip(axes[0], rooms):
@@ -509,7 +508,6 @@ def main(argv=None) -> int:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     for name, fig in comparison_figures(rows, grid).items():
         save_figure(fig, out / f"{name}.png", dpi=110)
-        plt.close(fig)
     entries = claims(rows, grid)
     write_claims(entries, out, args.table, grid, contrasts(rows, grid))
     for seed in grid.seeds:

@@ -9,16 +9,12 @@ from __future__ import annotations
 
 import re
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..core.runfolder import save_figure, write_atomic  # noqa: E402
-from ..pictures.render import PngFigure  # noqa: E402
-from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS  # noqa: E402  (colours: each method's registry entry)
-from ..runs.sweep import summarise  # noqa: E402
+from ..core.runfolder import save_figure, write_atomic
+from ..pictures.render import subplots
+from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS  # colours: each method's registry entry
+from ..runs.sweep import summarise
 
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
@@ -53,8 +49,8 @@ def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=
     summary = summarise(rows)
     tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
     proposers = proposers or _proposers(rows) or ["none"]
-    fig, axes = plt.subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
-                             squeeze=False, FigureClass=PngFigure)
+    fig, axes = subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
+                         squeeze=False)
     width = 0.8 / len(methods)
     for ax, proposer in zip(axes[:, 0], proposers):
         for i, method in enumerate(methods):
@@ -93,8 +89,7 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
     """
     summary = summarise(rows)
     proposers = proposers or _proposers(rows) or ["none"]
-    fig, axes = plt.subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False,
-                             FigureClass=PngFigure)
+    fig, axes = subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
     for ax, proposer in zip(axes[0], proposers):
         for method in methods:
             for subgoals, style in ((False, "-"), (True, "--")):
@@ -153,7 +148,7 @@ def calibration_figure(tables: dict):
     """
     from ..runs.calibrate import coverage
 
-    fig, ax = plt.subplots(figsize=(6.4, 6.0), FigureClass=PngFigure)
+    fig, ax = subplots(figsize=(6.4, 6.0))
     for (label, rows), marker in zip(tables.items(), "osD^v<>"):
         rows = [r for r in rows if r.get("predicted_ci_low") not in (None, "")]
         if not rows:
@@ -200,7 +195,6 @@ def main(argv=None) -> int:
     for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
         fig = make(rows)
         save_figure(fig, out / f"{name}.png", dpi=110)
-        plt.close(fig)
     write_atomic(out / "summary.md", markdown_table(rows) + "\n")
     print(f"{len(rows)} rows -> {out}/figure4.png, figure5.png, figure6.png, summary.md")
     return 0

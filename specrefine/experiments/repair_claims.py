@@ -185,7 +185,6 @@ def main(argv=None) -> int:
     write_atomic(args.out / "summary.md", result.summary() + "\n")
     for name, fig in cmp.comparison_figures(rows, GRID).items():
         save_figure(fig, args.out / f"{name}.png", dpi=110)
-        cmp.plt.close(fig)
     partial = sum(not e["complete"] for e in result.entries)
     print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, summary.md, figures "
           f"({partial} of {len(result.entries)} entries partial)")

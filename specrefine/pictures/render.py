@@ -41,6 +41,12 @@ class PngFigure(Figure):
     def _repr_png_(self):
         return to_png(self)
 
+
+def subplots(nrows: int = 1, ncols: int = 1, *, figsize, **kwargs):
+    """``(fig, axes)`` like ``pyplot.subplots``, on a :class:`PngFigure`: no pyplot state, nothing to close."""
+    fig = PngFigure(figsize=figsize)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
+
 WALL = "black"
 HAZARD = "#8e24aa"  # purple: hazard cells '~'
 START = "#00c8e6"  # cyan
@@ -54,8 +60,9 @@ PATH = "#1f4fff"
 DPI = 100
 
 __all__ = [
-    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "draw_walls", "draw_hazards",
-    "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints", "draw_points",
+    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "subplots", "PngFigure", "draw_walls",
+    "draw_hazards", "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints",
+    "draw_points",
 ]
 
 

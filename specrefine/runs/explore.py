@@ -62,7 +62,6 @@ def draw_step(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: 
 def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int = 640):
     """An ipywidgets slider that redraws the search at each recorded step."""
     import ipywidgets as widgets
-    import matplotlib.pyplot as plt
     from IPython.display import display
 
     out = widgets.Output()
@@ -74,7 +73,6 @@ def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int 
             out.clear_output(wait=True)
             fig = draw_step(maze, steps, input_graph, slider.value, size_px)
             display(fig)
-            plt.close(fig)
 
     slider.observe(show, names="value")
     show()
