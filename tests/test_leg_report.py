@@ -1,12 +1,7 @@
-"""scripts/leg_report.py: legs per room and per-leg failure pool episodes over seeds."""
-import importlib.util
-from pathlib import Path
-
+"""specrefine.experiments.legs: legs per room and per-leg failure pool episodes over seeds."""
 import pytest
 
-_spec = importlib.util.spec_from_file_location("leg_report", Path(__file__).parents[1] / "scripts" / "leg_report.py")
-legs = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(legs)
+from specrefine.experiments import legs
 
 
 def _run(seed, rate, path_edges):

@@ -109,7 +109,7 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
         ax.set_xticks(range(1, 6))
         ax.grid(alpha=0.3)
         ax.set_title(proposer_label(proposer, rows), fontsize=10)
-        if not legend_outside:
+        if not legend_outside and ax.get_legend_handles_labels()[0]:  # a panel without runs has no legend
             ax.legend(fontsize=7)
     if legend_outside:  # gathered from every panel: a proposer's panel may have no runs yet
         handles = {label: h for ax in axes[0] for h, label in zip(*ax.get_legend_handles_labels())}

@@ -1,8 +1,8 @@
 """Legs per room, per-leg failure and cost of the runs of sweep tables, one markdown line per (maze, method, proposer,
 policy) pooled over seeds (issue 30: where a long chain loses its episodes).
 
-    python scripts/leg_report.py data/results/ant/comparison.csv --method ours --proposer geometric
-    python scripts/leg_report.py data/results/ant/levers_*.csv
+    python -m specrefine.experiments.legs data/results/ant/comparison.csv --method ours --proposer geometric
+    python -m specrefine.experiments.legs data/results/ant/levers_*.csv
 
 Per-leg failure is 1 - s^(1/L) with s the pooled success and L the mean number of legs on the measured paths: what
 each leg would lose if legs failed independently and alike. Rooms: N of a ``u_chain_N`` maze (blank otherwise).
@@ -11,10 +11,10 @@ import argparse
 import re
 import sys
 
-from specrefine.core.argtypes import exit_code_quiet_on_broken_pipe
-from specrefine.core.errors import SpecrefineError
-from specrefine.core.results import wilson_ci
-from specrefine.runs.sweep import is_done, read_checked_table
+from ..core.argtypes import exit_code_quiet_on_broken_pipe
+from ..core.errors import SpecrefineError
+from ..core.results import wilson_ci
+from ..runs.sweep import is_done, read_checked_table
 
 HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | legs | legs per room | per-leg failure | "
           "evaluations | sim steps | wall s |\n|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -51,7 +51,7 @@ def report(tables, method=None, proposer=None) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
     ap.add_argument("tables", nargs="+")
     ap.add_argument("--method")
     ap.add_argument("--proposer")

@@ -1,0 +1,64 @@
+"""specrefine.experiments.scaling: the scaling grid's two decision rules on synthetic tables."""
+import csv
+
+import pytest
+
+from specrefine.experiments import scaling
+from specrefine.runs.sweep import COLUMNS
+
+
+def _row(maze, method, proposer, seed, rate, legs=10):
+    return {"cell": f"{maze}-{method}-{proposer}-{seed}", "maze": maze, "agent": "ant", "method": method,
+            "proposer": proposer, "seed": seed, "status": "ok", "success_rate": rate, "episodes": 200,
+            "path_edges": legs, "evaluations": 10, "sim_steps": 100, "wall_seconds": 1.0, "policy": "/x/ant_stage5.pt",
+            "success_ci_low": 0.0, "success_ci_high": 1.0, "graph_vertices": 5, "spec": ""}
+
+
+def _rows(ours_rate, oneshot_rate=0.3, repair_rate=None, zero=None):
+    rows = []
+    for maze in scaling.MAZES:
+        for seed in scaling.SEEDS:
+            rate = ours_rate(maze) if callable(ours_rate) else ours_rate
+            rows.append(_row(maze, "ours", scaling.ORACLE, seed, rate))
+            rows.append(_row(maze, "ours", scaling.ERRING, seed, 0.0 if (maze, seed) == zero else rate))
+            rows.append(_row(maze, "vlm-oneshot", scaling.ERRING, seed, oneshot_rate))
+            if repair_rate is not None:
+                rows.append(_row(maze, "ours-repair", scaling.ERRING, seed, repair_rate))
+    return rows
+
+
+def test_flat_at_the_level_holds_only_when_every_maze_is_above_it_and_the_change_is_flat():
+    assert scaling.flat_claim(_rows(0.93))["verdict"] == "holds"
+    below = scaling.flat_claim(_rows(lambda m: 0.85 if m == "u_chain_3" else 0.93))
+    assert below["verdict"] == "not met" and below["below_level"] == ["u_chain_3"]
+    falling = scaling.flat_claim(_rows(lambda m: 1.0 - 0.02 * scaling.rooms(m)))  # all >= 0.90, -0.08 over 4 rooms
+    assert falling["change_verdict"] == "falls" and falling["verdict"] == "not met"
+    assert falling["change_1_to_5"] == pytest.approx(-0.08)
+
+
+def test_a_missing_cell_makes_the_verdict_partial():
+    rows = [r for r in _rows(0.93) if not (r["maze"] == "u_chain_5" and r["seed"] == 2)]
+    assert scaling.flat_claim(rows)["verdict"].startswith("partial")
+
+
+def test_erring_rule_takes_the_better_method_per_maze_and_counts_zeros_where_the_one_shot_is_high():
+    held = scaling.erring_claim(_rows(0.7, oneshot_rate=0.3, repair_rate=0.2))
+    assert held["verdict"] == "holds" and held["ratio"] == pytest.approx(0.7 / 0.3)
+    assert {c["method"] for c in held["chosen"].values()} == {"ours"}
+    repaired = scaling.erring_claim(_rows(0.2, oneshot_rate=0.3, repair_rate=0.7))
+    assert {c["method"] for c in repaired["chosen"].values()} == {"ours-repair"}
+    zero = scaling.erring_claim(_rows(0.9, oneshot_rate=0.6, repair_rate=0.1, zero=("u_chain_2", 1)))
+    assert zero["zeros"] == ["u_chain_2 seed 1"] and zero["verdict"] == "not met"  # ratio 1.5 too
+
+
+def test_the_command_writes_claims_legs_and_figure(tmp_path):
+    table = tmp_path / "t.csv"
+    with table.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(_rows(0.93, repair_rate=0.5))
+    assert scaling.main([str(table), "--out", str(tmp_path / "out")]) == 0
+    claims = (tmp_path / "out" / "claims.md").read_text()
+    assert "holds" in claims and "u_chain_5_subgoals" in claims
+    assert (tmp_path / "out" / "figure5.png").stat().st_size > 0
+    assert "| u_chain_3 |" in (tmp_path / "out" / "legs.md").read_text()
