@@ -183,6 +183,18 @@ GEOMETRIC_48 = "geometric:max_waypoints=48"
 
 GRIDS = {g.name: g for g in (
     ExperimentGrid(
+        "paper-sweep", "data/results/README.md, the point sweep (the paper's Figures 4-6)", "point",
+        parts=(Part(("dirl", "symbolic", "vlm-oneshot", "ours"), ("geometric", "random")),), seeds=(0, 1, 2, 3),
+        code="d712821", table="data/results/results.csv", out="runs/sweep_full"),
+    ExperimentGrid(
+        "ant-uchain-stage3", "docs/ant_experiments.md, section 2 (stage 3; restarted as ant-comparison)", "ant",
+        parts=(Part(("ours",), ("geometric",)),), seeds=(0, 1, 2), mazes=U_CHAINS + SUBGOALS, evaluation="adaptive",
+        workers=1, code="9031f3b", table="data/results/ant/uchain.csv", out="runs/ant_uchain"),
+    ExperimentGrid(
+        "ant-baselines", "data/results/README.md, ant/baselines.csv (stage 3, not resumed)", "ant",
+        parts=(Part(("dirl", "symbolic", "vlm-oneshot"), ("geometric",)),), seeds=(0, 1, 2), evaluation="fixed",
+        workers=1, code="fd0ee3b", table="data/results/ant/baselines.csv", out="runs/ant_baselines"),
+    ExperimentGrid(
         "point-comparison", "docs/proposers.md, 'The comparison' and 'The controls, redefined'", "point",
         parts=(Part(("ours", "ours-nosearchvertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"), IMPERFECT),
                Part(CONTROLS, IMPERFECT, split="methods")),
