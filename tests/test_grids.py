@@ -94,7 +94,7 @@ def _dry_run(name: str, **env) -> list[str]:
 
 
 def test_run_grid_dry_run_prints_the_old_scripts_commands():
-    # scripts/repair_grid.sh and scripts/ant_scaling_grid.sh as they ran (CODE given, WORKERS unset)
+    # the deleted scripts/repair_grid.sh and scripts/ant_scaling_grid.sh as they ran (CODE given, WORKERS unset)
     repair = [f"CODE=410997e OUT=runs/repair SHIPPED=data/results/repair/results.csv bash scripts/pinned_sweep.sh "
               f"--agent point --workers 1 --methods ours ours-repair vlm-oneshot --proposers imperfect:{preset} "
               f"--seeds 0 1 2 3" for preset in ("moderate", "severe", "mild")]
