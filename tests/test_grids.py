@@ -50,11 +50,27 @@ def test_every_table_belongs_to_one_grid():
     assert len(tables) == len(set(tables))
 
 
+def _git(*args) -> subprocess.CompletedProcess:
+    return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
+
+
+PINNED = [g for g in grids.GRIDS.values() if g.code]
+
+
 @pytest.mark.skipif(not (ROOT / ".git").exists(), reason="not a git checkout")
-@pytest.mark.parametrize("code", sorted({g.code for g in grids.GRIDS.values() if g.code}))
-def test_every_pinned_code_is_a_commit_of_this_repository(code):
-    done = subprocess.run(["git", "cat-file", "-t", code], cwd=ROOT, capture_output=True, text=True)
-    assert done.stdout.strip() == "commit"
+@pytest.mark.parametrize("g", PINNED, ids=[g.name for g in PINNED])
+def test_the_pinned_code_takes_the_grids_arguments(g):
+    """The commit's own sweep knows every option and method the grid passes it, and what scripts/pinned_sweep.sh
+    reads from it to ship the table."""
+    assert _git("cat-file", "-t", g.code).stdout.strip() == "commit"
+    moved = _git("cat-file", "-e", f"{g.code}:specrefine/runs/sweep.py").returncode == 0  # the sub-package layout
+    module = "specrefine/runs/sweep.py" if moved else "specrefine/sweep.py"
+    source = _git("show", f"{g.code}:{module}").stdout
+    options = {a for i in range(len(g.parts)) for args in grids.sweep_args(g, i) for a in args if a.startswith("--")}
+    assert all(f'"{option}"' in source for option in options)
+    assert "def is_done" in source and "_typed" in source
+    for method in g.methods:
+        assert _git("grep", "-q", f'"{method}"', g.code, "--", "specrefine").returncode == 0, method
 
 
 @pytest.mark.parametrize("name", list(grids.GRIDS))

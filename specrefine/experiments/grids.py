@@ -191,10 +191,6 @@ GRIDS = {g.name: g for g in (
         parts=(Part(("ours",), ("geometric",)),), seeds=(0, 1, 2), mazes=U_CHAINS + SUBGOALS, evaluation="adaptive",
         workers=1, code="9031f3b", table="data/results/ant/uchain.csv", out="runs/ant_uchain"),
     ExperimentGrid(
-        "ant-baselines", "data/results/README.md, ant/baselines.csv (stage 3, not resumed)", "ant",
-        parts=(Part(("dirl", "symbolic", "vlm-oneshot"), ("geometric",)),), seeds=(0, 1, 2), evaluation="fixed",
-        workers=1, code="fd0ee3b", table="data/results/ant/baselines.csv", out="runs/ant_baselines"),
-    ExperimentGrid(
         "point-comparison", "docs/proposers.md, 'The comparison' and 'The controls, redefined'", "point",
         parts=(Part(("ours", "ours-nosearchvertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"), IMPERFECT),
                Part(CONTROLS, IMPERFECT, split="methods")),
