@@ -112,6 +112,11 @@ def _policy(g: ExperimentGrid, part: Part, root: Path) -> str:
     return str(root / policy)
 
 
+def _budget(g: ExperimentGrid) -> dict:
+    """The rollouts and episodes the grid passes the sweep (those it leaves to the sweep's defaults: none)."""
+    return {name: value for name, value in (("rollouts", g.rollouts), ("episodes", g.episodes)) if value}
+
+
 def _part(g: ExperimentGrid, index: int) -> Part:
     if not 0 <= index < len(g.parts):
         raise GridError(f"grid {g.name} has parts 0-{len(g.parts) - 1}, not {index}")
@@ -126,8 +131,8 @@ def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int
         common += ["--evaluation", g.evaluation]
     if (policy := _policy(g, part, root)) != "shipped":
         common += ["--policy", policy]
-    for name, value in (("rollouts", g.rollouts), ("episodes", g.episodes)):
-        common += [f"--{name}", str(value)] if value else []
+    for name, value in _budget(g).items():
+        common += [f"--{name}", str(value)]
     common += ["--workers", str(workers or g.workers)]
     out = []
     for axes in _steps(g, part):
@@ -159,7 +164,7 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      **{k: v for k, v in (("rollouts", g.rollouts), ("episodes", g.episodes)) if v})
+                      **_budget(g))
     return list(dict.fromkeys(cells))
 
 
@@ -283,10 +288,6 @@ def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) 
     return lines
 
 
-def _cell_count(g: ExperimentGrid) -> int:
-    return len(cells(g))
-
-
 def main(argv=None) -> int:
     from ..core.argtypes import OneLineParser, bounded_int
 
@@ -309,7 +310,7 @@ def main(argv=None) -> int:
     try:
         if args.command == "list":
             for g in GRIDS.values():
-                print(f"{g.name}\t{g.agent}\t{_cell_count(g)} cells\t{g.doc}")
+                print(f"{g.name}\t{g.agent}\t{len(cells(g))} cells\t{g.doc}")
             return 0
         g = get(args.grid)
         if args.command == "show":
