@@ -1,4 +1,4 @@
-"""Fold the controls' rerun (scripts/controls_grid.sh) into the offline comparison's table (issue 27).
+"""Fold the controls' rerun (bash scripts/run_grid.sh controls) into the offline comparison's table (issue 27).
 
     python scripts/merge_controls.py data/results/imperfect/results.csv data/results/controls/results.csv
 

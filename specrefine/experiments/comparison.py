@@ -16,14 +16,14 @@ is ``complete = False`` and is not the comparison the grid fixed.
 
 ``python -m specrefine.experiments.comparison TABLE --out DIR`` writes the figures, ``claims.md`` and ``claims.json``;
 ``--grid ant`` reads the Ant comparison of docs/ant_experiments.md instead (the paper's four methods, proposers
-``geometric`` and ``imperfect:moderate``, seeds 0-2; the claims on ``ours`` and ``vlm-oneshot``).
+``geometric`` and ``imperfect:moderate``, seeds 0-2; the claims on ``ours`` and ``vlm-oneshot``), ``--grid NAME``
+any grid of ``specrefine.experiments.grids`` with claim methods; a grid's cells are that module's.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -32,13 +32,22 @@ from ..core.runfolder import save_figure, write_atomic
 from ..pictures.render import subplots
 from ..runs.sweep import is_done, mean_std
 from .figures import METHOD_COLOURS, figure4, figure5, proposer_label
+from .grids import GRIDS as REGISTRY
+from .grids import ExperimentGrid as Grid
+from .grids import cells as run_cells
 
-COMPARISON_METHODS = ["ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
-                      "vlm-oneshot", "vlm-oneshot-matched"]
-ERROR_LEVELS = ["imperfect:mild", "imperfect:moderate", "imperfect:severe"]  # alpha = 0: the x axis, in order
-ALPHA_PRESET = "imperfect:moderate,alpha=0.1"  # builds the paper's hypothesis into the model: shown apart
-PRESETS = ERROR_LEVELS + [ALPHA_PRESET]
-SEEDS = (0, 1, 2, 3)
+#: The offline comparison of docs/proposers.md (point mass, eight methods, four presets, four seeds).
+POINT_GRID = REGISTRY["point-comparison"]
+#: The Ant comparison of docs/ant_experiments.md section 3: the paper's methods, claims on ours and one-shot.
+ANT_GRID = REGISTRY["ant-comparison"]
+#: ``--grid``: the two comparisons by their short names, and every grid of the registry with claim methods
+GRIDS = {"point": POINT_GRID, "ant": ANT_GRID} | {name: g for name, g in REGISTRY.items() if g.claim_methods}
+COMPARISON_METHODS = list(POINT_GRID.methods)
+ERROR_LEVELS = list(POINT_GRID.levels)  # alpha = 0: the x axis, in order
+PRESETS = list(POINT_GRID.proposers)
+#: imperfect:moderate,alpha=0.1 builds the paper's hypothesis into the model: shown apart from the levels
+ALPHA_PRESET = next(p for p in PRESETS if p not in ERROR_LEVELS)
+SEEDS = POINT_GRID.seeds
 U_CHAIN_ROOMS = {n: f"u_chain_{n}" for n in range(1, 6)}  # rooms -> the maze without subgoals
 
 #: The multi-room tasks of claim (i): the U-chains of 2-5 rooms, with and without subgoals at the doorways.
@@ -56,29 +65,6 @@ BOOTSTRAP_RESAMPLES = 10_000
 BOOTSTRAP_SEED = 0
 
 
-
-@dataclass(frozen=True)
-class Grid:
-    """A comparison's fixed grid: whose rows, which methods (figures) and which of them the claims test,
-    which proposers and seeds; ``levels``: the error levels of the error-level figure (none: no such figure)."""
-    agent: str
-    methods: tuple
-    claim_methods: tuple
-    proposers: tuple
-    seeds: tuple
-    levels: tuple = ()
-    contrasts: tuple = ()  # (first, second) method pairs: paired differences on the multi-room cells (descriptive)
-
-
-#: The offline comparison of docs/proposers.md (point mass, eight methods, four presets, four seeds).
-POINT_GRID = Grid("point", tuple(COMPARISON_METHODS), tuple(COMPARISON_METHODS), tuple(PRESETS), SEEDS,
-                  tuple(ERROR_LEVELS), (("vlm-oneshot-matched", "vlm-oneshot"), ("ours", "ours-novertex"),
-                                        ("ours", "ours-nosearchvertex"), ("ours", "ours-notune"),
-                                        ("ours", "ours-nofeedback"), ("ours", "ours-d1")))
-#: The Ant comparison of docs/ant_experiments.md section 3: the paper's methods, claims on ours and one-shot.
-ANT_GRID = Grid("ant", ("dirl", "symbolic", "vlm-oneshot", "ours"), ("ours", "vlm-oneshot"),
-                ("geometric", "imperfect:moderate"), (0, 1, 2))
-GRIDS = {"point": POINT_GRID, "ant": ANT_GRID}
 
 RATIO_CLAIM_TEXT = "ours >= 2x one-shot on multi-room tasks"
 ROOMS_CLAIM_TEXT = "success over 1-5 rooms"  # the paper: flat for ours, falling for vlm-oneshot
@@ -381,14 +367,9 @@ def comparison_figures(rows, grid: Grid = POINT_GRID) -> dict:
 
 
 def grid_cells(grid: Grid = POINT_GRID) -> set:
-    """The fixed grid's (maze, method, proposer, seed) keys: every maze in data/mazes; a method without a
-    proposer (dirl, symbolic) once per seed, with proposer ``none``, as ``specrefine.runs.sweep`` runs it."""
-    from ..core.mazes import benchmark_mazes
-    from ..runs.pipeline import PROPOSER_METHODS
-
-    return {(maze, method, proposer if method in PROPOSER_METHODS else "none", seed)
-            for maze in benchmark_mazes() for method in grid.methods for proposer in grid.proposers
-            for seed in grid.seeds}
+    """The fixed grid's (maze, method, proposer, seed) keys (``grids.cells``: a method without a proposer, dirl or
+    symbolic, once per seed, with proposer ``none``, as ``specrefine.runs.sweep`` runs it)."""
+    return {(c.maze, c.method, c.proposer, c.seed) for c in run_cells(grid)}
 
 
 def expected_cells(grid: Grid = POINT_GRID) -> int:
@@ -498,7 +479,8 @@ def main(argv=None) -> int:
                    help="folder for figure4.png, figure5.png, error_levels.png, claims.md, claims.json and "
                         "seedS.md (one table per seed)")
     p.add_argument("--grid", choices=sorted(GRIDS), default="point",
-                   help="point: docs/proposers.md's comparison (default); ant: docs/ant_experiments.md section 3")
+                   help="point: docs/proposers.md's comparison (default); ant: docs/ant_experiments.md section 3; "
+                        "or a grid of specrefine.experiments.grids with claim methods")
     args = p.parse_args(argv)
     grid = GRIDS[args.grid]
     try:

@@ -24,11 +24,12 @@ from ..core.mazes import benchmark_mazes
 from ..core.runfolder import ensure_dir, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
+from .grids import GRIDS
 
-PRESETS = ("imperfect:moderate", "imperfect:severe", "imperfect:mild")  # the order they run in
-METHODS = ("ours", "ours-repair", "vlm-oneshot")
-SEEDS = (0, 1, 2, 3)
-GRID = cmp.Grid("point", METHODS, METHODS, PRESETS, SEEDS, levels=tuple(cmp.ERROR_LEVELS))  # for the figures
+GRID = GRIDS["repair"]
+PRESETS = GRID.proposers  # the order they run in
+METHODS = GRID.methods
+SEEDS = GRID.seeds
 REPAIR_CLAIM = "ours-repair - ours"
 
 

@@ -493,7 +493,8 @@ def _check_policy(policy: str, agent: str) -> str | None:
     return None
 
 
-def main(argv=None) -> int:
+def parser() -> OneLineParser:
+    """The sweep's command line."""
     from ..core.mazes import benchmark_mazes
     from .pipeline import METHODS
 
@@ -523,10 +524,20 @@ def main(argv=None) -> int:
                         "Ray) (default: local)")
     p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
+    return p
+
+
+def cells_of(args) -> list[Cell]:
+    """The cells of parsed sweep arguments (a relative ``--policy`` is taken from the working directory)."""
+    return grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
+                episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
+                policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
+
+
+def main(argv=None) -> int:
+    p = parser()
     args = p.parse_args(argv)
-    cells = grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
-                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
-                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
+    cells = cells_of(args)
     bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
         return _fail(bad, 2)

@@ -1,0 +1,333 @@
+"""Every grid this project has run or fixed, defined once: read by ``scripts/run_grid.sh`` (which runs it through
+``scripts/pinned_sweep.sh``) and by the analysis of its table (``comparison``, ``repair_claims``).
+
+A grid is parts run in order; a part is one sweep, or one sweep per value of one axis (``split``: seed by seed,
+say, so that a table cut short holds whole seeds). ``sweep_args`` gives the ``specrefine.runs.sweep`` arguments of
+each step (without ``--out``), ``cells`` the cells they run. The arguments are those of the old per-grid scripts,
+option for option, so that a grid pinned to an old commit (``code``) resumes its shipped table with the same cell
+ids and parameters (``OUT/sweep.json`` refuses a cell run with another policy, rollouts or episodes)::
+
+    python -m specrefine.experiments.grids list                      # name, agent, cells, where it was fixed
+    python -m specrefine.experiments.grids show ant-comparison       # the pinned_sweep.sh commands, in order
+    python -m specrefine.experiments.grids args repair --part 0 --step 1    # one step's arguments, shell-quoted
+    python -m specrefine.experiments.grids plan repair               # what run_grid.sh reads
+"""
+
+from __future__ import annotations
+
+import shlex
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..core.errors import SpecrefineError
+from ..runs.sweep import Cell, grid
+
+ROOT = Path(__file__).resolve().parents[2]  # the checkout: a grid's paths are relative to it
+SPLITS = ("", "mazes", "methods", "proposers", "seeds")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One sweep of a grid (or one per value of ``split``), into ``table`` (None: the grid's) and the sweep folder
+    OUT/``out`` (None: the grid's OUT itself). None for ``seeds``, ``mazes``, ``policy``: the grid's."""
+    methods: tuple
+    proposers: tuple
+    seeds: tuple | None = None
+    mazes: tuple | None = None
+    split: str = ""
+    policy: str | None = None
+    table: str | None = None
+    out: str | None = None
+
+
+@dataclass(frozen=True)
+class ExperimentGrid:
+    """A grid: what its sweeps run (``parts``, in order), with which code, into which tables, and what its analysis
+    reads (``claim_methods``, ``levels``, ``contrasts``; ``figure_methods``: the methods' order in figures and tables,
+    empty = run order)."""
+    name: str
+    doc: str  # where it was fixed: file and section
+    agent: str
+    parts: tuple
+    seeds: tuple
+    mazes: tuple | None = None  # None: every maze of data/mazes (the sweep's default, in the code that runs it)
+    policy: str = "shipped"  # or a checkout-relative path to a checkpoint
+    policy_in_checkout: bool = False  # the checkout's copy (an absolute path), not the pinned code tree's
+    evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
+    rollouts: int | None = None  # None: the sweep's default (not passed)
+    episodes: int | None = None
+    workers: int = 2
+    code: str | None = None  # the commit it runs with (scripts/pinned_sweep.sh); None: the checkout's HEAD
+    table: str | None = None  # the shipped table (data/results/...), for parts without their own
+    out: str = "runs/sweep"  # the sweep folder, under which parts with their own ``out`` sit
+    claim_methods: tuple = ()
+    figure_methods: tuple = ()
+    levels: tuple = ()
+    contrasts: tuple = ()
+
+    @property
+    def methods(self) -> tuple:
+        return self.figure_methods or tuple(dict.fromkeys(m for part in self.parts for m in part.methods))
+
+    @property
+    def proposers(self) -> tuple:
+        return tuple(dict.fromkeys(p for part in self.parts for p in part.proposers))
+
+    @property
+    def tables(self) -> tuple:
+        return tuple(dict.fromkeys(self.part_table(i) for i in range(len(self.parts))))
+
+    def part_table(self, index: int) -> str:
+        return self.parts[index].table or self.table
+
+    def part_out(self, index: int, out: str | None = None) -> str:
+        """The sweep folder of a part: OUT (the grid's, or ``out``) or its sub-folder."""
+        base = out or self.out
+        return f"{base}/{self.parts[index].out}" if self.parts[index].out else base
+
+
+class GridError(SpecrefineError, ValueError):
+    """An unknown grid, part or step."""
+
+
+def _axes(g: ExperimentGrid, part: Part) -> dict:
+    return {"mazes": part.mazes if part.mazes is not None else g.mazes, "methods": part.methods,
+            "proposers": part.proposers, "seeds": part.seeds if part.seeds is not None else g.seeds}
+
+
+def _steps(g: ExperimentGrid, part: Part) -> list[dict]:
+    """The axes of each sweep of a part, in order."""
+    axes = _axes(g, part)
+    if not part.split:
+        return [axes]
+    return [axes | {part.split: (value,)} for value in axes[part.split]]
+
+
+def _policy(g: ExperimentGrid, part: Part, root: Path) -> str:
+    """The --policy argument: 'shipped', the checkout's absolute path, or a path the sweep takes from its working
+    directory, the pinned code tree."""
+    policy = part.policy or g.policy
+    if policy == "shipped" or not g.policy_in_checkout:
+        return policy
+    return str(root / policy)
+
+
+def _budget(g: ExperimentGrid) -> dict:
+    """The rollouts and episodes the grid passes the sweep (those it leaves to the sweep's defaults: none)."""
+    return {name: value for name, value in (("rollouts", g.rollouts), ("episodes", g.episodes)) if value}
+
+
+def _part(g: ExperimentGrid, index: int) -> Part:
+    if not 0 <= index < len(g.parts):
+        raise GridError(f"grid {g.name} has parts 0-{len(g.parts) - 1}, not {index}")
+    return g.parts[index]
+
+
+def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int | None = None) -> list[list[str]]:
+    """The ``specrefine.runs.sweep`` arguments (no ``--out``) of each step of part ``index``, in order."""
+    part = _part(g, index)
+    common = ["--agent", g.agent]
+    if g.evaluation:
+        common += ["--evaluation", g.evaluation]
+    if (policy := _policy(g, part, root)) != "shipped":
+        common += ["--policy", policy]
+    for name, value in _budget(g).items():
+        common += [f"--{name}", str(value)]
+    common += ["--workers", str(workers or g.workers)]
+    out = []
+    for axes in _steps(g, part):
+        args = list(common)
+        if axes["mazes"] is not None:
+            args += ["--mazes", *axes["mazes"]]
+        args += ["--methods", *axes["methods"], "--proposers", *axes["proposers"],
+                 "--seeds", *map(str, axes["seeds"])]
+        out.append(args)
+    return out
+
+
+def _recorded_policy(g: ExperimentGrid, part: Part, root: Path) -> str:
+    """The policy a cell records when run by run_grid.sh from the checkout ``root``: a relative path is the pinned
+    code tree's (scripts/pinned_sweep.sh runs the sweep in runs/code_CODE)."""
+    policy = _policy(g, part, root)
+    if policy == "shipped" or Path(policy).is_absolute():
+        return policy
+    return str(root / "runs" / f"code_{g.code}" / policy)
+
+
+def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell]:
+    """The cells of part ``index``, in the order its sweeps run them (a cell run by an earlier step counts once)."""
+    from ..core.mazes import benchmark_mazes
+
+    part = _part(g, index)
+    cells = []
+    for axes in _steps(g, part):
+        mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
+        cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
+                      evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
+                      **_budget(g))
+    return list(dict.fromkeys(cells))
+
+
+def cells(g: ExperimentGrid, *, root: Path = ROOT, table: str | None = None) -> list[Cell]:
+    """Every cell of the grid (or of the parts writing ``table``), in run order, each once."""
+    return list(dict.fromkeys(c for i in range(len(g.parts)) if table in (None, g.part_table(i))
+                              for c in part_cells(g, i, root=root)))
+
+
+def get(name: str) -> ExperimentGrid:
+    if name not in GRIDS:
+        raise GridError(f"no grid {name!r}; grids: {', '.join(GRIDS)}")
+    return GRIDS[name]
+
+
+IMPERFECT = ("imperfect:mild", "imperfect:moderate", "imperfect:severe", "imperfect:moderate,alpha=0.1")
+CONTROLS = ("ours-novertex", "ours-notune", "ours-nofeedback")
+U_CHAINS = tuple(f"u_chain_{n}" for n in range(1, 6))
+SUBGOALS = tuple(f"u_chain_{n}_subgoals" for n in range(2, 6))
+GEOMETRIC_48 = "geometric:max_waypoints=48"
+
+GRIDS = {g.name: g for g in (
+    ExperimentGrid(
+        "paper-sweep", "data/results/README.md, the point sweep (the paper's Figures 4-6)", "point",
+        parts=(Part(("dirl", "symbolic", "vlm-oneshot", "ours"), ("geometric", "random")),), seeds=(0, 1, 2, 3),
+        code="d712821", table="data/results/results.csv", out="runs/sweep_full"),
+    ExperimentGrid(
+        "ant-uchain-stage3", "docs/ant_experiments.md, section 2 (stage 3; restarted as ant-comparison)", "ant",
+        parts=(Part(("ours",), ("geometric",)),), seeds=(0, 1, 2), mazes=U_CHAINS + SUBGOALS, evaluation="adaptive",
+        workers=1, code="9031f3b", table="data/results/ant/uchain.csv", out="runs/ant_uchain"),
+    ExperimentGrid(
+        "point-comparison", "docs/proposers.md, 'The comparison' and 'The controls, redefined'", "point",
+        parts=(Part(("ours", "ours-nosearchvertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"), IMPERFECT),
+               Part(CONTROLS, IMPERFECT, split="methods")),
+        seeds=(0, 1, 2, 3), code="309875a", table="data/results/imperfect/results.csv",
+        out="runs/imperfect_comparison", claim_methods=(
+            "ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
+            "vlm-oneshot", "vlm-oneshot-matched"),
+        figure_methods=("ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
+                        "vlm-oneshot", "vlm-oneshot-matched"),
+        levels=IMPERFECT[:3], contrasts=(("vlm-oneshot-matched", "vlm-oneshot"), ("ours", "ours-novertex"),
+                                         ("ours", "ours-nosearchvertex"), ("ours", "ours-notune"),
+                                         ("ours", "ours-nofeedback"), ("ours", "ours-d1"))),
+    ExperimentGrid(
+        "controls", "docs/proposers.md, 'The controls, redefined' (issue 27)", "point",
+        parts=(Part(CONTROLS, IMPERFECT, split="methods"),), seeds=(0, 1, 2, 3), code="309875a",
+        table="data/results/controls/results.csv", out="runs/controls"),
+    ExperimentGrid(
+        "repair", "docs/proposers.md, 'Look-ahead repair'", "point",
+        parts=(Part(("ours", "ours-repair", "vlm-oneshot"),
+                    ("imperfect:moderate", "imperfect:severe", "imperfect:mild"), split="proposers"),),
+        seeds=(0, 1, 2, 3), workers=1, code="410997e", table="data/results/repair/results.csv", out="runs/repair",
+        claim_methods=("ours", "ours-repair", "vlm-oneshot"), levels=IMPERFECT[:3]),
+    ExperimentGrid(
+        "repair-tuned", "docs/proposers.md, 'Tuning a repaired chain'", "point",
+        parts=(Part(("ours-repair", "ours-repair-tuned"), ("imperfect:moderate", "imperfect:severe"),
+                    split="proposers"),),
+        seeds=(0, 1, 2, 3), workers=1, code="e72df7a", table="data/results/repair/tuned.csv", out="runs/repair_tuned"),
+    ExperimentGrid(
+        "ant-comparison", "docs/ant_experiments.md, sections 2, 3 and 3a", "ant",
+        parts=(Part(("ours",), ("geometric",), mazes=U_CHAINS + SUBGOALS),
+               Part(("dirl", "symbolic", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate"), split="seeds")),
+        seeds=(0, 1, 2), policy="data/policies/ant_stage4.pt", policy_in_checkout=True, evaluation="adaptive",
+        code="92ee10e", table="data/results/ant/comparison.csv", out="runs/ant_comparison",
+        claim_methods=("ours", "vlm-oneshot"), figure_methods=("dirl", "symbolic", "vlm-oneshot", "ours")),
+    ExperimentGrid(
+        "ant-levers", "docs/ant_experiments.md, section 4 (issue 30)", "ant",
+        parts=tuple(part for maze in ("u_chain_3", "u_chain_5") for part in (
+            Part(("ours",), ("geometric",), mazes=(maze,), policy="data/policies/ant_stage4_heading.pt",
+                 table="data/results/ant/levers_heading.csv", out="heading"),
+            Part(("ours-shortcut",), ("geometric",), mazes=(maze,), table="data/results/ant/levers_shortcut.csv",
+                 out="shortcut"),
+            Part(("ours-repair",), ("imperfect:moderate",), mazes=(maze,),
+                 table="data/results/ant/levers_repair.csv", out="repair"))),
+        seeds=(0, 1, 2), policy="data/policies/ant_stage4.pt", evaluation="adaptive", code="5476420",
+        out="runs/ant_levers"),
+    ExperimentGrid(
+        "ant-levers-stage5", "docs/ant_experiments.md, section 4, 'Stage 5'", "ant",
+        parts=(Part(("ours",), ("geometric",), mazes=("u_chain_3", "u_chain_5"), split="mazes"),),
+        seeds=(0, 1, 2), policy="data/policies/ant_stage5.pt", evaluation="adaptive", code="03f2f78",
+        table="data/results/ant/levers_stage5.csv", out="runs/ant_levers/stage5"),
+    ExperimentGrid(
+        "ant-scaling", "docs/ant_experiments.md, section 5", "ant",
+        parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds", table="data/results/ant/scaling/ours_geometric.csv",
+                    out="ours_geometric"),
+               Part(("vlm-oneshot",), (GEOMETRIC_48, "imperfect:moderate"),
+                    table="data/results/ant/scaling/oneshot.csv", out="oneshot"),
+               Part(("ours", "ours-repair"), ("imperfect:moderate",), split="seeds",
+                    table="data/results/ant/scaling/imperfect.csv", out="imperfect"),
+               Part(("ours-repair",), (GEOMETRIC_48,), table="data/results/ant/scaling/repair_geometric.csv",
+                    out="repair_geometric")),
+        seeds=(0, 1, 2), mazes=("u_chain_1", "u_chain_2", "u_chain_2_subgoals", "u_chain_3",
+                                          "u_chain_3_subgoals", "u_chain_4", "u_chain_4_subgoals", "u_chain_5",
+                                          "u_chain_5_subgoals"), policy="data/policies/ant_stage5.pt",
+        evaluation="adaptive", code="fc93db3", out="runs/ant_scaling"),
+    ExperimentGrid(
+        "antmaze", "docs/official_env.md (issue 28; not run yet)", "ant",
+        parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),
+        seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
+        policy_in_checkout=True, evaluation="adaptive", episodes=200, table="data/results/ant/antmaze.csv",
+        out="runs/antmaze"),
+)}
+
+
+def show(g: ExperimentGrid, root: Path = ROOT) -> list[str]:
+    """The grid's pinned_sweep.sh commands, in the order run_grid.sh runs them."""
+    code = g.code or "HEAD"
+    return [f"CODE={code} OUT={g.part_out(i)} SHIPPED={g.part_table(i)} bash scripts/pinned_sweep.sh "
+            + shlex.join(args) for i in range(len(g.parts)) for args in sweep_args(g, i, root=root)]
+
+
+def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) -> list[str]:
+    """What run_grid.sh reads: 'code COMMIT' (or 'code -': the checkout's HEAD), then 'step PART STEP OUT TABLE'
+    per sweep, in order."""
+    if shipped and len(g.tables) > 1:
+        raise GridError(f"grid {g.name} writes {len(g.tables)} tables: SHIPPED names one table only")
+    lines = [f"code {g.code or '-'}"]
+    for i in range(len(g.parts)):
+        for j in range(len(_steps(g, g.parts[i]))):
+            lines.append(f"step {i} {j} {g.part_out(i, out)} {shipped or g.part_table(i)}")
+    return lines
+
+
+def main(argv=None) -> int:
+    from ..core.argtypes import OneLineParser, bounded_int
+
+    p = OneLineParser(prog="python -m specrefine.experiments.grids", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="every grid: name, agent, cells, where it was fixed")
+    for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),
+                       ("args", "one step's sweep arguments, shell-quoted on one line"),
+                       ("plan", "the code and steps run_grid.sh runs")):
+        sp = sub.add_parser(name, help=what)
+        sp.add_argument("grid")
+        if name == "args":
+            sp.add_argument("--part", type=int, required=True)
+            sp.add_argument("--step", type=int, default=0)
+            sp.add_argument("--workers", type=bounded_int("workers"), default=None)
+        if name == "plan":
+            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it)")
+            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids)")
+    args = p.parse_args(argv)
+    try:
+        if args.command == "list":
+            for g in GRIDS.values():
+                print(f"{g.name}\t{g.agent}\t{len(cells(g))} cells\t{g.doc}")
+            return 0
+        g = get(args.grid)
+        if args.command == "show":
+            print("\n".join(show(g)))
+        elif args.command == "plan":
+            print("\n".join(plan(g, args.out, args.shipped)))
+        else:
+            steps = sweep_args(g, args.part, workers=args.workers)
+            if not 0 <= args.step < len(steps):
+                raise GridError(f"part {args.part} of grid {g.name} has steps 0-{len(steps) - 1}, not {args.step}")
+            print(shlex.join(steps[args.step]))
+    except GridError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    from ..core.argtypes import exit_code_quiet_on_broken_pipe
+
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

@@ -1,0 +1,142 @@
+"""The grid registry: each shipped table holds cells of its grid only (all of them for the finished grids), with the
+grid's rollouts, episodes, evaluation and policy; the sweep arguments parse back to the same cells; the CLI and
+scripts/run_grid.sh (dry run) print what the old per-grid scripts ran."""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from specrefine.experiments import grids
+from specrefine.runs import sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the grids whose every cell has a row (decided from the tables: these ran to the end)
+COMPLETE = {"paper-sweep", "point-comparison", "controls", "repair", "ant-comparison"}
+SHIPPED = [(g, t) for g in grids.GRIDS.values() for t in g.tables if (ROOT / t).exists()]
+
+
+def _rows(table: str) -> list[dict]:
+    with (ROOT / table).open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+@pytest.mark.parametrize("g, table", SHIPPED, ids=[f"{g.name}:{t}" for g, t in SHIPPED])
+def test_a_shipped_table_holds_cells_of_its_grid_with_its_parameters(g, table):
+    expected = {c.id: c for c in grids.cells(g, table=table)}
+    rows = _rows(table)
+    assert {r["cell"] for r in rows} <= set(expected), "rows of cells outside the grid"
+    if g.name in COMPLETE:
+        assert {r["cell"] for r in rows} == set(expected)
+    for row in rows:
+        cell = expected[row["cell"]]
+        assert (int(row["rollouts_per_evaluation"]), int(row["episodes"])) == (cell.rollouts, cell.episodes)
+        assert row.get("evaluation") in (None, cell.evaluation)
+        if row.get("policy") == "shipped" or cell.policy == "shipped":
+            assert row.get("policy") in (None, "shipped") and cell.policy == "shipped"
+        elif row.get("policy"):  # a path from the machine that ran it: the same file of the same tree
+            relative = Path(cell.policy).relative_to(ROOT).as_posix()
+            assert row["policy"].endswith("/" + relative)
+            assert "/runs/" not in row["policy"][:-len(relative)], "a pinned tree's copy where the checkout's ran"
+
+
+def test_every_table_belongs_to_one_grid():
+    tables = [t for g in grids.GRIDS.values() for t in g.tables]
+    assert len(tables) == len(set(tables))
+
+
+def _git(*args) -> subprocess.CompletedProcess:
+    return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
+
+
+PINNED = [g for g in grids.GRIDS.values() if g.code]
+
+
+@pytest.mark.skipif(not (ROOT / ".git").exists(), reason="not a git checkout")
+@pytest.mark.parametrize("g", PINNED, ids=[g.name for g in PINNED])
+def test_the_pinned_code_takes_the_grids_arguments(g):
+    """The commit's own sweep knows every option and method the grid passes it, and what scripts/pinned_sweep.sh
+    reads from it to ship the table."""
+    assert _git("cat-file", "-t", g.code).stdout.strip() == "commit"
+    moved = _git("cat-file", "-e", f"{g.code}:specrefine/runs/sweep.py").returncode == 0  # the sub-package layout
+    module = "specrefine/runs/sweep.py" if moved else "specrefine/sweep.py"
+    source = _git("show", f"{g.code}:{module}").stdout
+    options = {a for i in range(len(g.parts)) for args in grids.sweep_args(g, i) for a in args if a.startswith("--")}
+    assert all(f'"{option}"' in source for option in options)
+    assert "def is_done" in source and "_typed" in source
+    for method in g.methods:
+        assert _git("grep", "-q", f'"{method}"', g.code, "--", "specrefine").returncode == 0, method
+
+
+@pytest.mark.parametrize("name", list(grids.GRIDS))
+def test_sweep_args_parse_back_to_the_grids_cells(name, tmp_path, monkeypatch):
+    g = grids.GRIDS[name]
+    root = tmp_path.resolve()
+    tree = root / "runs" / f"code_{g.code}"
+    tree.mkdir(parents=True)
+    monkeypatch.chdir(tree)  # where scripts/pinned_sweep.sh runs the sweep: a relative --policy is that tree's
+    for i in range(len(g.parts)):
+        steps = grids.sweep_args(g, i, root=root)
+        assert steps and all("--out" not in args for args in steps)
+        parsed = [c for args in steps for c in sweep.cells_of(sweep.parser().parse_args(args))]
+        assert list(dict.fromkeys(parsed)) == grids.part_cells(g, i, root=root)
+
+
+def test_args_cli_prints_one_step_and_refuses_an_unknown_grid(capsys):
+    command = [sys.executable, "-m", "specrefine.experiments.grids", "args", "repair", "--part", "0", "--step", "1"]
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, env=os.environ | {"PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0
+    assert done.stdout == ("--agent point --workers 1 --methods ours ours-repair vlm-oneshot "
+                           "--proposers imperfect:severe --seeds 0 1 2 3\n")
+    for argv in (["args", "nonsense", "--part", "0"], ["show", "nonsense"], ["args", "repair", "--part", "1"],
+                 ["args", "repair", "--part", "0", "--step", "3"]):
+        with pytest.raises(SystemExit) as exit_:
+            grids.main(argv)
+        assert exit_.value.code == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "error:" in err
+
+
+def _dry_run(name: str, **env) -> list[str]:
+    done = subprocess.run(["bash", str(ROOT / "scripts" / "run_grid.sh"), name], capture_output=True, text=True,
+                          env=os.environ | {"DRY_RUN": "1", "PYTHON": sys.executable} | env)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+def test_run_grid_dry_run_prints_the_old_scripts_commands():
+    # the deleted scripts/repair_grid.sh and scripts/ant_scaling_grid.sh as they ran (CODE given, WORKERS unset)
+    repair = [f"CODE=410997e OUT=runs/repair SHIPPED=data/results/repair/results.csv bash scripts/pinned_sweep.sh "
+              f"--agent point --workers 1 --methods ours ours-repair vlm-oneshot --proposers imperfect:{preset} "
+              f"--seeds 0 1 2 3" for preset in ("moderate", "severe", "mild")]
+    assert _dry_run("repair") == repair
+    common = ("--agent ant --evaluation adaptive --policy data/policies/ant_stage5.pt --workers 2 --mazes u_chain_1 "
+              "u_chain_2 u_chain_2_subgoals u_chain_3 u_chain_3_subgoals u_chain_4 u_chain_4_subgoals u_chain_5 "
+              "u_chain_5_subgoals")
+
+    def step(part, args):
+        return (f"CODE=fc93db3 OUT=runs/ant_scaling/{part} SHIPPED=data/results/ant/scaling/{part}.csv "
+                f"bash scripts/pinned_sweep.sh {common} {args}")
+
+    geo48 = "geometric:max_waypoints=48"
+    assert _dry_run("ant-scaling") == (
+        [step("ours_geometric", f"--methods ours --proposers {geo48} --seeds {s}") for s in range(3)]
+        + [step("oneshot", f"--methods vlm-oneshot --proposers {geo48} imperfect:moderate --seeds 0 1 2")]
+        + [step("imperfect", f"--methods ours ours-repair --proposers imperfect:moderate --seeds {s}")
+           for s in range(3)]
+        + [step("repair_geometric", f"--methods ours-repair --proposers {geo48} --seeds 0 1 2")])
+
+
+def test_run_grid_takes_code_out_and_workers_from_the_environment_and_refuses_bad_names():
+    lines = _dry_run("ant-comparison", CODE="abc1234", OUT="/tmp/elsewhere", WORKERS="1")
+    assert len(lines) == 4 and all(line.startswith("CODE=abc1234 OUT=/tmp/elsewhere ") for line in lines)
+    assert all(f"--policy {ROOT}/data/policies/ant_stage4.pt --workers 1 " in line for line in lines)
+    for name, env in (("nonsense", {}), ("ant-scaling", {"SHIPPED": "one.csv"})):
+        done = subprocess.run(["bash", str(ROOT / "scripts" / "run_grid.sh"), name], capture_output=True, text=True,
+                              env=os.environ | {"DRY_RUN": "1", "PYTHON": sys.executable} | env)
+        assert done.returncode == 2 and done.stdout == "" and done.stderr.count("\n") == 1
