@@ -93,3 +93,22 @@ def test_cli_refuses_a_missing_table(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         rc.main([str(tmp_path / "nope.csv"), "--out", str(tmp_path / "out")])
     assert exc.value.code == 2 and "no table" in capsys.readouterr().err
+
+
+def test_tuned_study_pairs_the_tuned_repair_with_the_repair_per_preset(tmp_path):
+    rows = [row(maze, m, 0.0 if (m, maze, seed) == ("ours-repair", "u_chain_3", 0) else
+                (0.8 if m == "ours-repair-tuned" and maze in MULTI_ROOM_MAZES else 0.6), seed, preset)
+            | {"evaluations": 12 if m == "ours-repair-tuned" else 10, "proposer_calls": 3}
+            for preset in rc.TUNED.proposers for maze in sorted(benchmark_mazes()) for m in rc.TUNED_PAIR
+            for seed in rc.TUNED.seeds]
+    entries, cost_rows, text = rc.tuned_study(rows)
+    first = entries[0]
+    assert first["claim"] == "ours-repair-tuned - ours-repair, multi-room" and first["verdict"] == "helps"
+    assert first["complete"] and first["n_cells"] == len(MULTI_ROOM_MAZES) * len(rc.TUNED.seeds)
+    assert cost_rows[0]["zero_runs"] == {"ours-repair-tuned": 0, "ours-repair": 1}
+    assert cost_rows[0]["evaluations_ratio"] == pytest.approx(1.2)
+    assert "ours-repair-tuned / ours-repair: evaluations" in text
+    table = tmp_path / "t.csv"
+    write_csv(table, rows)
+    assert rc.main([str(table), "--tuned", "--out", str(tmp_path / "o")]) == 0
+    assert json.loads((tmp_path / "o" / "tuned_claims.json").read_text())["claims"][0]["verdict"] == "helps"

@@ -33,12 +33,13 @@ SEEDS = GRID.seeds
 REPAIR_CLAIM = "ours-repair - ours"
 
 
-def paired_claim(cells: dict, failed: set, proposer: str, mazes, scope: str) -> dict:
-    """Mean of the paired success difference ours-repair - ours over (maze, seed) cells; helps if its interval
-    lies above 0, hurts if below."""
-    entry = cmp.paired_difference(cells, failed, proposer, "ours-repair", "ours", SEEDS, mazes)
+def paired_claim(cells: dict, failed: set, proposer: str, mazes, scope: str, pair=("ours-repair", "ours"),
+                 seeds=SEEDS) -> dict:
+    """Mean of the paired success difference first - second (ours-repair - ours) over (maze, seed) cells; helps if
+    its interval lies above 0, hurts if below."""
+    entry = cmp.paired_difference(cells, failed, proposer, *pair, seeds, mazes)
     verdict = {"higher": "helps", "lower": "hurts"}.get(entry["verdict"], "undecided")
-    return entry | {"claim": f"{REPAIR_CLAIM}, {scope}", "verdict": verdict}
+    return entry | {"claim": f"{pair[0]} - {pair[1]}, {scope}", "verdict": verdict}
 
 
 def as_ours(cells: dict) -> dict:
@@ -57,16 +58,16 @@ def paper_claims(cells: dict, failed: set, proposer: str) -> list[dict]:
     return [ratio, rooms] + [cmp.rooms_claim(cells, failed, proposer, m, SEEDS) for m in ("ours", "vlm-oneshot")]
 
 
-def costs(rows: list[dict], proposer: str) -> dict:
-    """Descriptive: runs at success 0 per method; ours-repair / ours ratio of mean evaluations and proposer calls
-    over the cells where both ran."""
+def costs(rows: list[dict], proposer: str, pair=("ours-repair", "ours"), methods=METHODS) -> dict:
+    """Descriptive: runs at success 0 per method; first / second (ours-repair / ours) ratio of mean evaluations and
+    proposer calls over the cells where both ran."""
     by = {(r["maze"], r["method"], r["seed"]): r for r in cmp._task_rows(rows, "point")
           if r["proposer"] == proposer and cmp.is_done(r)}
     zeros = {m: sum(1 for (_, method, _), r in by.items() if method == m and r["success_rate"] == 0)
-             for m in METHODS}
-    runs = {m: sum(1 for (_, method, _) in by if method == m) for m in METHODS}
-    pairs = [(by[(maze, "ours-repair", s)], r) for (maze, m, s), r in by.items()
-             if m == "ours" and (maze, "ours-repair", s) in by]
+             for m in methods}
+    runs = {m: sum(1 for (_, method, _) in by if method == m) for m in methods}
+    pairs = [(by[(maze, pair[0], s)], r) for (maze, m, s), r in by.items()
+             if m == pair[1] and (maze, pair[0], s) in by]
 
     def ratio(key):
         return float(np.mean([a[key] for a, _ in pairs]) / np.mean([b[key] for _, b in pairs])) if pairs else None
@@ -76,7 +77,7 @@ def costs(rows: list[dict], proposer: str) -> dict:
 
 
 def _zero_runs(cost: dict) -> str:
-    return ", ".join(f"{cost['zero_runs'][m]}/{cost['runs'][m]}" for m in METHODS)
+    return ", ".join(f"{cost['zero_runs'][m]}/{cost['runs'][m]}" for m in cost["runs"])
 
 
 def _times(ratio: float | None) -> str:
@@ -90,7 +91,7 @@ def _interval(e) -> str:
     return f"{e['estimate']:{sign}.3f} [{e['ci_low']:{sign}.3f}, {e['ci_high']:{sign}.3f}]"
 
 
-def markdown(entries: list[dict], cost_rows: list[dict]) -> str:
+def markdown(entries: list[dict], cost_rows: list[dict], pair=("ours-repair", "ours")) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass; 95 % bootstrap percentile intervals ({cmp.BOOTSTRAP_RESAMPLES} "
              f"resamples, numpy seed {cmp.BOOTSTRAP_SEED}) over (maze, seed) cells; multi-room = "
              f"{', '.join(cmp.MULTI_ROOM_MAZES)}; change 1→5 rooms = least-squares slope x 4 on u_chain_1..5, flat "
@@ -102,8 +103,9 @@ def markdown(entries: list[dict], cost_rows: list[dict]) -> str:
         seeds = ",".join(map(str, e["seeds"])) or "none"
         lines.append(f"| {e['proposer']} | {e['claim']} | {_interval(e)} | {verdict} | {e['n_cells']}/"
                      f"{e['n_expected']} ({seeds}) | {cmp._missing_summary(e['missing'])} |")
-    lines += ["", "| proposer | runs at success 0 (of runs): " + ", ".join(METHODS) +
-              " | ours-repair / ours: evaluations, proposer calls (pairs) |", "|---|---|---|"]
+    methods = list(cost_rows[0]["runs"]) if cost_rows else list(METHODS)
+    lines += ["", "| proposer | runs at success 0 (of runs): " + ", ".join(methods) +
+              f" | {pair[0]} / {pair[1]}: evaluations, proposer calls (pairs) |", "|---|---|---|"]
     for c in cost_rows:
         lines.append(f"| {c['proposer']} | {_zero_runs(c)} | {_times(c['evaluations_ratio'])}, "
                      f"{_times(c['proposer_calls_ratio'])} ({c['pairs']}) |")
@@ -166,16 +168,42 @@ def study(rows: list[dict]) -> Study:
     return out
 
 
+TUNED = GRIDS["repair-tuned"]
+TUNED_PAIR = ("ours-repair-tuned", "ours-repair")
+
+
+def tuned_study(rows: list[dict]) -> tuple[list[dict], list[dict], str]:
+    """The repair-tuned grid (docs/proposers.md, "Tuning a repaired chain"): per preset, the paired difference
+    ours-repair-tuned - ours-repair on the multi-room cells and on every cell, runs at 0, the cost ratios."""
+    cells, failed = cmp.table_cells(rows, "point")
+    entries, cost_rows = [], []
+    scopes = ((cmp.MULTI_ROOM_MAZES, "multi-room"), (sorted(benchmark_mazes()), "every maze"))
+    for p in TUNED.proposers:
+        entries += [paired_claim(cells, failed, p, mazes, scope, TUNED_PAIR, TUNED.seeds) for mazes, scope in scopes]
+        cost_rows.append(costs(rows, p, TUNED_PAIR, TUNED_PAIR))
+    return entries, cost_rows, markdown(entries, cost_rows, TUNED_PAIR)
+
+
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.experiments.repair_claims", description=__doc__.splitlines()[0])
     ap.add_argument("table")
     ap.add_argument("--out", required=True, type=out_path)
+    ap.add_argument("--tuned", action="store_true", help="TABLE is the repair-tuned grid's (data/results/repair/"
+                                                         "tuned.csv): writes tuned_claims.md and tuned_claims.json")
     args = ap.parse_args(argv)
     try:
         rows = read_checked_table(args.table)
         ensure_dir(args.out)
     except SpecrefineError as exc:
         ap.exit(2, f"{ap.prog}: error: {exc}\n")
+    if args.tuned:
+        entries, cost_rows, text = tuned_study(rows)
+        write_atomic(args.out / "tuned_claims.md", text + "\n")
+        write_atomic(args.out / "tuned_claims.json", json.dumps(cmp._jsonable(
+            {"table": str(args.table), "claims": entries, "costs": cost_rows}), indent=1) + "\n")
+        print(f"{len(rows)} rows -> {args.out}: tuned_claims.md, tuned_claims.json "
+              f"({sum(not e['complete'] for e in entries)} of {len(entries)} entries partial)")
+        return 0
     result = study(rows)
     about = {"table": str(args.table), "note": cmp.OFFLINE_NOTE, "presets": list(PRESETS), "seeds": list(SEEDS),
              "bootstrap_resamples": cmp.BOOTSTRAP_RESAMPLES, "bootstrap_seed": cmp.BOOTSTRAP_SEED}
