@@ -259,3 +259,13 @@ def test_front_page_offline_line_is_the_claims():
             ("mild", "ours-nosearchvertex"): "undecided"}  # later round and tuning help; feedback, search vertices not
     assert {k: contrasts["imperfect:" + k[0], f"ours - {k[1]}"]["verdict"] for k in said} == said
     assert "at least 2x the one-shot on the multi-room tasks at moderate errors" in " ".join(FRONT.split())
+
+
+def test_repair_tuned_tables_are_the_tuned_grid():
+    """The results page's repair-tuned tables are repair_claims --tuned on the shipped, complete grid."""
+    from specrefine.experiments.repair_claims import tuned_study
+
+    entries, _, text = tuned_study(read_table(ROOT / "data/results/repair/tuned.csv"))
+    assert all(e["complete"] for e in entries)
+    assert "<!-- repair tuned -->\n" + text.split("\n\n", 1)[1] + "\n" in README
+    assert (ROOT / "data/results/repair/tuned_claims.md").read_text() == text + "\n"

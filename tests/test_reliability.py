@@ -135,8 +135,9 @@ def _group(pgid: int) -> list[int]:
 
 
 def _sweep_proc(out: Path):
-    cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", "0", "1",
-           "2", "3", "--rollouts", "8", "--episodes", "16", "--workers", "2", "--out", str(out)]
+    seeds = [str(s) for s in range(40)]  # enough cells that the sweep is still running when the test interrupts it
+    cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", *seeds,
+           "--rollouts", "8", "--episodes", "16", "--workers", "2", "--out", str(out)]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
 
