@@ -37,8 +37,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import os
-from collections import OrderedDict
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -62,6 +60,7 @@ from ..core.results import (
     unreached,
     wilson_ci,
 )
+from .cache import ResultCache
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
@@ -134,27 +133,38 @@ class Evaluator:
         self.clearance = self.agent_radius + self.contact_margin
         #: fresh starts (default pose) keep this far from walls: the body radius, or the legs' reach if larger
         self.spawn_radius = max(self.clearance, footprint_radius(model) + self.contact_margin)
-        self.cache_dir = Path(cache_dir) if cache_dir is not None else None
+        self.cache = ResultCache(cache_dir, self.MEMO_SIZE)
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
-        self.cache_hits = 0
-        self.disk_hits = 0  # evaluations found in cache_dir, written by an earlier (interrupted) run
-        #: environment steps of the evaluations read from cache_dir that this process never simulated (an earlier
-        #: run of the same folder did): each counted once, so sim_steps + cached_steps is the same for a run done
-        #: in one go and one resumed after a kill
-        self.cached_steps = 0
-        self._simulated: set[str] = set()
-        self._steps_counted: set[str] = set()
         self._act = policy.act if hasattr(policy, "act") else policy
         self.observation_frame = getattr(policy, "observation_frame", "world")
         self._sims: dict[int, object] = {}
-        self._memo: OrderedDict[str, EdgeResult] = OrderedDict()  # LRU, MEMO_SIZE entries
         self._compiled: dict[Region, CompiledRegion] = {}
         self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
         grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
         self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
 
     # --- plumbing ------------------------------------------------------------------------------
+    @property
+    def cache_dir(self) -> Path | None:
+        return self.cache.folder
+
+    @property
+    def cache_hits(self) -> int:
+        return self.cache.hits
+
+    @property
+    def disk_hits(self) -> int:
+        """Evaluations found in cache_dir, written by an earlier (interrupted) run."""
+        return self.cache.disk_hits
+
+    @property
+    def cached_steps(self) -> int:
+        """Environment steps of the evaluations read from cache_dir that this process never simulated (an earlier run
+        of the same folder did): each counted once, so sim_steps + cached_steps is the same for a run done in one go
+        and one resumed after a kill."""
+        return self.cache.cached_steps
+
     @property
     def control_period(self) -> float:
         """Seconds per control step."""
@@ -235,48 +245,6 @@ class Evaluator:
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
-    def _cache_path(self, key: str) -> Path | None:
-        if self.cache_dir is None:
-            return None
-        return self.cache_dir / key[:2] / f"{key}.npz"
-
-    def _load(self, key: str, text: str) -> EdgeResult | None:
-        path = self._cache_path(key)
-        if path is None or not path.exists():
-            return None
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if str(z["key"]) != text:
-                    raise ValueError("key mismatch")
-                success = z["success"].astype(bool)
-                n = len(success)
-                end = StartStates(z["end_states"].astype(np.float64), z["end_xy"].astype(np.float64))
-                res = EdgeResult(p=float(success.mean()) if n else 0.0, ci=wilson_ci(int(success.sum()), n), n=n,
-                                 successes=int(success.sum()), success=success, trajectories=z["trajectories"],
-                                 lengths=z["lengths"].astype(np.int64), end_states=end, steps=int(z["steps"]),
-                                 cached=True, outcome=z["outcome"].astype(np.int8))
-                if len(res.lengths) != n or len(res.trajectories) != n or len(end) != res.successes:
-                    raise ValueError("inconsistent arrays")
-                return res
-        except Exception as e:  # corrupt, truncated, foreign: never crash, recompute
-            log.warning("ignoring unreadable cache entry %s: %s: %s", path, type(e).__name__, e)
-            return None
-
-    def _store(self, key: str, text: str, res: EdgeResult) -> None:
-        path = self._cache_path(key)
-        if path is None:
-            return
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-            with open(tmp, "wb") as f:
-                np.savez_compressed(f, key=np.array(text), success=res.success, trajectories=res.trajectories,
-                                    lengths=res.lengths, end_states=res.end_states.states, end_xy=res.end_states.xy,
-                                    steps=np.array(res.steps), outcome=res.outcome)
-            os.replace(tmp, path)
-        except OSError as e:
-            log.warning("could not write cache entry %s: %s", path, e)
-
     # --- public API ----------------------------------------------------------------------------
     MAX_EPISODES = 2048  # evaluate_many simulates at most this many episodes side by side
 
@@ -307,7 +275,7 @@ class Evaluator:
             key, text = self._key("edge", start, legs, n, seed, fp)
             if key in todo:  # asked twice in one batch: simulated once, the second is a cache hit
                 todo[key][2].append(i)
-            elif (hit := self._lookup(key, text, disk=fp is not None)) is not None:
+            elif (hit := self.cache.lookup(key, text, disk=fp is not None)) is not None:
                 results[i] = hit
             elif isinstance(start, StartStates) and len(start) == 0:
                 # nothing reached the start: p = 0, nothing run
@@ -321,37 +289,12 @@ class Evaluator:
             for (key, (text, _, positions)), out in zip(chunk, self._rollout_many([t for _, (_, t, _) in chunk])):
                 res = _edge_result(out, n)
                 self.evaluations += 1
-                self._simulated.add(key)
-                self._remember(key, res)
-                if fp is not None:
-                    self._store(key, text, res)
+                self.cache.add(key, text, res, disk=fp is not None)
                 results[positions[0]] = res
                 for i in positions[1:]:
-                    self.cache_hits += 1
+                    self.cache.hits += 1
                     results[i] = replace(res, cached=True)
         return results
-
-    def _lookup(self, key: str, text: str, disk: bool) -> EdgeResult | None:
-        hit = self._memo.get(key)
-        if hit is not None:
-            self._memo.move_to_end(key)
-        elif disk and (hit := self._load(key, text)) is not None:
-            self.disk_hits += 1
-            if key not in self._simulated and key not in self._steps_counted:
-                self._steps_counted.add(key)
-                self.cached_steps += hit.steps
-            self._remember(key, replace(hit, cached=False))
-        if hit is None:
-            return None
-        self.cache_hits += 1
-        return replace(hit, cached=True)
-
-    def _remember(self, key: str, res: EdgeResult) -> None:
-        for a in (res.success, res.trajectories, res.lengths, res.outcome, res.end_states.states, res.end_states.xy):
-            a.flags.writeable = False  # shared with the cache: read-only
-        self._memo[key] = res
-        while len(self._memo) > self.MEMO_SIZE:
-            self._memo.popitem(last=False)
 
     def evaluate_edge(self, graph, u: str, v: str, start: Region | StartStates | None = None, seed=None,
                       n: int | None = None) -> EdgeResult:
