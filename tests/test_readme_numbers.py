@@ -269,3 +269,20 @@ def test_repair_tuned_tables_are_the_tuned_grid():
     assert all(e["complete"] for e in entries)
     assert "<!-- repair tuned -->\n" + text.split("\n\n", 1)[1] + "\n" in README
     assert (ROOT / "data/results/repair/tuned_claims.md").read_text() == text + "\n"
+
+
+def test_scaling_seed_tables_are_the_tables():
+    """docs/ant_experiments.md's seed-0 table of the scaling grid is experiments.scaling.seed_table of its tables, and
+    its sentence's shares of wall time are seed 0's."""
+    from specrefine.experiments import scaling
+
+    doc = (ROOT / "docs" / "ant_experiments.md").read_text()
+    rows = scaling.read_rows(sorted((ROOT / "data/results/ant/scaling").glob("*.csv")))
+    baseline = scaling.read_rows([ROOT / "data/results/ant/comparison.csv"])
+    assert "<!-- scaling seed 0 -->\n" + scaling.seed_table(baseline, rows, 0) + "\n" in doc
+    multi = [r for r in rows if (r["seed"], r["method"], r["proposer"]) == (0, "ours", scaling.ORACLE)
+             and r["maze"] != "u_chain_1"]
+    assert len(multi) == 8
+    shares = {k: [100 * r[k] / r["wall_seconds"] for r in multi] for k in scaling.PHASES}
+    s, m, c = (f"{round(min(v))}-{round(max(v))} %" for v in shares.values())
+    assert f"takes {s} of the wall time" in doc and f"measurement\n{m}" in doc and f"episodes {c}" in doc

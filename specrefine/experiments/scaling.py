@@ -112,6 +112,29 @@ def legs_table(rows) -> str:
     return "\n".join([LEGS_HEADER, *(legs_line(k, groups[k]) for k in order)])
 
 
+PHASES = ("search_seconds", "measure_seconds", "calibrate_seconds")
+
+
+def _rate(row) -> str:
+    return "—" if row is None else f"{row['success_rate']:.3f}"
+
+
+def seed_table(baseline_rows, rows, seed: int) -> str:
+    """One seed of ``ours`` x ORACLE beside the same seed of the stage-4 comparison (``ours`` x ``geometric``)."""
+    def run(table, proposer, maze):
+        return next((r for r in table if (r["maze"], r["method"], r["proposer"], r["seed"]) ==
+                     (maze, "ours", proposer, seed) and is_done(r)), None)
+
+    lines = [f"| maze | stage 4, seed {seed} | stage 5, seed {seed} | legs (stage 5) | search / measure / calibrate s "
+             "(stage 5) |", "|---|---|---|---|---|"]
+    for maze in MAZES:
+        old, new = run(baseline_rows, "geometric", maze), run(rows, ORACLE, maze)
+        cells = [_rate(old), _rate(new), "—" if new is None else f"{new['path_edges']:.0f}",
+                 "—" if new is None else " / ".join(f"{new[k]:.0f}" for k in PHASES)]
+        lines.append(f"| {maze} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def markdown(flat: dict, erring: dict) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Ant, stage 5, seeds {', '.join(map(str, SEEDS))}, 200 fresh episodes per run; "
              "Wilson 95 % intervals on pooled episodes; the change from 1 to 5 rooms as in the comparison "
@@ -137,12 +160,17 @@ def main(argv=None) -> int:
     p = OneLineParser(prog="python -m specrefine.experiments.scaling", description=__doc__.split("\n")[0])
     p.add_argument("tables", nargs="+", help="the grid's sweep tables (data/results/ant/scaling/*.csv)")
     p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--baseline", help="the stage-4 comparison's table (data/results/ant/comparison.csv): seeds.md sets "
+                                      "each seed beside it")
     args = p.parse_args(argv)
     try:
         rows = read_rows(args.tables)
+        baseline = read_rows([args.baseline]) if args.baseline else None
         out = ensure_dir(args.out)
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
+    if baseline is not None:
+        write_atomic(out / "seeds.md", "\n\n".join(seed_table(baseline, rows, s) for s in SEEDS) + "\n")
     flat, erring = flat_claim(rows), erring_claim(rows)
     write_atomic(out / "claims.md", markdown(flat, erring))
     write_atomic(out / "claims.json", json.dumps({"flat": flat, "erring": erring}, indent=1, default=float) + "\n")
