@@ -286,3 +286,19 @@ def test_scaling_seed_tables_are_the_tables():
     shares = {k: [100 * r[k] / r["wall_seconds"] for r in multi] for k in scaling.PHASES}
     s, m, c = (f"{round(min(v))}-{round(max(v))} %" for v in shares.values())
     assert f"takes {s} of the wall time" in doc and f"measurement\n{m}" in doc and f"episodes {c}" in doc
+
+
+def test_front_page_scaling_line_is_seed_0_of_both_grids():
+    from specrefine.experiments import scaling
+
+    text = " ".join(FRONT[FRONT.index("<!-- front scaling -->"):FRONT.index("<!-- /front scaling -->")].split())
+    rows = scaling.read_rows(sorted((ROOT / "data/results/ant/scaling").glob("*.csv")))
+    baseline = scaling.read_rows([ROOT / "data/results/ant/comparison.csv"])
+
+    def seed0(table, proposer):
+        rate = {r["maze"]: r["success_rate"] for r in table if (r["method"], r["proposer"], r["seed"]) ==
+                ("ours", proposer, 0)}
+        return ", ".join(f"{rate[f'u_chain_{n}']:.3f}" for n in range(1, 6))
+
+    assert text == (f"<!-- front scaling -->{seed0(rows, scaling.ORACLE)} for 1-5 rooms (stage 4, seed 0: "
+                    f"{seed0(baseline, 'geometric')})")
