@@ -261,11 +261,11 @@ GRIDS = {g.name: g for g in (
                                           "u_chain_5_subgoals"), policy="data/policies/ant_stage5.pt",
         evaluation="adaptive", code="fc93db3", out="runs/ant_scaling"),
     ExperimentGrid(
-        "antmaze", "docs/official_env.md (issue 28; not run yet)", "ant",
+        "antmaze", "docs/official_env.md, 'The AntMaze grid' (issue 28)", "ant",
         parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),
         seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
         policy_in_checkout=True, evaluation="adaptive", episodes=200, table="data/results/ant/antmaze.csv",
-        out="runs/antmaze"),
+        out="runs/antmaze", code="59e5b8d"),
 )}
 
 
