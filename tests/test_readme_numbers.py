@@ -302,3 +302,13 @@ def test_front_page_scaling_line_is_seed_0_of_both_grids():
 
     assert text == (f"<!-- front scaling -->{seed0(rows, scaling.ORACLE)} for 1-5 rooms (stage 4, seed 0: "
                     f"{seed0(baseline, 'geometric')})")
+
+
+def test_leg_profiles_table_is_the_shipped_profiles():
+    import json
+
+    from specrefine.experiments.legs import profile_table
+
+    doc = (ROOT / "docs" / "ant_experiments.md").read_text()
+    profiles = json.loads((ROOT / "data/results/ant/scaling/leg_profiles.json").read_text())
+    assert "<!-- leg profiles -->\n" + profile_table(profiles) + "\n" in doc

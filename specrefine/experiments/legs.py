@@ -6,14 +6,20 @@ policy) pooled over seeds (issue 30: where a long chain loses its episodes).
 
 Per-leg failure is 1 - s^(1/L) with s the pooled success and L the mean number of legs on the measured paths: what
 each leg would lose if legs failed independently and alike. Rooms: N of a ``u_chain_N`` maze (blank otherwise).
+
+Leg profiles (``--profiles RUN/result.json ... --out FILE.json``): each run's measured per-leg failure (among the
+episodes that started the leg) beside the search's estimate of that leg, small enough to ship, and
+``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few.
 """
 import argparse
+import json
 import re
 import sys
 
 from ..core.argtypes import exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
+from ..core.runfolder import read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
 
 HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | legs | legs per room | per-leg failure | "
@@ -50,13 +56,54 @@ def report(tables, method=None, proposer=None) -> str:
     return "\n".join([HEADER, *(line(k, groups[k]) for k in order)])
 
 
+def leg_profile(result: dict) -> dict:
+    """One run's legs: measured failure (1 - leg success on the 200 fresh episodes), the search's estimate."""
+    return {k: result.get(k) for k in ("maze", "method", "proposer", "seed", "episode_outcomes")} | {
+        "leg_failure": [round(1.0 - float(p), 6) for p in result.get("leg_success") or []],
+        "search_estimate": [float(p) for p in result.get("edge_probabilities") or []]}
+
+
+def worst_share(failures, share: float = 0.2) -> float:
+    """The part of the summed per-leg failure that the worst ``share`` of the legs carry."""
+    ordered = sorted(failures, reverse=True)
+    total = sum(ordered)
+    return sum(ordered[:max(1, int(len(ordered) * share))]) / total if total else 0.0
+
+
+PROFILE_HEADER = ("| maze | seed | legs | legs losing episodes (measured) | legs the search saw fail | worst leg's "
+                  "failure | worst 20 % of legs' share of the failure | avoid / flipped / timeout |\n"
+                  "|---|---|---|---|---|---|---|---|")
+
+
+def profile_table(profiles) -> str:
+    lines = [PROFILE_HEADER]
+    for p in sorted(profiles, key=lambda p: (p["seed"], rooms(p["maze"]) or 0, p["maze"])):
+        out = p["episode_outcomes"] or {}
+        seen = sum(e < 1.0 for e in p["search_estimate"])
+        losing = sum(f > 0 for f in p["leg_failure"])
+        lines.append(f"| {p['maze']} | {p['seed']} | {len(p['leg_failure'])} | {losing} | {seen} | "
+                     f"{max(p['leg_failure']):.3f} | "
+                     f"{worst_share(p['leg_failure']):.2f} | {out.get('avoid', 0)} / {out.get('flipped', 0)} / "
+                     f"{out.get('timeout', 0)} |")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
-    ap.add_argument("tables", nargs="+")
+    ap.add_argument("tables", nargs="+", help="sweep tables (with --profiles: runs' result.json files)")
     ap.add_argument("--method")
     ap.add_argument("--proposer")
+    ap.add_argument("--profiles", action="store_true", help="the inputs are result.json files: write their leg "
+                                                            "profiles to --out and print profile_table")
+    ap.add_argument("--out", help="with --profiles: the JSON file to write")
     args = ap.parse_args(argv)
     try:
+        if args.profiles:
+            profiles = [leg_profile(read_result(path)) for path in args.tables]
+            if args.out:
+                write_atomic(args.out, json.dumps(profiles, indent=1) + "\n")
+            print(profile_table(profiles))
+            return 0
         print(report(args.tables, args.method, args.proposer))
     except SpecrefineError as exc:  # a missing or malformed table: one line
         print(f"error: {exc}", file=sys.stderr)
