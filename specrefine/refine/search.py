@@ -32,12 +32,14 @@ from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
 from .edge_split import SplitCandidate, edge_split
+from .polish import polish
 from .racing import Racing
 from .repair import cheapest, repair
 from .shortcut import add_shortcuts, shortcuts
 from .vertex import refine_chain
 
 EVALUATIONS = ("fixed", "adaptive")
+POLISH_SEED_OFFSET = 7919  # polishing draws its rollouts apart from the search's (and the measurement's) seeds
 
 
 @dataclass
@@ -58,6 +60,7 @@ class SearchConfig:
     repair: bool = False  # beyond the paper: split a candidate's failing legs before it is judged (repair.py)
     repair_tuning: bool = False  # beyond the paper: Algorithm 2 on a repaired chain before it is judged
     shortcut_reach: float | None = None  # beyond the paper: shortcut edges up to this long on the path (shortcut.py)
+    polish_rollouts: int | None = None  # beyond the paper: the path's weak waypoints tuned on this many rollouts
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -142,6 +145,8 @@ class RefinementSearch:
         path = self._trace(final)
         if path and self.cfg.shortcut_reach:
             path = self._shortcut(path)
+        if path and self.cfg.polish_rollouts:
+            self._polish(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0)
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
@@ -308,6 +313,19 @@ class RefinementSearch:
             for v in self.graph.successors(u):
                 if v not in f.closed:
                     self._relax(u, v)
+
+    # --- beyond the paper: polishing the found path (polish.py) --------------------------
+    def _polish(self, path: list[str]) -> None:
+        g = self.graph
+        for step in polish(g, path, self.evaluator, rollouts=self.cfg.polish_rollouts, k=self.cfg.k, rng=self.rng,
+                           seed=self.cfg.seed + POLISH_SEED_OFFSET):
+            self._log("path-polished", vertex=step.vertex, p_before=step.p_before, p_after=step.p_after,
+                      changed=step.changed, region=g.region(step.vertex).to_dict())
+        assert_refines(g, self.original)
+        # the path's estimates again on the search's own rollouts, so that its prediction is made as before
+        legs = [Leg(g.region(b), g.avoid(a, b), g.goal_point(b)) for a, b in zip(path, path[1:])]
+        for edge, result in zip(zip(path, path[1:]), estimate_legs(self.evaluator, g.region(path[0]), legs).results):
+            self.results[edge] = result
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
     def _shortcut(self, path: list[str]) -> list[str]:

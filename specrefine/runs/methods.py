@@ -176,6 +176,9 @@ register_method("ours-repair", ours_variant(repair=True),
 register_method("ours-repair-tuned", ours_variant(repair=True, repair_tuning=True),
                 "beyond the paper: ours-repair, and a repaired chain is tuned by Algorithm 2 (vertex subsets) before "
                 "it is judged", colour="#ab47bc")
+register_method("ours-polish", ours_variant(polish_rollouts=128),
+                "beyond the paper: ours, then the found path's legs estimated again on 128 rollouts and its weak "
+                "waypoints tuned by Algorithm 2 on those estimates (refine/polish.py)", colour="#00838f")
 register_method("ours-shortcut", ours_variant(shortcut_reach="policy"),
                 "beyond the paper: ours, then shortcut edges over the found path's waypoints (one long leg where it "
                 "beats several short ones; refine/shortcut.py)", colour="#283593")
