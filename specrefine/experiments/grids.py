@@ -261,6 +261,11 @@ GRIDS = {g.name: g for g in (
                                           "u_chain_5_subgoals"), policy="data/policies/ant_stage5.pt",
         evaluation="adaptive", code="fc93db3", out="runs/ant_scaling"),
     ExperimentGrid(
+        "ant-polish", "docs/ant_experiments.md, section 5, 'Lever E'", "ant",
+        parts=(Part(("ours-polish",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
+        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        code="1242800", table="data/results/ant/polish.csv", out="runs/ant_polish"),
+    ExperimentGrid(
         "antmaze", "docs/official_env.md, 'The AntMaze grid' (issue 28)", "ant",
         parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),
         seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
