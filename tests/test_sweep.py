@@ -217,3 +217,17 @@ def test_w_d_k_are_grid_axes_and_the_paper_values_keep_their_ids(tmp_path):
     assert [c.id for c in pending(cells, table)] == [c.id for c in cells if c.method != "dirl"]
     with pytest.raises(ValueError, match="no 'w', 'd', 'k' columns"):
         _append(table, {"cell": "x", "w": 5, "d": 2, "k": 5})
+
+
+def test_every_table_column_comes_from_a_runs_result_or_its_cell(tmp_path):
+    """sweep.COLUMNS is the table's chosen subset of result.json: a column no run writes would stay empty."""
+    import json
+
+    from specrefine.runs.pipeline import refine_maze
+    from specrefine.runs.sweep import COLUMNS, result_row
+
+    refine_maze("u_maze", agent="point", method="ours", proposer="geometric", seed=0, rollouts=8, episodes=20,
+                out=tmp_path / "run")
+    data = json.loads((tmp_path / "run" / "result.json").read_text())
+    row = result_row(data, {"cell": "u_maze__point__ours__geometric__s0", "w": 3, "d": 2, "k": 5})
+    assert [c for c in COLUMNS if c not in row] == []
