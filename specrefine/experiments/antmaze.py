@@ -1,0 +1,128 @@
+"""The AntMaze grid's table (docs/official_env.md, "The AntMaze grid"): each map and method in this package's
+simulator and in the official ``AntMaze_*-v5``, pooled over seeds, with Wilson 95 % intervals.
+
+    python -m specrefine.experiments.antmaze runs/antmaze --official 200 --out data/results/ant/antmaze
+
+Reads every finished run folder of the grid's sweep (``RUN/result.json``); with ``--official N`` it first runs
+``specrefine official RUN --episodes N`` where a run has no ``official.json`` yet (minutes per run). Writes
+``official.csv`` (one row per run: both simulators' success), ``table.md`` (pooled per map, method and proposer)
+and ``figure.png``. Every proposer here is offline, NOT a VLM.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
+from ..core.errors import SpecrefineError
+from ..core.results import wilson_ci
+from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
+from ..pictures.render import subplots
+from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS
+from ..runs.official import OFFICIAL_JSON, run_official
+
+FIELDS = ["maze", "method", "proposer", "seed", "sim_successes", "sim_episodes", "official_successes",
+          "official_episodes", "env_id"]
+
+
+def run_rows(sweep_dir, official_episodes: int | None = None, seed: int = 0) -> list[dict]:
+    """One row per finished run under ``sweep_dir/cells``; runs without official.json get one first if asked."""
+    rows = []
+    for run in sorted(Path(sweep_dir, "cells").glob("*/")):
+        if not (run / "result.json").is_file():
+            continue
+        result = read_result(run / "result.json")
+        official = run / OFFICIAL_JSON
+        if not official.is_file() and official_episodes:
+            run_official(run, official_episodes, seed)
+        off = json.loads(official.read_text()) if official.is_file() else None
+        proposer = result["proposer"] if result["method"] in PROPOSER_METHODS else "none"  # as the sweep's table
+        rows.append({"maze": result["maze"], "method": result["method"], "proposer": proposer,
+                     "seed": result["seed"], "sim_successes": round(result["success_rate"] * result["episodes"]),
+                     "sim_episodes": result["episodes"],
+                     "official_successes": "" if off is None else round(off["success_rate"] * off["episodes"]),
+                     "official_episodes": "" if off is None else off["episodes"],
+                     "env_id": "" if off is None else off["env_id"]})
+    return rows
+
+
+def _pooled(rows, side: str) -> tuple[int, int]:
+    done = [r for r in rows if r[f"{side}_episodes"] != ""]
+    return sum(int(r[f"{side}_successes"]) for r in done), sum(int(r[f"{side}_episodes"]) for r in done)
+
+
+def _rate(k: int, n: int) -> str:
+    if not n:
+        return "—"
+    lo, hi = wilson_ci(k, n)
+    return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] ({n})"
+
+
+def groups(rows) -> dict[tuple, list[dict]]:
+    out: dict[tuple, list[dict]] = {}
+    for r in rows:
+        out.setdefault((r["maze"], r["method"], r["proposer"]), []).append(r)
+    return out
+
+
+def table(rows) -> str:
+    lines = ["| map | method | proposer | seeds | this simulator [95 % CI] (episodes) | official [95 % CI] "
+             "(episodes) |", "|---|---|---|---|---|---|"]
+    for (maze, method, proposer), runs in groups(rows).items():
+        seeds = ",".join(str(r["seed"]) for r in sorted(runs, key=lambda r: int(r["seed"])))
+        lines.append(f"| {maze} | {method} | {proposer} | {seeds} | {_rate(*_pooled(runs, 'sim'))} | "
+                     f"{_rate(*_pooled(runs, 'official'))} |")
+    return "\n".join(lines)
+
+
+def figure(rows):
+    by = groups(rows)
+    maps = list(dict.fromkeys(k[0] for k in by))
+    fig, axes = subplots(1, max(1, len(maps)), figsize=(5.5 * max(1, len(maps)), 4.2), squeeze=False, sharey=True)
+    for ax, maze in zip(axes[0], maps):
+        keys = [k for k in by if k[0] == maze]
+        x = np.arange(len(keys))
+        for offset, side, hatch in ((-0.2, "sim", ""), (0.2, "official", "//")):
+            rates = [(lambda k, n: k / n if n else np.nan)(*_pooled(by[k], side)) for k in keys]
+            ax.bar(x + offset, rates, 0.4, color=[METHOD_COLOURS.get(k[1], "grey") for k in keys], hatch=hatch,
+                   edgecolor="black", linewidth=0.5, label="this simulator" if side == "sim" else "official env")
+        ax.set_xticks(x, [f"{k[1]}\n{k[2]}" for k in keys], fontsize=7)
+        ax.set_ylim(0, 1.05)
+        ax.set_title(f"{maze} (offline proposers, not a VLM)", fontsize=9)
+        ax.grid(axis="y", alpha=0.3)
+    axes[0, 0].set_ylabel("success rate (pooled over seeds)")
+    axes[0, 0].legend(fontsize=7)
+    return fig
+
+
+def main(argv=None) -> int:
+    p = OneLineParser(prog="python -m specrefine.experiments.antmaze", description=__doc__.split("\n")[0])
+    p.add_argument("sweep_dir", help="the AntMaze grid's sweep folder (runs/antmaze)")
+    p.add_argument("--official", type=int, default=None, metavar="N",
+                   help="run the official environment on N episodes where a run has no official.json yet")
+    p.add_argument("--seed", type=int, default=0, help="the official episodes' seed (default 0)")
+    p.add_argument("--out", type=Path, required=True)
+    args = p.parse_args(argv)
+    try:
+        rows = run_rows(args.sweep_dir, args.official, args.seed)
+        out = ensure_dir(args.out)
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, FIELDS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_atomic(out / "official.csv", buf.getvalue())
+    write_atomic(out / "table.md", table(rows) + "\n")
+    save_figure(figure(rows), out / "figure.png", dpi=110)
+    print(f"{len(rows)} runs -> {out}: official.csv, table.md, figure.png")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

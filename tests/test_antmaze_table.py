@@ -1,0 +1,47 @@
+"""specrefine.experiments.antmaze: the AntMaze table pools each map and method over seeds in both simulators."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from specrefine.experiments import antmaze
+
+
+def _run(root, name, method, proposer, seed, sim, official=None):
+    run = root / "cells" / name
+    run.mkdir(parents=True)
+    (run / "result.json").write_text(json.dumps({"maze": "gr:U_MAZE", "agent": "ant", "method": method,
+                                                 "proposer": proposer, "seed": seed, "success_rate": sim,
+                                                 "episodes": 200, "path": [], "graph": {}}))
+    if official is not None:
+        (run / "official.json").write_text(json.dumps({"success_rate": official, "episodes": 100,
+                                                       "env_id": "AntMaze_UMaze-v5"}))
+
+
+def test_the_table_pools_seeds_in_both_simulators_and_names_no_proposer_for_dirl(tmp_path):
+    _run(tmp_path, "a", "ours", "geometric", 0, 0.9, 0.8)
+    _run(tmp_path, "b", "ours", "geometric", 1, 0.8, 0.7)
+    _run(tmp_path, "c", "dirl", "geometric", 0, 0.0)  # no official run yet
+    (tmp_path / "cells" / "d").mkdir()  # a cell still running: no result.json
+    rows = antmaze.run_rows(tmp_path)
+    assert [(r["method"], r["proposer"], r["seed"]) for r in rows] == [("ours", "geometric", 0),
+                                                                        ("ours", "geometric", 1), ("dirl", "none", 0)]
+    table = antmaze.table(rows).splitlines()
+    assert table[2] == ("| gr:U_MAZE | ours | geometric | 0,1 | 0.850 [0.812, 0.882] (400) | "
+                        "0.750 [0.686, 0.805] (200) |")  # 340 of 400 and 150 of 200, Wilson intervals
+    assert table[3].endswith("| — |")
+    assert antmaze.main([str(tmp_path), "--out", str(tmp_path / "out")]) == 0
+    with (tmp_path / "out" / "official.csv").open() as fh:
+        assert [r["official_successes"] for r in csv.DictReader(fh)] == ["80", "70", ""]
+    assert (tmp_path / "out" / "figure.png").stat().st_size > 0
+
+
+def test_a_malformed_result_is_one_line_and_exit_2(tmp_path, capsys):
+    (tmp_path / "cells" / "x").mkdir(parents=True)
+    (tmp_path / "cells" / "x" / "result.json").write_text("[1]")
+    with pytest.raises(SystemExit) as exit_:
+        antmaze.main([str(tmp_path), "--out", str(tmp_path / "out")])
+    assert exit_.value.code == 2 and len(capsys.readouterr().err.strip().splitlines()) == 1
