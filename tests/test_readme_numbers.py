@@ -312,3 +312,15 @@ def test_leg_profiles_table_is_the_shipped_profiles():
     doc = (ROOT / "docs" / "ant_experiments.md").read_text()
     profiles = json.loads((ROOT / "data/results/ant/scaling/leg_profiles.json").read_text())
     assert "<!-- leg profiles -->\n" + profile_table(profiles) + "\n" in doc
+
+
+def test_antmaze_table_is_its_official_csv():
+    import csv
+
+    from specrefine.experiments.antmaze import table
+
+    with (ROOT / "data/results/ant/antmaze/official.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    doc = (ROOT / "docs" / "official_env.md").read_text()
+    assert "<!-- antmaze table -->\n" + table(rows) + "\n" in doc
+    assert (ROOT / "data/results/ant/antmaze/table.md").read_text() == table(rows) + "\n"
