@@ -87,6 +87,11 @@ class TaskGraph:
     def out_degree(self, v: str) -> int:
         return self.g.out_degree(v)
 
+    def is_chain_vertex(self, v: str) -> bool:
+        """An inner vertex of a chain (neither initial nor final, one edge in, one out): narrowing it changes the
+        subtasks of one path only."""
+        return v != self.initial and v not in self.finals and self.in_degree(v) == 1 and self.out_degree(v) == 1
+
     def label(self, v: str) -> str:
         return self.g.nodes[v]["label"]
 

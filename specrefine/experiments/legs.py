@@ -31,10 +31,14 @@ def rooms(maze: str) -> int | None:
     return int(m.group(1)) if m else None
 
 
+def pooled(runs) -> tuple[int, int]:
+    """(successes, episodes) over runs."""
+    return sum(round(r["success_rate"] * r["episodes"]) for r in runs), sum(int(r["episodes"]) for r in runs)
+
+
 def line(key: tuple, runs: list[dict]) -> str:
     maze, method, proposer, policy = key
-    ok = sum(round(r["success_rate"] * r["episodes"]) for r in runs)
-    n = sum(int(r["episodes"]) for r in runs)
+    ok, n = pooled(runs)
     lo, hi = wilson_ci(ok, n)
     legs = sum(r["path_edges"] for r in runs) / len(runs)
     per_room = f"{legs / rooms(maze):.1f}" if rooms(maze) else ""

@@ -26,7 +26,7 @@ from . import comparison as cmp
 from .figures import figure5
 from .legs import HEADER as LEGS_HEADER
 from .legs import line as legs_line
-from .legs import rooms
+from .legs import pooled, rooms
 
 ORACLE = "geometric:max_waypoints=48"
 ERRING = "imperfect:moderate"
@@ -46,11 +46,6 @@ def read_rows(tables) -> list[dict]:
 def _runs(rows, maze, method, proposer) -> list[dict]:
     return sorted((r for r in rows if (r["maze"], r["method"], r["proposer"]) == (maze, method, proposer)
                    and int(r["seed"]) in SEEDS), key=lambda r: int(r["seed"]))
-
-
-def pooled(runs) -> tuple[int, int]:
-    """(successes, episodes) over runs."""
-    return sum(round(r["success_rate"] * r["episodes"]) for r in runs), sum(int(r["episodes"]) for r in runs)
 
 
 def flat_claim(rows) -> dict:

@@ -53,7 +53,7 @@ def polish(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, ro
                 Leg(graph.region(w), graph.avoid(v, w), graph.goal_point(w))]
         current = estimate_legs(ev, arrival, legs)
         into = current.results[0]
-        if into.n - into.successes < min_failures or not _tunable(graph, v):
+        if into.n - into.successes < min_failures or not graph.is_chain_vertex(v):
             arrival = start_of(into)
             continue
         choice = refine_chain(ev, arrival, [graph.region(v)], graph.region(w), [legs[0].avoid, legs[1].avoid], k, rng,
@@ -64,8 +64,3 @@ def polish(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, ro
         done.append(Polished(v, current.p, choice.p if changed else current.p, changed))
         arrival = start_of(choice.results[0] if changed else into)
     return done
-
-
-def _tunable(graph: TaskGraph, v: str) -> bool:
-    """An inner waypoint of a chain: one edge in, one out (a narrowed region then changes no other path)."""
-    return v != graph.initial and v not in graph.finals and graph.in_degree(v) == 1 and graph.out_degree(v) == 1

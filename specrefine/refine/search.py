@@ -210,9 +210,7 @@ class RefinementSearch:
 
     def _vertex_eligible(self, v) -> bool:
         g = self.graph
-        if v in g.finals or v == g.initial or g.in_degree(v) != 1 or g.out_degree(v) != 1:
-            return False
-        return g.successors(v)[0] not in self.f.closed
+        return g.is_chain_vertex(v) and g.successors(v)[0] not in self.f.closed
 
     def _signature(self, u, v) -> tuple:
         g = self.graph
