@@ -81,3 +81,30 @@ def test_the_search_takes_a_shortcut_when_its_estimate_is_better():
     assert np.isclose(short.predicted_success, 0.9 ** (len(short.path) - 1))
     assert check_refines(short.graph, g) == []
     assert any(s["event"] == "shortcut" for s in short.steps)
+
+
+def test_shortcut_edges_are_named_by_the_graph_and_drawn_dashed():
+    from matplotlib.patches import FancyArrowPatch
+
+    from specrefine.core.mazes import load_maze
+    from specrefine.pictures.render import render_graph_diagram, render_task
+
+    original, refined, path = split_line([(0, 0), (2, 0), (4, -2), (6, 0), (8, 0)])
+    assert not any(refined.is_shortcut(u, v) for u, v in refined.edges())  # a plain split has none
+    found = shortcuts(refined, path, reach=5.0, clearance=0.2)
+    add_shortcuts(refined, path, found)
+    dashed_edges = {(u, v) for u, v in refined.edges() if refined.is_shortcut(u, v)}
+    assert dashed_edges == {(path[s.i], path[s.j]) for s in found}  # the split's own legs stay solid
+    assert len(found) >= 1 and not original.is_shortcut("S", "G")
+
+    def dashed(fig):
+        arrows = [p for ax in fig.axes for p in ax.patches if isinstance(p, FancyArrowPatch)]
+        return sum(a.get_linestyle() not in ("-", "solid") for a in arrows), len(arrows)
+
+    maze = load_maze("u_maze")
+    expected = (len(found), refined.g.number_of_edges())
+    assert dashed(render_task(maze, refined, path=path)) == expected
+    assert dashed(render_graph_diagram(refined, path=path)) == expected
+    legend = [t.get_text() for t in render_task(maze, refined).legends[0].get_texts()]
+    assert "shortcut edge" in legend
+    assert "shortcut edge" not in [t.get_text() for t in render_task(maze, original).legends[0].get_texts()]

@@ -92,6 +92,13 @@ class TaskGraph:
         subtasks of one path only."""
         return v != self.initial and v not in self.finals and self.in_degree(v) == 1 and self.out_degree(v) == 1
 
+    def is_shortcut(self, u: str, v: str) -> bool:
+        """u -> v skips waypoints of one split: another path u -> w -> ... -> v leaves u through a waypoint w of the
+        same parent edge (refine/shortcut.py adds such edges; a split or a repair removes the edge it replaces)."""
+        parent = self.parent(u, v)
+        return any(w != v and self.refines(w) is None and self.parent(u, w) == parent and nx.has_path(self.g, w, v)
+                   for w in self.g.successors(u))
+
     def label(self, v: str) -> str:
         return self.g.nodes[v]["label"]
 

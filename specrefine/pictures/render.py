@@ -188,7 +188,8 @@ def draw_graph(ax, graph, *, path=None, edge_labels=None, regions=True, alpha=0.
     """The task graph on the map: vertex regions, vertices at their representative points, edge arrows.
 
     ``path`` (a list of vertex names) is highlighted in blue; ``edge_labels`` maps ``(u, v)`` to text
-    (e.g. a success probability) written at the middle of the arrow.
+    (e.g. a success probability) written at the middle of the arrow. Shortcut edges (over a split's waypoints,
+    ``ours-shortcut``) are dashed.
     """
     fs = _fs(ax)
     if regions:
@@ -202,7 +203,8 @@ def draw_graph(ax, graph, *, path=None, edge_labels=None, regions=True, alpha=0.
         hot = (u, v) in on_path
         arrow = FancyArrowPatch(pts[u], pts[v], arrowstyle="-|>", mutation_scale=1.4 * fs,
                                 color=PATH if hot else EDGE, lw=2.4 if hot else 1.2, alpha=0.95 if hot else 0.8,
-                                shrinkA=0.7 * fs, shrinkB=0.7 * fs, connectionstyle="arc3,rad=0.08", zorder=5)
+                                shrinkA=0.7 * fs, shrinkB=0.7 * fs, connectionstyle="arc3,rad=0.08", zorder=5,
+                                linestyle="--" if graph.is_shortcut(u, v) else "-")
         ax.add_patch(arrow)
         if edge_labels and (u, v) in edge_labels:
             mid = (pts[u] + pts[v]) / 2
@@ -266,7 +268,7 @@ def _legend(fig, ax, items) -> None:
             handles.append(Patch(facecolor=colour, edgecolor="black" if colour == WALL else colour, label=name,
                                  hatch="xx" if colour == HAZARD else None))
         else:
-            handles.append(Line2D([0], [0], color=colour, lw=2, label=name))
+            handles.append(Line2D([0], [0], color=colour, lw=2, label=name, ls="--" if kind == "dashed" else "-"))
     fs = _fs(ax)
     box = ax.get_position()
     fig.legend(handles=handles, loc="lower center", bbox_to_anchor=(0.5, box.y1 + 0.1 * fs / fig.bbox.height),
@@ -309,6 +311,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
             items.insert(1, ("hazard", HAZARD, "patch"))
         if (graph is not None and len(graph.vertices()) > 2) or maze.subgoals or waypoints:
             items.append(("subgoal / waypoint", SUBGOAL, "patch"))
+        if graph is not None and any(graph.is_shortcut(u, v) for u, v in graph.edges()):
+            items.append(("shortcut edge", EDGE, "dashed"))
         if trajectories is not None and len(trajectories):
             if success is None:
                 items.append(("trajectory", "#777777", "line"))
@@ -356,7 +360,8 @@ def render_graph_diagram(graph, probs=None, *, path=None, title=None, size_px=51
         rad = 0.0 if depth[v] - depth[u] == 1 else -0.3
         ax.add_patch(FancyArrowPatch(pos[u], pos[v], arrowstyle="-|>", mutation_scale=1.5 * fs,
                                      color=PATH if hot else EDGE, lw=2.4 if hot else 1.2, shrinkA=shrink,
-                                     shrinkB=shrink, connectionstyle=f"arc3,rad={rad}", zorder=2))
+                                     shrinkB=shrink, connectionstyle=f"arc3,rad={rad}", zorder=2,
+                                     linestyle="--" if graph.is_shortcut(u, v) else "-"))
         if probs is not None and probs.get((u, v)) is not None:
             mid = (pos[u] + pos[v]) / 2 + np.array([0.0, 0.1 if rad == 0 else 0.1 + 0.3 * (depth[v] - depth[u]) / 2])
             ax.text(mid[0], mid[1], f"{float(probs[(u, v)]):.2f}", ha="center", va="bottom", fontsize=0.9 * fs,
