@@ -142,3 +142,24 @@ def test_run_grid_takes_code_out_and_workers_from_the_environment_and_refuses_ba
         done = subprocess.run(["bash", str(ROOT / "scripts" / "run_grid.sh"), name], capture_output=True, text=True,
                               env=os.environ | {"DRY_RUN": "1", "PYTHON": sys.executable} | env)
         assert done.returncode == 2 and done.stdout == "" and done.stderr.count("\n") == 1
+
+
+def test_status_counts_each_parts_done_rows_and_names_the_rest(tmp_path, capsys):
+    for name in sorted(COMPLETE):  # every cell of a finished grid is done
+        assert all(done == total and not missing for _, done, total, missing in grids.status(grids.get(name)))
+    g = grids.get("ant-scaling")  # a table cut short: its done rows are counted, the rest named in run order
+    (tmp_path / "data/results/ant/scaling").mkdir(parents=True)
+    first = [c.id for c in grids.part_cells(g, 0)]
+    table = tmp_path / g.part_table(0)
+    shipped = {r["cell"]: r for r in _rows(g.part_table(0))}
+    rows = [shipped[c] for c in first[:3]] + [shipped[first[3]] | {"status": "error", "error": "killed"}]
+    with table.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    report = grids.status(g, root=tmp_path)
+    assert report[0][1:3] == (3, len(first)) and report[0][3] == first[3:]
+    assert all(done == 0 for _, done, _, _ in report[1:])
+    grids.main(["status", "ant-scaling"])
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == len(g.parts) and out[0].startswith("part 0: ours x geometric:max_waypoints=48: ")

@@ -11,6 +11,7 @@ ids and parameters (``OUT/sweep.json`` refuses a cell run with another policy, r
     python -m specrefine.experiments.grids show ant-comparison       # the pinned_sweep.sh commands, in order
     python -m specrefine.experiments.grids args repair --part 0 --step 1    # one step's arguments, shell-quoted
     python -m specrefine.experiments.grids plan repair               # what run_grid.sh reads
+    python -m specrefine.experiments.grids status ant-scaling        # done cells per part, from the shipped tables
 """
 
 from __future__ import annotations
@@ -293,6 +294,19 @@ def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) 
     return lines
 
 
+def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, list[str]]]:
+    """Per part: (part, cells done in its shipped table, cells, the ids still to run, in run order)."""
+    from ..runs.sweep import is_done, read_checked_table
+
+    out = []
+    for i in range(len(g.parts)):
+        table = root / g.part_table(i)
+        done = {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
+        ids = [c.id for c in part_cells(g, i, root=root)]
+        out.append((i, len(ids) - sum(c not in done for c in ids), len(ids), [c for c in ids if c not in done]))
+    return out
+
+
 def main(argv=None) -> int:
     from ..core.argtypes import OneLineParser, bounded_int
 
@@ -301,13 +315,16 @@ def main(argv=None) -> int:
     sub.add_parser("list", help="every grid: name, agent, cells, where it was fixed")
     for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),
                        ("args", "one step's sweep arguments, shell-quoted on one line"),
-                       ("plan", "the code and steps run_grid.sh runs")):
+                       ("plan", "the code and steps run_grid.sh runs"),
+                       ("status", "cells done per part, from the shipped tables (--missing: which are not)")):
         sp = sub.add_parser(name, help=what)
         sp.add_argument("grid")
         if name == "args":
             sp.add_argument("--part", type=int, required=True)
             sp.add_argument("--step", type=int, default=0)
             sp.add_argument("--workers", type=bounded_int("workers"), default=None)
+        if name == "status":
+            sp.add_argument("--missing", action="store_true", help="list the cells still to run")
         if name == "plan":
             sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it)")
             sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids)")
@@ -320,6 +337,13 @@ def main(argv=None) -> int:
         g = get(args.grid)
         if args.command == "show":
             print("\n".join(show(g)))
+        elif args.command == "status":
+            for i, done, total, missing in status(g):
+                part = g.parts[i]
+                print(f"part {i}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {done}/{total} done "
+                      f"({g.part_table(i)})")
+                if args.missing:
+                    print("".join(f"  {cell}\n" for cell in missing), end="")
         elif args.command == "plan":
             print("\n".join(plan(g, args.out, args.shipped)))
         else:
