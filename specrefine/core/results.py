@@ -101,6 +101,15 @@ def wilson_ci(successes, n, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
+def newcombe_ci(k1, n1, k2, n2, z: float = 1.96) -> tuple[float, float]:
+    """Newcombe's hybrid score interval (his method 10) for p1 - p2 of two independent proportions, from their
+    Wilson intervals."""
+    p1, p2 = k1 / n1, k2 / n2
+    (l1, u1), (l2, u2) = wilson_ci(k1, n1, z), wilson_ci(k2, n2, z)
+    d = p1 - p2
+    return (d - math.sqrt((p1 - l1) ** 2 + (u2 - p2) ** 2), d + math.sqrt((u1 - p1) ** 2 + (p2 - l2) ** 2))
+
+
 PathResult = CompositionalResult  # the former name (notebooks written against it)
 
 

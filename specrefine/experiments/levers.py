@@ -1,0 +1,82 @@
+"""A lever's check against its baseline on the same cells (docs/ant_experiments.md sections 4-5): success pooled over
+the lever's runs and over the baseline's runs of the same (maze, seed) cells, and the difference with Newcombe's 95 %
+interval; the lever helps when that interval lies above 0.
+
+    python -m specrefine.experiments.levers data/results/ant/polish.csv --method ours-polish \\
+        --baseline data/results/ant/scaling/ours_geometric.csv --baseline-method ours \\
+        --mazes u_chain_3 u_chain_5 --seeds 0 1 2 --out data/results/ant/polish_check.md
+
+A cell missing from either table makes the check partial (its verdict so far is still printed). Every proposer here
+is offline, NOT a VLM.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
+from ..core.errors import SpecrefineError
+from ..core.results import newcombe_ci, wilson_ci
+from ..core.runfolder import write_atomic
+from ..runs.sweep import is_done, read_checked_table
+from .legs import pooled
+
+
+def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], dict]:
+    return {(r["maze"], int(r["seed"])): r for r in read_checked_table(table)
+            if is_done(r) and r["method"] == method and proposer in (None, r["proposer"])}
+
+
+def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:
+    """Pooled success of both sides on the cells both have; ``complete`` when both have every cell."""
+    both = [c for c in cells if c in lever and c in baseline]
+    (k1, n1), (k2, n2) = pooled([lever[c] for c in both]), pooled([baseline[c] for c in both])
+    if not both:
+        return {"cells": 0, "expected": len(cells), "complete": False, "verdict": "no cell yet"}
+    lo, hi = newcombe_ci(k1, n1, k2, n2)
+    verdict = "helps" if lo > 0 else "hurts" if hi < 0 else "no difference shown"
+    return {"cells": len(both), "expected": len(cells), "complete": len(both) == len(cells),
+            "lever": (k1, n1), "baseline": (k2, n2), "difference": k1 / n1 - k2 / n2, "ci": (lo, hi),
+            "verdict": verdict if len(both) == len(cells) else f"partial ({verdict} so far)",
+            "rows": [(c, lever[c]["success_rate"], baseline[c]["success_rate"]) for c in both]}
+
+
+def markdown(check: dict, lever_name: str, baseline_name: str) -> str:
+    if not check["cells"]:
+        return f"**{lever_name} against {baseline_name}: no cell yet** (0 of {check['expected']}).\n"
+    (k1, n1), (k2, n2), (lo, hi) = check["lever"], check["baseline"], check["ci"]
+    rate = lambda k, n: f"{k / n:.3f} [{wilson_ci(k, n)[0]:.3f}, {wilson_ci(k, n)[1]:.3f}] ({n})"  # noqa: E731
+    lines = [f"**{lever_name} against {baseline_name}, {check['cells']} of {check['expected']} cells: "
+             f"{check['verdict']}.** Pooled {rate(k1, n1)} against {rate(k2, n2)}: difference "
+             f"{check['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe 95 %).", "",
+             f"| maze | seed | {lever_name} | {baseline_name} |", "|---|---|---|---|"]
+    lines += [f"| {maze} | {seed} | {a:.3f} | {b:.3f} |" for (maze, seed), a, b in check["rows"]]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    p = OneLineParser(prog="python -m specrefine.experiments.levers", description=__doc__.split("\n")[0])
+    p.add_argument("table", help="the lever's sweep table")
+    p.add_argument("--method", required=True, help="the lever's method in it")
+    p.add_argument("--baseline", required=True, help="the baseline's sweep table")
+    p.add_argument("--baseline-method", required=True)
+    p.add_argument("--proposer", default=None, help="both sides' proposer (default: any)")
+    p.add_argument("--mazes", nargs="+", required=True)
+    p.add_argument("--seeds", nargs="+", type=int, required=True)
+    p.add_argument("--out", type=Path, default=None, help="write the markdown here (default: print it only)")
+    args = p.parse_args(argv)
+    try:
+        lever = _by_cell(args.table, args.method, args.proposer)
+        baseline = _by_cell(args.baseline, args.baseline_method, args.proposer)
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
+    cells = [(m, s) for m in args.mazes for s in args.seeds]
+    text = markdown(lever_check(lever, baseline, cells), args.method, args.baseline_method)
+    if args.out is not None:
+        write_atomic(args.out, text)
+    print(text, end="")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))
