@@ -10,10 +10,10 @@ import pytest
 from specrefine.experiments import antmaze
 
 
-def _run(root, name, method, proposer, seed, sim, official=None):
+def _run(root, name, method, proposer, seed, sim, official=None, maze="gr:U_MAZE"):
     run = root / "cells" / name
     run.mkdir(parents=True)
-    (run / "result.json").write_text(json.dumps({"maze": "gr:U_MAZE", "agent": "ant", "method": method,
+    (run / "result.json").write_text(json.dumps({"maze": maze, "agent": "ant", "method": method,
                                                  "proposer": proposer, "seed": seed, "success_rate": sim,
                                                  "episodes": 200, "path": [], "graph": {}}))
     if official is not None:
@@ -32,11 +32,19 @@ def test_the_table_pools_seeds_in_both_simulators_and_names_no_proposer_for_dirl
     table = antmaze.table(rows).splitlines()
     assert table[2] == ("| gr:U_MAZE | ours | geometric | 0,1 | 0.850 [0.812, 0.882] (400) | "
                         "0.750 [0.686, 0.805] (200) |")  # 340 of 400 and 150 of 200, Wilson intervals
-    assert table[3].endswith("| — |")
+    assert table[3].endswith("| — |") and "| dirl | none | 0 (official: none yet) |" in table[3]
     assert antmaze.main([str(tmp_path), "--out", str(tmp_path / "out")]) == 0
     with (tmp_path / "out" / "official.csv").open() as fh:
         assert [r["official_successes"] for r in csv.DictReader(fh)] == ["80", "70", ""]
     assert (tmp_path / "out" / "figure.png").stat().st_size > 0
+
+
+def test_maps_come_small_to_large_whatever_their_folder_names(tmp_path):
+    for name, maze in (("gr-LARGE_MAZE__s0", "gr:LARGE_MAZE"), ("gr-MEDIUM_MAZE__s0", "gr:MEDIUM_MAZE"),
+                       ("gr-U_MAZE__s0", "gr:U_MAZE"), ("my_maze__s0", "my_maze")):
+        _run(tmp_path, name, "ours", "geometric", 0, 0.5, maze=maze)
+    assert [k[0] for k in antmaze.groups(antmaze.run_rows(tmp_path))] == ["gr:U_MAZE", "gr:MEDIUM_MAZE",
+                                                                          "gr:LARGE_MAZE", "my_maze"]
 
 
 def test_a_malformed_result_is_one_line_and_exit_2(tmp_path, capsys):

@@ -63,9 +63,14 @@ def _rate(k: int, n: int) -> str:
     return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] ({n})"
 
 
+MAP_ORDER = ("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE")  # small to large, as the grid runs them
+
+
 def groups(rows) -> dict[tuple, list[dict]]:
+    """Runs by (map, method, proposer): the grid's maps small to large (others after them, by name)."""
     out: dict[tuple, list[dict]] = {}
-    for r in rows:
+    for r in sorted(rows, key=lambda r: (MAP_ORDER.index(r["maze"]) if r["maze"] in MAP_ORDER else len(MAP_ORDER),
+                                         r["maze"])):
         out.setdefault((r["maze"], r["method"], r["proposer"]), []).append(r)
     return out
 
@@ -74,7 +79,11 @@ def table(rows) -> str:
     lines = ["| map | method | proposer | seeds | this simulator [95 % CI] (episodes) | official [95 % CI] "
              "(episodes) |", "|---|---|---|---|---|---|"]
     for (maze, method, proposer), runs in groups(rows).items():
-        seeds = ",".join(str(r["seed"]) for r in sorted(runs, key=lambda r: int(r["seed"])))
+        runs = sorted(runs, key=lambda r: int(r["seed"]))
+        seeds = ",".join(str(r["seed"]) for r in runs)
+        official = [str(r["seed"]) for r in runs if r["official_episodes"] != ""]
+        if len(official) < len(runs):
+            seeds += f" (official: {','.join(official) or 'none yet'})"
         lines.append(f"| {maze} | {method} | {proposer} | {seeds} | {_rate(*_pooled(runs, 'sim'))} | "
                      f"{_rate(*_pooled(runs, 'official'))} |")
     return "\n".join(lines)
