@@ -238,3 +238,49 @@ def test_heading_and_world_frames_agree_at_heading_zero_and_for_the_point():
     np.testing.assert_array_equal(point.observe(goals, "heading"), point.observe(goals, "world"))
     with pytest.raises(SpecrefineError, match="observation frame"):
         ant.observe(goals, "compass")
+
+
+def test_random_maze_is_connected_seeded_and_none_of_the_benchmark():
+    from specrefine.core.errors import MazeError
+    from specrefine.core.mazes import benchmark_mazes, load_maze, random_maze, reachable_cells
+
+    maze = random_maze((4, 6), seed=3)
+    assert maze == random_maze((4, 6), seed=3) and maze.grid != random_maze((4, 6), seed=4).grid
+    assert (maze.rows, maze.cols) == (9, 13) and maze.cells("S") == [(1, 1)] and maze.cells("G") == [(7, 11)]
+    assert reachable_cells(maze, maze.cells("S")) == set(maze.free_cells())  # one corridor system
+    assert all(maze.grid[r][c] == "#" for r in range(0, 9, 2) for c in range(0, 13, 2))  # pillars stay
+    assert maze.grid not in {load_maze(p).grid for p in benchmark_mazes().values()}
+    with pytest.raises(MazeError):
+        random_maze((1, 5), seed=0)
+
+
+def test_training_among_walls_walks_goals_along_the_corridors_and_ends_on_a_wall():
+    from dataclasses import replace
+
+    from specrefine.core.agents import AGENTS
+    from specrefine.core.mazes import random_maze
+
+    maze = random_maze((3, 3), seed=1)
+    task = replace(AGENTS["point"].reach_task, goals_per_episode=50, wall_penalty=2.0)
+    env = GoalReachEnv("point", 6, seed=0, nthread=1, task=task, maze=maze)
+    td = env.reset()
+    scaled = env.maze
+    centres = {tuple(np.round(scaled.cell_to_xy(r, c), 6)) for r, c in scaled.free_cells()}
+    for _ in range(30):  # each reached goal: the next is the centre of a free neighbouring cell
+        before = env.cell.copy()
+        assert {tuple(np.round(g, 6)) for g in env.goals} <= centres
+        env.goals[:] = env.sim.xy  # every env reaches its goal on this step
+        td["action"] = torch.zeros(6, 2)
+        out, td = env.step_and_maybe_reset(td)
+        moved = np.abs(env.cell - before).sum(axis=1)
+        assert set(moved.tolist()) <= {1} and not out["next", "wall"].any()
+    wall = scaled.cell_to_xy(0, 1)  # the outer wall above the first room
+    near = wall + np.array([[0.0, -0.55], [0.0, -1.0]])  # 0.05 m below it (within the clearance), and a cell centre
+    assert env.touching(near).tolist() == [True, False]
+    assert not GoalReachEnv("point", 2, seed=0, nthread=1).touching(near).any()  # the open floor has no walls
+    env.touching = lambda xy: np.arange(len(xy)) == 0  # env 0 touches a wall on the next step (contacts push a
+    td["action"] = torch.zeros(6, 2)  # body out within a step, so the test forces the touch)
+    out, _ = env.step_and_maybe_reset(td)
+    assert bool(out["next", "wall"][0]) and bool(out["next", "terminated"][0]) and not bool(out["next", "flipped"][0])
+    assert not bool(out["next", "success"][0]) and out["next", "reward"][0].item() < out["next", "reward"][1].item() - 1
+    assert not out["next", "wall"][1:].any() and not out["next", "done"][1:].any()

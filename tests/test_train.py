@@ -195,3 +195,16 @@ def test_a_policy_file_records_its_observation_frame(tmp_path):
     assert (world.observation_frame, back.observation_frame) == ("world", "heading")
     assert back.fingerprint != world.fingerprint  # the same weights fed another observation: another policy
     assert load_policy("ant").fingerprint == world.fingerprint  # files without the header stay "world"
+
+
+def test_training_among_walls_runs_and_logs_wall_touches(tmp_path, capsys):
+    cfg = make_config("point", frames=4_096, seed=0, checkpoint_every_s=1e9, train_maze="random:3x3:0",
+                      wall_penalty=1.0, goals_per_episode=4)
+    Trainer(cfg, tmp_path / "walls", progress=False).train()
+    rows = read_log(tmp_path / "walls" / "log.jsonl")
+    assert rows and all("wall_rate" in r for r in rows)
+    assert all(0.0 <= r["wall_rate"] <= 1.0 for r in rows if r["episodes"])
+    for bad in ("random:3:0", "random:axb:1", "random:1x4:0"):
+        assert main(["--agent", "point", "--out", str(tmp_path / "r"), "--train-maze", bad]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and ("train-maze" in err or "random maze" in err)

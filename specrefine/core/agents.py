@@ -35,6 +35,7 @@ class ReachTask:
     goals_per_episode: int = 1  # > 1: on success a new goal is drawn from where the agent is, without a reset
     tilt_cost: float = 0.0  # per step x (1 - the torso's up-vector z): a dense warning long before a flip
     goal_radius: tuple[float, float] | None = None  # each goal's success radius drawn from [lo, hi] (None: fixed)
+    wall_penalty: float = 0.0  # among walls (GoalReachEnv's maze): touching one ends the episode with this penalty
 
 
 @dataclass(frozen=True)

@@ -264,6 +264,37 @@ def reachable_cells(maze: Maze, sources, through=None) -> set[tuple[int, int]]:
     return seen
 
 
+def random_maze(rooms: tuple[int, int], seed: int, loops: float = 0.25, cell_size: float = 1.0) -> Maze:
+    """A corridor maze for training among walls, none of the benchmark's layouts: a spanning tree of rooms[0] x
+    rooms[1] one-cell rooms (randomised depth-first search), each room joined to its neighbours by one-cell
+    corridors, plus a fraction ``loops`` of the remaining walls between rooms opened; S top-left, G bottom-right."""
+    rows, cols = (int(k) for k in rooms)
+    if rows < 2 or cols < 2 or not 0 <= loops <= 1:
+        raise MazeError(f"random maze {rows}x{cols}, loops {loops:g}: needs at least 2x2 rooms and 0 <= loops <= 1")
+    rng = np.random.default_rng(seed)
+    grid = [["#"] * (2 * cols + 1) for _ in range(2 * rows + 1)]
+    seen, stack = {(0, 0)}, [(0, 0)]
+    grid[1][1] = "."
+    while stack:
+        r, c = stack[-1]
+        nbs = [(r + dr, c + dc) for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1))
+               if 0 <= r + dr < rows and 0 <= c + dc < cols and (r + dr, c + dc) not in seen]
+        if not nbs:
+            stack.pop()
+            continue
+        nr, nc = nbs[rng.integers(len(nbs))]
+        grid[2 * nr + 1][2 * nc + 1] = "."
+        grid[r + nr + 1][c + nc + 1] = "."
+        seen.add((nr, nc))
+        stack.append((nr, nc))
+    inner = [(r, c) for r in range(1, 2 * rows) for c in range(1, 2 * cols) if (r + c) % 2 == 1 and grid[r][c] == "#"]
+    for k in rng.permutation(len(inner))[: round(loops * len(inner))]:
+        r, c = inner[k]
+        grid[r][c] = "."
+    grid[1][1], grid[2 * rows - 1][2 * cols - 1] = "S", "G"
+    return Maze(f"random_{rows}x{cols}_s{seed}", tuple("".join(line) for line in grid), cell_size)
+
+
 def load_maze(path, cell_size: float = 1.0) -> Maze:
     """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/, and 'gr:NAME' is the
     Gymnasium-Robotics map NAME (``specrefine.core.standard_maps``)."""

@@ -13,7 +13,9 @@ from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
 from ..core.agents import ReachTask, get_agent
-from .simulator import BatchedSim, sample_goals
+from ..core.mazes import Maze
+from ..core.regions import CompiledRegion
+from .simulator import BatchedSim, contact_margin, sample_goals
 
 
 class GoalReachEnv(EnvBase):
@@ -26,12 +28,25 @@ class GoalReachEnv(EnvBase):
     state instead, as a compositional policy switches subtasks, and ``max_steps`` counts per goal.  With
     ``task.goal_radius`` = (lo, hi), each goal counts as reached within its own radius drawn from [lo, hi]
     (a refined graph's goal regions are that size: the next goal arrives while the agent still moves).
+
+    ``maze`` (training among walls): episodes start at a free cell's centre and every goal is the centre of a
+    neighbouring free cell, as the oracle's waypoints along a corridor, turning where the corridor turns and not
+    going back unless it ends; touching a wall (closer than the evaluator's clearance, the body radius plus MuJoCo's
+    contact margin) ends the episode with ``task.wall_penalty``. The policy's observation stays as it is: the walls
+    are in the physics only.
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None,
-                 frame: str = "world"):
+                 frame: str = "world", maze: Maze | None = None):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
-        self.sim = BatchedSim(agent, None, n, nthread=nthread)
+        self.maze = None if maze is None else maze.for_agent(agent)
+        self.sim = BatchedSim(agent, self.maze, n, nthread=nthread)
+        if self.maze is not None:
+            self._walls = CompiledRegion(self.maze.walls)
+            self.clearance = get_agent(agent).body_radius + contact_margin(self.sim.model)
+            self._free = np.array(self.maze.free_cells())
+            self.cell = np.zeros((n, 2), dtype=np.int64)  # the cell of each env's current goal (or start)
+            self.came_from = np.zeros((n, 2), dtype=np.int64)
         self.frame = frame  # the observation frame of the policy being trained (simulator.BatchedSim.observe)
         self.task = task or get_agent(agent).reach_task
         self.rng = np.random.default_rng(seed)
@@ -44,7 +59,7 @@ class GoalReachEnv(EnvBase):
         self.observation_spec = Composite(
             observation=Unbounded((*bs, self.sim.obs_dim), dtype=torch.float32),
             success=Categorical(2, (*bs, 1), dtype=torch.bool), flipped=Categorical(2, (*bs, 1), dtype=torch.bool),
-            shape=bs)
+            wall=Categorical(2, (*bs, 1), dtype=torch.bool), shape=bs)
         self.action_spec = Bounded(-1.0, 1.0, (*bs, self.sim.act_dim), dtype=torch.float32)
         self.reward_spec = Unbounded((*bs, 1), dtype=torch.float32)
         flag = Categorical(2, (*bs, 1), dtype=torch.bool)
@@ -53,33 +68,56 @@ class GoalReachEnv(EnvBase):
     def _set_seed(self, seed: int | None):
         self.rng = np.random.default_rng(seed)
 
-    def _obs_td(self, success, flipped) -> TensorDict:
-        return TensorDict({
-            "observation": torch.from_numpy(self.sim.observe(self.goals, self.frame)),
-            "success": torch.from_numpy(success).unsqueeze(-1), "flipped": torch.from_numpy(flipped).unsqueeze(-1),
-        }, batch_size=self.batch_size)
+    def _obs_td(self, success, flipped, wall) -> TensorDict:
+        flags = {k: torch.from_numpy(v).unsqueeze(-1) for k, v in (("success", success), ("flipped", flipped),
+                                                                  ("wall", wall))}
+        return TensorDict({"observation": torch.from_numpy(self.sim.observe(self.goals, self.frame)), **flags},
+                          batch_size=self.batch_size)
 
     def _reset(self, tensordict: TensorDict | None = None, **kwargs) -> TensorDict:
         mask = np.ones(self.sim.n, dtype=bool)
         if tensordict is not None and "_reset" in tensordict.keys():
             mask = tensordict["_reset"].reshape(self.sim.n).numpy().copy()
         idx = np.flatnonzero(mask)
-        self.sim.reset(rng=self.rng, idx=idx)
+        if self.maze is None:
+            self.sim.reset(rng=self.rng, idx=idx)
+        else:
+            self.cell[idx] = self.came_from[idx] = self._free[self.rng.integers(len(self._free), size=len(idx))]
+            self.sim.reset(xy=self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2),
+                           rng=self.rng, idx=idx)
         self._new_goals(idx)
         self.t[idx] = 0
         self.goal_index[idx] = 0
         zeros = np.zeros(self.sim.n, dtype=bool)
-        out = self._obs_td(zeros, zeros)
+        out = self._obs_td(zeros, zeros, zeros)
         out.update(self._dones(zeros, zeros))
         return out
 
     def _new_goals(self, idx: np.ndarray) -> None:
         """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are."""
         task = self.task
-        self.goals[idx] = sample_goals(self.sim.xy[idx], task.goal_min, task.goal_max, self.rng)
+        if self.maze is None:
+            self.goals[idx] = sample_goals(self.sim.xy[idx], task.goal_min, task.goal_max, self.rng)
+        else:
+            for i in idx:
+                self.came_from[i], self.cell[i] = self.cell[i].copy(), self._next_cell(self.cell[i], self.came_from[i])
+            self.goals[idx] = self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2)
         self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
         if task.goal_radius is not None:
             self.radius[idx] = self.rng.uniform(*task.goal_radius, size=len(idx))
+
+    def touching(self, xy: np.ndarray) -> np.ndarray:
+        """Which positions touch a wall: closer than the evaluator's clearance (none on the open floor)."""
+        if self.maze is None:
+            return np.zeros(len(xy), dtype=bool)
+        return self._walls.below(xy, self.clearance)
+
+    def _next_cell(self, cell: np.ndarray, came_from: np.ndarray) -> np.ndarray:
+        """A random free neighbour of ``cell``, not the one it was reached from unless it is the only one."""
+        r, c = (int(v) for v in cell)
+        nbs = [nb for nb in ((r + 1, c), (r - 1, c), (r, c + 1), (r, c - 1)) if self.maze.is_free(*nb)]
+        ahead = [nb for nb in nbs if nb != tuple(int(v) for v in came_from)] or nbs
+        return np.array(ahead[self.rng.integers(len(ahead))])
 
     def _dones(self, terminated: np.ndarray, truncated: np.ndarray) -> dict:
         t = torch.from_numpy(terminated).unsqueeze(-1)
@@ -100,20 +138,22 @@ class GoalReachEnv(EnvBase):
         dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
         success, flipped = dist < self.radius, self.sim.flipped
         task = self.task
+        hit = self.touching(self.sim.xy)
+        success &= ~hit
         if task.arrive_speed is not None:
             success &= np.linalg.norm(self.sim.qvel[:, :2], axis=1) < task.arrive_speed
         reward = (task.progress_scale * (self.dist - dist) + task.success_bonus * success
                   - task.flip_penalty * flipped - task.step_cost - task.lateral_cost * self._sideways(before)
-                  - task.tilt_cost * (1.0 - self.sim.up))
+                  - task.tilt_cost * (1.0 - self.sim.up) - task.wall_penalty * hit)
         self.dist = dist
-        more = success & ~flipped & (self.goal_index + 1 < task.goals_per_episode)
+        more = success & ~flipped & (self.goal_index + 1 < task.goals_per_episode)  # (success excludes a wall hit)
         if more.any():  # chained goals: the next one starts from here, at whatever speed the agent has
             self.goal_index[more] += 1
             self.t[more] = 0
             self._new_goals(np.flatnonzero(more))
-        terminated = (success & ~more) | flipped
+        terminated = (success & ~more) | flipped | hit
         truncated = ~terminated & (self.t >= task.max_steps)
-        out = self._obs_td(success, flipped)
+        out = self._obs_td(success, flipped, hit)
         out["reward"] = torch.from_numpy(reward.astype(np.float32)).unsqueeze(-1)
         out.update(self._dones(terminated, truncated))
         return out

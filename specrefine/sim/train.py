@@ -86,6 +86,11 @@ class Config:
                                            "taken out: behaviour independent of the direction of travel)")
     switch_radius: tuple[float, float] | None = knob(None, "each goal counts as reached within a radius drawn "
                                                            "from [LO, HI] m (default: the task's success radius)")
+    train_maze: str | None = knob(None, "train among walls: 'random:RxC:SEED' (a generated corridor maze of R x C "
+                                        "rooms, none of the benchmark's layouts) or any maze the CLI takes; goals "
+                                        "are neighbouring cells' centres (default: the open floor)")
+    wall_penalty: float | None = knob(None, "with --train-maze: touching a wall ends the episode with this "
+                                            "penalty (default: the agent's task)")
 
     @property
     def frames_per_batch(self) -> int:
@@ -130,6 +135,22 @@ def config_arguments(parser: argparse.ArgumentParser) -> None:
 def make_config(agent: str, **overrides) -> Config:
     """The agent's training defaults (``specrefine.core.agents``) with ``overrides`` on top."""
     return replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
+
+
+def training_maze(text: str | None):
+    """``--train-maze``: None (open floor), 'random:RxC:SEED' (``core.mazes.random_maze``) or a maze the CLI takes."""
+    from ..core.mazes import load_maze, random_maze
+
+    if text is None:
+        return None
+    if text.startswith("random:"):
+        try:
+            rooms, seed = text.removeprefix("random:").split(":")
+            r, c = (int(k) for k in rooms.lower().split("x"))
+            return random_maze((r, c), int(seed))
+        except ValueError:
+            raise SpecrefineError(f"--train-maze {text!r}: expected random:RxC:SEED, e.g. random:4x6:0") from None
+    return load_maze(text)
 
 
 # --- networks ---------------------------------------------------------------------------------
@@ -183,14 +204,15 @@ class Trainer:
         self.out.mkdir(parents=True, exist_ok=True)
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
-        optional = {k: v for k in ("tilt_cost", "flip_penalty", "lateral_cost") if (v := getattr(cfg, k)) is not None}
+        optional = {k: v for k in ("tilt_cost", "flip_penalty", "lateral_cost", "wall_penalty")
+                    if (v := getattr(cfg, k)) is not None}
         if cfg.switch_radius is not None:
             optional["goal_radius"] = _radius_range(cfg.switch_radius)
         task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
         # the policy first: a bad --observation-frame is one line before the simulator is built
         self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
-                                frame=cfg.observation_frame)
+                                frame=cfg.observation_frame, maze=training_maze(cfg.train_maze))
         self.actor, self.critic = make_modules(self.policy, self.env)
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
                                 entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,
@@ -291,8 +313,10 @@ class Trainer:
         n_done = int(done.sum())
         succ = int(nxt["success"].squeeze(-1).numpy()[done].sum())
         flips = int(nxt["flipped"].squeeze(-1).numpy()[done].sum())
+        walls = int(nxt["wall"].squeeze(-1).numpy()[done].sum())
         return {"episodes": n_done, "success_rate": succ / n_done if n_done else float("nan"),
                 "flip_rate": flips / n_done if n_done else float("nan"),
+                "wall_rate": walls / n_done if n_done else float("nan"),
                 "return": float(np.mean(returns)) if returns else float("nan")}
 
     def train(self) -> Path:
