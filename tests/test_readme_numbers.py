@@ -326,6 +326,20 @@ def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
     assert _between(FRONT, "front cost") == " and ".join(f"{r['wall_seconds']:.0f} s" for r in cost["runs"])
 
 
+def test_polish_check_is_the_levers_rule_on_the_shipped_tables():
+    from specrefine.experiments import levers
+
+    def side(table, method):
+        return levers._by_cell(ROOT / table, method, "geometric:max_waypoints=48")
+
+    cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
+    text = levers.markdown(levers.lever_check(side("data/results/ant/polish.csv", "ours-polish"),
+                                              side("data/results/ant/scaling/ours_geometric.csv", "ours"), cells),
+                           "ours-polish", "ours")
+    assert (ROOT / "data/results/ant/polish_check.md").read_text() == text
+    assert "<!-- polish check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
+
+
 def test_leg_profiles_table_is_the_shipped_profiles():
     import json
 
