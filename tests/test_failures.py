@@ -68,3 +68,32 @@ def test_an_unreadable_result_is_one_line(tmp_path, capsys, text):
     bad.write_text(text)
     assert main([str(bad)]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_goal_points_at_the_centres_aim_every_leg_at_its_sets_centre(monkeypatch, tmp_path):
+    from specrefine.core.errors import SpecrefineError
+    from specrefine.core.graph import TaskGraph
+    from specrefine.evaluation.evaluator import Evaluator
+    from specrefine.experiments import failures
+
+    seen = []
+    real = Evaluator.run_compositional
+
+    def spy(self, start, legs, n=None, seed=None):
+        seen.append([None if p is None else tuple(np.round(p, 9)) for _, _, p in legs])
+        return real(self, start, legs, n=n, seed=seed)
+
+    monkeypatch.setattr(Evaluator, "run_compositional", spy)
+    result = refine_maze("u_chain_1", agent="point", method="ours", proposer="geometric", seed=0, rollouts=8,
+                         episodes=20, out=tmp_path / "run").data
+    seen.clear()  # the run's own measurement
+    report = failures.path_failures(result, episodes=8, seed=1, goal_points="centre")
+    graph = TaskGraph.from_dict(result["graph"])
+    centres = [tuple(np.round(graph.region(v).centre(), 9)) for v in result["path"][1:]]
+    assert report["goal_points"] == "centre" and seen and all(points == centres for points in seen)
+    seen.clear()
+    assert failures.path_failures(result, episodes=8, seed=1)["goal_points"] == "sampled"
+    assert all(p is None or graph.goal_point(v) is not None for points in seen
+               for p, v in zip(points, result["path"][1:]))
+    with pytest.raises(SpecrefineError, match="goal points"):
+        failures.path_failures(result, episodes=8, seed=1, goal_points="corner")

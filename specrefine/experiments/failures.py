@@ -52,8 +52,14 @@ def leg_table(run, n_legs: int) -> list[dict]:
     return rows
 
 
-def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> dict:
-    """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures."""
+GOAL_POINTS = ("sampled", "centre")
+
+
+def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal_points: str = "sampled") -> dict:
+    """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
+
+    ``goal_points``: "sampled" (as the run measured it, the paper's rule: each episode aims at a point drawn from
+    the goal vertex's set) or "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper)."""
     from ..core.graph import TaskGraph
     from ..evaluation.evaluator import Evaluator, path_legs
     from ..runs.experiment import setup
@@ -67,11 +73,16 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped") -> d
         path, legs = result["path"], path_legs(graph, result["path"])
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
+    if goal_points not in GOAL_POINTS:
+        raise SpecrefineError(f"goal points {goal_points!r}: expected one of {', '.join(GOAL_POINTS)}")
     start = graph.region(path[0])
     centres = [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
+    if goal_points == "centre":
+        legs = [(goal, avoid, np.asarray(centres[k + 1], dtype=float)) for k, (goal, avoid, _) in enumerate(legs)]
     turns = turn_angles(centres)
     lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
     out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
+           "goal_points": goal_points,
            "legs": [{"leg": k, "from": path[k], "to": path[k + 1], "turn_deg": turns[k], "length_m": lengths[k]}
                     for k in range(len(legs))]}
     bare = open_floor(exp.maze)
@@ -111,6 +122,9 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
     p.add_argument("--policy", default="shipped", help="'shipped' or a policy checkpoint")
+    p.add_argument("--goal-points", choices=GOAL_POINTS, default="sampled",
+                   help="sampled: each episode aims at a point drawn from the goal vertex's set (as measured, the "
+                        "paper's rule); centre: at the set's centre (beyond the paper)")
     p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
     args = p.parse_args(argv)
     try:
@@ -118,7 +132,7 @@ def main(argv=None) -> int:
             writable_parent(args.out)  # before the re-run, not after it
         result = read_result(args.result)
         maze = recorded_maze(args.result, result["maze"])
-        report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy)
+        report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
         if args.out is not None:
             write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:
