@@ -316,12 +316,10 @@ def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
     from specrefine.experiments.legs import pooled
 
     rows = scaling.read_rows([ROOT / "data/results/ant/scaling/ours_geometric.csv"])
-    runs = [r for r in rows if (r["maze"], r["method"], r["proposer"]) == ("u_chain_5", "ours", scaling.ORACLE)
-            and r["seed"] in (0, 1)]
-    assert len(runs) == 2
+    runs = [r for r in rows if (r["maze"], r["method"], r["proposer"]) == ("u_chain_5", "ours", scaling.ORACLE)]
+    assert sorted(r["seed"] for r in runs) == [0, 1, 2]
     k, n = pooled(runs)
-    assert _between(FRONT, "front five") == (f"{k / n:.3f} ({k} of {n} episodes); even a perfect seed 2 would "
-                                             f"leave it at {(k + 200) / (n + 200):.3f}")
+    assert _between(FRONT, "front five") == f"{k / n:.3f} ({k} of {n} episodes)"
     cost = json.loads((ROOT / "data/results/ant/scaling/cost_u_chain_5.json").read_text())
     assert _between(FRONT, "front cost") == " and ".join(f"{r['wall_seconds']:.0f} s" for r in cost["runs"])
 
