@@ -358,3 +358,15 @@ def test_antmaze_table_is_its_official_csv():
     doc = (ROOT / "docs" / "official_env.md").read_text()
     assert "<!-- antmaze table -->\n" + table(rows) + "\n" in doc
     assert (ROOT / "data/results/ant/antmaze/table.md").read_text() == table(rows) + "\n"
+
+
+def test_front_page_goal_point_numbers_are_the_shipped_reruns():
+    import json
+
+    folder = ROOT / "data/results/ant/scaling/goal_points"
+    text = " ".join(FRONT.split())
+    for maze in ("u_chain_3", "u_chain_5"):
+        rate = {gp: json.loads((folder / f"{maze}_s0_{gp}.json").read_text())["walls"]["rate"]
+                for gp in ("sampled", "centre")}
+        n = maze[-1]
+        assert f"U-chain {n} path from {rate['sampled']:.3f} to {rate['centre']:.3f}" in text
