@@ -101,6 +101,14 @@ def wilson_ci(successes, n, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
+def rate_text(k: int, n: int) -> str:
+    """'k/n [Wilson 95 % interval] (n)' as the result tables write a pooled rate; '—' without episodes."""
+    if not n:
+        return "—"
+    lo, hi = wilson_ci(k, n)
+    return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] ({n})"
+
+
 def newcombe_ci(k1, n1, k2, n2, z: float = 1.96) -> tuple[float, float]:
     """Newcombe's hybrid score interval (his method 10) for p1 - p2 of two independent proportions, from their
     Wilson intervals."""

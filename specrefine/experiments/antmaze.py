@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
-from ..core.results import wilson_ci
+from ..core.results import rate_text
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS
@@ -56,13 +56,6 @@ def _pooled(rows, side: str) -> tuple[int, int]:
     return sum(int(r[f"{side}_successes"]) for r in done), sum(int(r[f"{side}_episodes"]) for r in done)
 
 
-def _rate(k: int, n: int) -> str:
-    if not n:
-        return "—"
-    lo, hi = wilson_ci(k, n)
-    return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] ({n})"
-
-
 MAP_ORDER = ("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE")  # small to large, as the grid runs them
 
 
@@ -84,8 +77,8 @@ def table(rows) -> str:
         official = [str(r["seed"]) for r in runs if r["official_episodes"] != ""]
         if len(official) < len(runs):
             seeds += f" (official: {','.join(official) or 'none yet'})"
-        lines.append(f"| {maze} | {method} | {proposer} | {seeds} | {_rate(*_pooled(runs, 'sim'))} | "
-                     f"{_rate(*_pooled(runs, 'official'))} |")
+        lines.append(f"| {maze} | {method} | {proposer} | {seeds} | {rate_text(*_pooled(runs, 'sim'))} | "
+                     f"{rate_text(*_pooled(runs, 'official'))} |")
     return "\n".join(lines)
 
 

@@ -303,7 +303,8 @@ def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, li
         table = root / g.part_table(i)
         done = {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
         ids = [c.id for c in part_cells(g, i, root=root)]
-        out.append((i, len(ids) - sum(c not in done for c in ids), len(ids), [c for c in ids if c not in done]))
+        missing = [c for c in ids if c not in done]
+        out.append((i, len(ids) - len(missing), len(ids), missing))
     return out
 
 

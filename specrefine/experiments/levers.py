@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
-from ..core.results import newcombe_ci, wilson_ci
+from ..core.results import newcombe_ci, rate_text
 from ..core.runfolder import write_atomic
 from ..runs.sweep import is_done, read_checked_table
 from .legs import pooled
@@ -30,9 +30,9 @@ def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], 
 def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:
     """Pooled success of both sides on the cells both have; ``complete`` when both have every cell."""
     both = [c for c in cells if c in lever and c in baseline]
-    (k1, n1), (k2, n2) = pooled([lever[c] for c in both]), pooled([baseline[c] for c in both])
     if not both:
         return {"cells": 0, "expected": len(cells), "complete": False, "verdict": "no cell yet"}
+    (k1, n1), (k2, n2) = pooled([lever[c] for c in both]), pooled([baseline[c] for c in both])
     lo, hi = newcombe_ci(k1, n1, k2, n2)
     verdict = "helps" if lo > 0 else "hurts" if hi < 0 else "no difference shown"
     return {"cells": len(both), "expected": len(cells), "complete": len(both) == len(cells),
@@ -44,10 +44,10 @@ def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> di
 def markdown(check: dict, lever_name: str, baseline_name: str) -> str:
     if not check["cells"]:
         return f"**{lever_name} against {baseline_name}: no cell yet** (0 of {check['expected']}).\n"
-    (k1, n1), (k2, n2), (lo, hi) = check["lever"], check["baseline"], check["ci"]
-    rate = lambda k, n: f"{k / n:.3f} [{wilson_ci(k, n)[0]:.3f}, {wilson_ci(k, n)[1]:.3f}] ({n})"  # noqa: E731
+    lo, hi = check["ci"]
     lines = [f"**{lever_name} against {baseline_name}, {check['cells']} of {check['expected']} cells: "
-             f"{check['verdict']}.** Pooled {rate(k1, n1)} against {rate(k2, n2)}: difference "
+             f"{check['verdict']}.** Pooled {rate_text(*check['lever'])} against {rate_text(*check['baseline'])}: "
+             f"difference "
              f"{check['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe 95 %).", "",
              f"| maze | seed | {lever_name} | {baseline_name} |", "|---|---|---|---|"]
     lines += [f"| {maze} | {seed} | {a:.3f} | {b:.3f} |" for (maze, seed), a, b in check["rows"]]
