@@ -121,17 +121,23 @@ def test_sweep_exits_1_when_every_cell_failed(tmp_path, capsys, monkeypatch):
 
 
 # --- the sweep's processes: Ctrl-C and a killed parent ------------------------------------------------
-def _group(pgid: int) -> list[int]:
-    """Live (non-zombie) processes of a process group."""
+def _group(pgid: int, command: bytes = b"") -> list[int]:
+    """Live (non-zombie) processes of a process group (whose command line holds ``command``)."""
     pids = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             fields = stat.read_text().rsplit(")", 1)[1].split()
+            if int(fields[2]) == pgid and fields[0] != "Z" and command in (stat.parent / "cmdline").read_bytes():
+                pids.append(int(stat.parent.name))
         except OSError:
             continue
-        if int(fields[2]) == pgid and fields[0] != "Z":
-            pids.append(int(stat.parent.name))
     return pids
+
+
+def _pool_started(pgid: int) -> bool:
+    """The sweep and both its workers (forks, so the same command line) are up; a helper process that a
+    library starts for a moment (glfw's `python -c` probe, for one) is not a worker."""
+    return len(_group(pgid, b"specrefine.runs.sweep")) >= 3
 
 
 def _sweep_proc(out: Path):
@@ -154,7 +160,7 @@ def test_sweep_ctrl_c_ends_with_one_line_and_keeps_rows(tmp_path):
     sweep._append(tmp_path / "results.csv", done)  # a finished cell from before
     proc = _sweep_proc(tmp_path)
     try:
-        assert _wait_for(lambda: len(_group(proc.pid)) >= 3, 60), "no pool workers"
+        assert _wait_for(lambda: _pool_started(proc.pid), 60), "no pool workers"
         time.sleep(1)
         os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C: the whole foreground group, workers included
         _, err = proc.communicate(timeout=60)
@@ -170,7 +176,7 @@ def test_sweep_ctrl_c_ends_with_one_line_and_keeps_rows(tmp_path):
 def test_sweep_workers_die_with_a_killed_parent(tmp_path):
     proc = _sweep_proc(tmp_path)
     try:
-        assert _wait_for(lambda: len(_group(proc.pid)) >= 3, 60), "no pool workers"
+        assert _wait_for(lambda: _pool_started(proc.pid), 60), "no pool workers"
         proc.kill()  # the parent only: its workers are orphaned
         proc.wait(timeout=10)
         assert _wait_for(lambda: not _group(proc.pid), 20), "pool workers outlived the sweep"

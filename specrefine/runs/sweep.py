@@ -356,6 +356,10 @@ def _run_local(cells, out_root, workers, _address):
         for cell in cells:
             yield run_cell(cell, out_root)
         return
+    # Imported once here, before the fork: importing mujoco starts a short-lived `python -c` (glfw's library
+    # probe); in a worker, Ctrl-C could end the worker under it and the orphan printed a BrokenPipeError.
+    import mujoco  # noqa: F401
+
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),),
                                mp_context=_mp_context())
     finished = False
