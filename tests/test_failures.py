@@ -77,13 +77,13 @@ def test_goal_points_at_the_centres_aim_every_leg_at_its_sets_centre(monkeypatch
     from specrefine.experiments import failures
 
     seen = []
-    real = Evaluator.run_compositional
+    real = Evaluator._rollout
 
-    def spy(self, start, legs, n=None, seed=None):
+    def spy(self, start, legs, n, seed):  # the legs as simulated, each with the point it aims at
         seen.append([None if p is None else tuple(np.round(p, 9)) for _, _, p in legs])
-        return real(self, start, legs, n=n, seed=seed)
+        return real(self, start, legs, n, seed)
 
-    monkeypatch.setattr(Evaluator, "run_compositional", spy)
+    monkeypatch.setattr(Evaluator, "_rollout", spy)
     result = refine_maze("u_chain_1", agent="point", method="ours", proposer="geometric", seed=0, rollouts=8,
                          episodes=20, out=tmp_path / "run").data
     seen.clear()  # the run's own measurement

@@ -4,9 +4,9 @@ It holds the refined path (one leg per edge of the chosen path of the refined gr
 I(v), the avoid set O(u, v) and v's fixed goal point, if any), the goal-conditioned policy and the
 goal-switching rule of :meth:`specrefine.evaluation.evaluator.Evaluator.run_compositional`:
 
-* at ``reset`` every leg gets its goal point: the vertex's fixed point, else a point drawn uniformly
-  in its goal region at least ``clearance`` from walls and hazards (``Evaluator.sample_free``, the
-  evaluator's own rule and code);
+* at ``reset`` every leg gets its goal point: the vertex's fixed point (a run with ``goal_points="centre"``
+  records its goal regions' centres as fixed points), else a point drawn uniformly in its goal region at least
+  ``clearance`` from walls and hazards (``Evaluator.sample_free``, the evaluator's own rule and code);
 * at every decision the agent's position is checked first: while it lies in the current leg's goal
   region the policy moves on to the next leg (several at once if the regions overlap); then the goal
   policy is fed the current leg's goal point (the last leg's once all are done).
@@ -181,9 +181,10 @@ def save_run_policy(run_dir, maze: Maze, agent: str, graph, path: list[str], eva
     record = _goal_policy_record(run_dir, getattr(evaluator, "policy", None))
     if not path or len(path) < 2 or record is None:
         return None
-    legs = [Leg(v, graph.region(v), graph.avoid(u, v),
-                None if graph.goal_point(v) is None else tuple(float(x) for x in graph.goal_point(v)))
-            for u, v in zip(path, path[1:], strict=False)]
+    aim = getattr(evaluator, "aim", lambda goal, point: point)  # the evaluator's rule: a centre becomes a fixed point
+    points = [aim(graph.region(v), graph.goal_point(v)) for v in path[1:]]
+    legs = [Leg(v, graph.region(v), graph.avoid(u, v), None if p is None else tuple(float(x) for x in p))
+            for u, v, p in zip(path, path[1:], points, strict=False)]
     policy = CompositionalPolicy(agent, maze, legs, evaluator.policy, int(evaluator.horizon))
     data = policy.to_dict(record) | {"path": list(path)}
     from ..core.runfolder import write_atomic

@@ -9,7 +9,9 @@ agent's body radius + MuJoCo's contact margin (pass the same ``Evaluator.clearan
 :func:`specrefine.evaluation.monitor.satisfies`). The policy's goal point is ``goal_point`` if given, else a
 point sampled uniformly from ``goal`` per rollout, at least ``clearance`` from walls where the
 region allows (the paper's "representative waypoint randomly sampled from the inclusion set of the
-subtask's goal vertex"); :meth:`Evaluator.goal_point_rule` says this in words for the VLM.
+subtask's goal vertex"; ``goal_points="sampled"``), or with ``goal_points="centre"`` the goal region's centre in
+every rollout (beyond the paper: the policy's legs between sampled points are longer and more varied than the
+legs it then runs; :meth:`Evaluator.aim`).  :class:`EvaluationFacts` says the rule in words for the VLM.
 
 All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
 :class:`~specrefine.sim.simulator.BatchedSim` (one per batch size, built lazily and reused); a rollout that
@@ -65,6 +67,9 @@ from .cache import ResultCache
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
 CACHE_VERSION = 1
+#: where a leg's policy aims when its goal vertex has no fixed point: a point drawn in the goal region per rollout
+#: (the paper's rule) or the goal region's centre
+GOAL_POINTS = ("sampled", "centre")
 
 
 @dataclass(frozen=True)
@@ -82,6 +87,7 @@ class EvaluationFacts:
     horizon: int  # control steps per subtask
     control_period: float  # s per control step
     rollouts: int  # per subtask evaluation
+    goal_points: str = "sampled"  # GOAL_POINTS
 
     @property
     def horizon_seconds(self) -> float:
@@ -115,10 +121,13 @@ class Evaluator:
     MEMO_SIZE = 512  # results kept in memory (least recently used dropped; the disk cache keeps everything)
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = PAPER.rollouts, horizon: int | None = None,
-                 seed: int = 0, cache_dir=None, nthread: int | None = None):
+                 seed: int = 0, cache_dir=None, nthread: int | None = None, goal_points: str = "sampled"):
         from ..sim.simulator import build_model, contact_margin, footprint_radius
 
         spec = get_agent(agent)
+        if goal_points not in GOAL_POINTS:
+            raise SpecrefineError(f"goal points {goal_points!r}: expected one of {', '.join(GOAL_POINTS)}")
+        self.goal_points = goal_points
         if abs(maze.cell_size - spec.cell_size) > 1e-9:
             raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
                                   f"{spec.cell_size:g} m: pass maze.for_agent({agent!r})")
@@ -173,7 +182,8 @@ class Evaluator:
 
     def facts(self) -> EvaluationFacts:
         """What this evaluator does, in the terms a prompt states it (see :class:`EvaluationFacts`)."""
-        return EvaluationFacts(self.agent, self.clearance, self.horizon, self.control_period, self.n)
+        return EvaluationFacts(self.agent, self.clearance, self.horizon, self.control_period, self.n,
+                               self.goal_points)
 
     @property
     def body_radius(self) -> float:
@@ -201,6 +211,13 @@ class Evaluator:
     def policy_fingerprint(self) -> str | None:
         fp = getattr(self.policy, "fingerprint", None)
         return str(fp) if fp is not None else None
+
+    def aim(self, goal: Region, point=None):
+        """The fixed point a leg to ``goal`` aims at: ``point`` if given, else the goal's centre when
+        ``goal_points`` is "centre"; None: a point is drawn per rollout (``sample_free``)."""
+        if point is not None or self.goal_points == "sampled":
+            return point
+        return np.asarray(goal.centre(), dtype=float)
 
     def sample_free(self, region: Region, k: int, rng: np.random.Generator, clearance: float | None = None
                     ) -> np.ndarray:
@@ -256,7 +273,7 @@ class Evaluator:
     def fresh_copy(self, cache_dir=None) -> Evaluator:
         """The same evaluator (maze, agent, policy, n, horizon, seed) with zero counters and its own cache."""
         return Evaluator(self.maze, self.agent, self.policy, n=self.n, horizon=self.horizon, seed=self.seed,
-                         cache_dir=cache_dir, nthread=self.nthread)
+                         cache_dir=cache_dir, nthread=self.nthread, goal_points=self.goal_points)
 
     def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
         """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
@@ -271,7 +288,7 @@ class Evaluator:
         results: list[EdgeResult | None] = [None] * len(subtasks)
         todo: dict[str, tuple] = {}  # key -> (text, task, positions)
         for i, (start, goal, avoid, goal_point) in enumerate(subtasks):
-            legs = [(goal, avoid, goal_point)]
+            legs = [(goal, avoid, self.aim(goal, goal_point))]  # a centre is keyed as the fixed point it is
             key, text = self._key("edge", start, legs, n, seed, fp)
             if key in todo:  # asked twice in one batch: simulated once, the second is a cache hit
                 todo[key][2].append(i)
@@ -312,7 +329,7 @@ class Evaluator:
         """
         n = int(n or self.n)
         seed = self.seed if seed is None else seed
-        legs = [tuple(leg) if len(leg) == 3 else (leg[0], leg[1], None) for leg in legs]
+        legs = [(leg[0], leg[1], self.aim(leg[0], leg[2] if len(leg) == 3 else None)) for leg in legs]
         if not legs:
             raise SpecrefineError("run_compositional needs at least one leg")
         out = self._rollout(start, legs, n, seed)

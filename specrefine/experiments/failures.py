@@ -52,33 +52,29 @@ def leg_table(run, n_legs: int) -> list[dict]:
     return rows
 
 
-GOAL_POINTS = ("sampled", "centre")
-
-
-def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal_points: str = "sampled") -> dict:
+def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal_points: str | None = None) -> dict:
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
 
-    ``goal_points``: "sampled" (as the run measured it, the paper's rule: each episode aims at a point drawn from
-    the goal vertex's set) or "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper)."""
+    ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
+    "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper); None: as the run measured
+    it (its configuration's ``goal_points``)."""
     from ..core.graph import TaskGraph
     from ..evaluation.evaluator import Evaluator, path_legs
     from ..runs.experiment import setup
 
     if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
+    if goal_points is None:
+        goal_points = (result.get("config") or {}).get("goal_points", "sampled")
     agent = result["agent"]
-    exp = setup(result["maze"], agent=agent, seed=seed, policy=policy)
+    exp = setup(result["maze"], agent=agent, seed=seed, policy=policy, goal_points=goal_points)
     try:
         graph = TaskGraph.from_dict(result["graph"])
         path, legs = result["path"], path_legs(graph, result["path"])
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
-    if goal_points not in GOAL_POINTS:
-        raise SpecrefineError(f"goal points {goal_points!r}: expected one of {', '.join(GOAL_POINTS)}")
     start = graph.region(path[0])
     centres = [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
-    if goal_points == "centre":
-        legs = [(goal, avoid, np.asarray(centres[k + 1], dtype=float)) for k, (goal, avoid, _) in enumerate(legs)]
     turns = turn_angles(centres)
     lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
     out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
@@ -87,7 +83,8 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal
                     for k in range(len(legs))]}
     bare = open_floor(exp.maze)
     variants = {"walls": (exp.evaluator, legs),
-                "no_inner_walls": (Evaluator(bare, agent, exp.policy, n=exp.evaluator.n, seed=seed),
+                "no_inner_walls": (Evaluator(bare, agent, exp.policy, n=exp.evaluator.n, seed=seed,
+                                             goal_points=goal_points),
                                    [(goal, bare.walls, point) for goal, _avoid, point in legs])}
     for name, (evaluator, variant_legs) in variants.items():
         run = evaluator.run_compositional(start, variant_legs, n=episodes, seed=seed)
@@ -115,6 +112,7 @@ def summary(report: dict) -> str:
 def main(argv=None) -> int:
     from ..core.argtypes import OneLineParser, bounded_int, out_path
     from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+    from ..evaluation.evaluator import GOAL_POINTS
 
     p = OneLineParser(prog="python -m specrefine.experiments.failures", description=__doc__.split("\n\n")[0])
     p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
@@ -122,9 +120,9 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
     p.add_argument("--policy", default="shipped", help="'shipped' or a policy checkpoint")
-    p.add_argument("--goal-points", choices=GOAL_POINTS, default="sampled",
-                   help="sampled: each episode aims at a point drawn from the goal vertex's set (as measured, the "
-                        "paper's rule); centre: at the set's centre (beyond the paper)")
+    p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
+                   help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
+                        "centre: at the set's centre (beyond the paper) (default: as the run measured it)")
     p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
     args = p.parse_args(argv)
     try:

@@ -55,6 +55,7 @@ class ExperimentGrid:
     policy: str = "shipped"  # or a checkout-relative path to a checkpoint
     policy_in_checkout: bool = False  # the checkout's copy (an absolute path), not the pinned code tree's
     evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
+    goal_points: str | None = None  # None: the sweep's default, the paper's sampled points (not passed)
     rollouts: int | None = None  # None: the sweep's default (not passed)
     episodes: int | None = None
     workers: int = 2
@@ -130,6 +131,8 @@ def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int
     common = ["--agent", g.agent]
     if g.evaluation:
         common += ["--evaluation", g.evaluation]
+    if g.goal_points:
+        common += ["--goal-points", g.goal_points]
     if (policy := _policy(g, part, root)) != "shipped":
         common += ["--policy", policy]
     for name, value in _budget(g).items():
@@ -165,7 +168,7 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      **_budget(g))
+                      **_budget(g), **({"goal_points": g.goal_points} if g.goal_points else {}))
     return list(dict.fromkeys(cells))
 
 

@@ -66,14 +66,22 @@ def environment_text(maze, agent: str, facts: EvaluationFacts | None = None) -> 
         f"Agent: {agent}, {info.description}.",
         f"Policy: a goal-conditioned policy pretrained on an open floor to reach goal points up to "
         f"{info.policy_reach:g} m away; it knows nothing about walls (they are the task graph's job).",
-        f"Target point: in each rollout of a subtask the policy steers towards one target point, drawn uniformly "
-        f"at random inside the next region (at least {r} m from walls where the region allows), a new draw per "
-        f"rollout; the subtask is reached as soon as the agent's centre enters that region.",
+        _target_sentence(facts, r),
         f"Body size: the agent's position is its centre; it counts as touching a wall when its centre comes within "
         f"{r} m of one, so keep waypoints at least that far from walls.",
         f"Time limit: {facts.horizon} control steps ({facts.horizon_seconds:g} s) per subtask.",
         _avoid_sentence(maze),
     ])
+
+
+def _target_sentence(facts: EvaluationFacts, r: str) -> str:
+    if facts.goal_points == "centre":
+        aim = "the centre of the next region, in every rollout"
+    else:
+        aim = (f"one target point, drawn uniformly at random inside the next region (at least {r} m from walls where "
+               f"the region allows), a new draw per rollout")
+    return (f"Target point: in each rollout of a subtask the policy steers towards {aim}; the subtask is reached as "
+            f"soon as the agent's centre enters that region.")
 
 
 def _avoid_sentence(maze) -> str:

@@ -64,6 +64,12 @@ def _evaluations() -> list[str]:
     return list(EVALUATIONS)
 
 
+def _goal_points() -> tuple[str, ...]:
+    from ..evaluation.evaluator import GOAL_POINTS
+
+    return GOAL_POINTS
+
+
 def policy_arg(text: str) -> str:
     """'shipped' and 'scripted' as they are; a checkpoint path as ``str(Path(text))`` (the form run.json records)."""
     return text if text in ("shipped", "scripted") else str(Path(text))
@@ -97,6 +103,10 @@ class RunConfig:
                                           "that cannot be chosen (same full budget for what is chosen; far fewer "
                                           "simulator steps)", choices=_evaluations,
                                     shown="the agent's: fixed for point, adaptive for ant")
+    goal_points: str = option("sampled", "where a subtask's policy aims when its goal vertex has no fixed point, in "
+                                         "the search, the measurement and the calibration alike: sampled (a point "
+                                         "drawn in the goal region per rollout, the paper's rule) or centre (the goal "
+                                         "region's centre in every rollout; beyond the paper)", choices=_goal_points)
 
     def resolved(self) -> RunConfig:
         """This configuration with ``evaluation`` filled in: None becomes the agent's ``default_evaluation``."""

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.agents import get_agent
-from ..core.errors import PolicyError
+from ..core.errors import PolicyError, SpecrefineError
 from ..core.graph import TaskGraph
 from ..core.mazes import Maze, load_maze
 from ..core.paper import PAPER
@@ -58,7 +58,7 @@ def load_goal_policy(agent: str, policy="shipped"):
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = PAPER.rollouts,
           policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None,
-          spec: str | None = None) -> Experiment:
+          spec: str | None = None, goal_points: str = "sampled") -> Experiment:
     """Everything an experiment starts from.
 
     maze: a name in ``data/mazes/``, a ``.maze`` path or a :class:`Maze`; agent: a registered agent
@@ -68,7 +68,8 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     keeps evaluations unless ``cache_dir`` says otherwise; evaluator: use this one instead of
     building one; record_path: where a ``litellm:`` proposer records its calls; spec: the task as an
     expression over the maze's letters (``"(a | b) -> c -> G"``, see ``specrefine.core.spec.parse_spec``),
-    None = the maze's own task (its ``; spec:`` line, else its chain).
+    None = the maze's own task (its ``; spec:`` line, else its chain); goal_points: where a leg's policy aims,
+    "sampled" (a point drawn in the goal region per rollout, the paper's rule) or "centre" (``Evaluator.aim``).
     """
     from ..core.spec import maze_task
     from ..evaluation.evaluator import Evaluator
@@ -82,8 +83,12 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
         cache_dir = out / "cache" if cache_dir is None else cache_dir
     if evaluator is None:
         goal_policy, policy_name = load_goal_policy(agent, policy)
-        evaluator = Evaluator(maze, agent, goal_policy, n=rollouts, seed=seed, cache_dir=cache_dir)
+        evaluator = Evaluator(maze, agent, goal_policy, n=rollouts, seed=seed, cache_dir=cache_dir,
+                              goal_points=goal_points)
     else:
+        if getattr(evaluator, "goal_points", "sampled") != goal_points:
+            raise SpecrefineError(f"the evaluator given aims at {getattr(evaluator, 'goal_points', 'sampled')} goal "
+                                  f"points, the run asks for {goal_points}")
         goal_policy, policy_name = getattr(evaluator, "policy", None), "given with the evaluator"
     chosen = None
     if proposer is not None:

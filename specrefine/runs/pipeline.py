@@ -24,7 +24,7 @@ from ..evaluation.compositional import save_run_policy
 from ..evaluation.monitor import measure
 from ..refine.search import EVALUATIONS
 from .calibrate import predict
-from .config import RunConfig
+from .config import DEFAULTS, RunConfig
 from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
 from .progress import RunProgress
 from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
@@ -87,12 +87,14 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
             "spec": config.spec}
     if config.evaluation != "fixed":  # run folders of the fixed protocol keep the records they always had
         args["evaluation"] = config.evaluation
+    if config.goal_points != DEFAULTS.goal_points:  # so do those of the paper's goal points
+        args["goal_points"] = config.goal_points
     if config.evaluation not in EVALUATIONS:
         raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {config.evaluation!r}")
     with claim(out, args) as out:
         exp = setup(maze, agent=config.agent, proposer=proposer, seed=config.seed, rollouts=config.rollouts,
                     policy=config.policy, out=out, evaluator=evaluator, record_path=out / "vlm_recording.jsonl",
-                    spec=config.spec)
+                    spec=config.spec, goal_points=config.goal_points)
         write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
         with RunProgress(exp.evaluator, exp.proposer, enabled=progress) as shown:
             return _refine(exp, config, out, t0, shown)
@@ -121,7 +123,7 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data = _result_dict(exp, config, search, measured, t0)
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
-    data["evaluation"] = config.evaluation
+    data["evaluation"], data["goal_points"] = config.evaluation, config.goal_points
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])
     data["config"] = config.to_dict()  # everything this run was asked to do (evaluation resolved)

@@ -17,7 +17,8 @@ The search settings ``w``, ``d`` and ``k`` (``-w 3 5 -k 5 10``; defaults and bou
 :class:`specrefine.runs.config.RunConfig`) are grid axes too: a method gets one cell per combination of the
 settings it reads (``methods.Method.knobs``).  A cell with the paper's values keeps the id it always had; any
 other value is named in the id (``...__s0__w5``) and recorded in the ``w``, ``d``, ``k`` columns (a table from
-before them reads as the paper's values; cells with other values are refused into it).
+before them reads as the paper's values; cells with other values are refused into it).  ``--goal-points centre``
+(``RunConfig.goal_points``) likewise ends the id in ``__centre``.
 
 A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
 ``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
@@ -72,7 +73,7 @@ COLUMNS = [
     "evaluations", "cache_hits", "sim_steps", "vlm_calls", "vlm_cost_usd", "wall_seconds", "refinements",
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
     "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
-    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k",
+    "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k", "goal_points",
 ]
 #: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
 #: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
@@ -94,6 +95,7 @@ class Cell:
     w: int = DEFAULTS.w
     d: int = DEFAULTS.d
     k: int = DEFAULTS.k
+    goal_points: str = DEFAULTS.goal_points  # "sampled" (the paper's) or "centre": named in the id when not sampled
 
     @property
     def id(self) -> str:
@@ -106,6 +108,7 @@ class Cell:
         tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
                         if getattr(self, knob) != getattr(DEFAULTS, knob))  # the paper's w, d, k: the id they had
+        tail += "" if self.goal_points == DEFAULTS.goal_points else f"__{self.goal_points}"
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
 
     def config(self) -> RunConfig:
@@ -113,7 +116,7 @@ class Cell:
         return RunConfig(agent=self.agent, method=self.method, seed=self.seed, rollouts=self.rollouts,
                          episodes=self.episodes, spec=self.spec or None, evaluation=self.evaluation,
                          proposer="geometric" if self.proposer == "none" else self.proposer, policy=self.policy,
-                         w=self.w, d=self.d, k=self.k)
+                         w=self.w, d=self.d, k=self.k, goal_points=self.goal_points)
 
 
 def spec_slug(spec: str) -> str:
@@ -146,14 +149,15 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = DEFAULTS.rollouts, episodes: int = DEFAULTS.episodes,
          specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped",
-         w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,)
-         ) -> list[Cell]:
+         w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,),
+         goal_points: str = DEFAULTS.goal_points) -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
 
     ``w``, ``d``, ``k``: the values of each search setting; a method gets one cell per combination of the settings
     it reads (``methods.Method.knobs``: dirl none, symbolic k only), the others at the paper's defaults.
 
     ``evaluation``: None = the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
+    ``goal_points``: every cell's (``RunConfig.goal_points``).
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
     ``MAZE=SPEC`` runs that spec only.
@@ -172,7 +176,7 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                     for seed in seeds:
                         for knobs in _knob_values(method, axes):
                             cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
-                                              spec, evaluation, policy, **knobs))
+                                              spec, evaluation, policy, **knobs, goal_points=goal_points))
     return cells
 
 
@@ -267,6 +271,8 @@ def _append(path: Path, row: dict) -> None:
         if any(row.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob) for knob in KNOBS) \
                 and "w" not in columns:
             raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
+        if row.get("goal_points", DEFAULTS.goal_points) != DEFAULTS.goal_points and "goal_points" not in columns:
+            raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
     if not new:
         _drop_cut_row(path)
     with path.open("a", newline="") as fh:
@@ -437,8 +443,8 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
         if r.get("status") == "ok":
             if r.get("spec") and "maze" in by:  # a task other than the maze's own is its own group
                 r = {**r, "maze": f"{r['maze']} [{r['spec']}]"}
-            tuned = [f"{knob}={r[knob]}" for knob in KNOBS
-                     if knob not in by and r.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob)]
+            tuned = [f"{knob}={r[knob]}" for knob in (*KNOBS, "goal_points")
+                     if knob not in by and r.get(knob) not in (None, "", getattr(DEFAULTS, knob))]
             if tuned and "method" in by:  # so is a method run with other w, d or k than the paper's
                 r = {**r, "method": f"{r['method']} [{', '.join(tuned)}]"}
             groups.setdefault(tuple(r[k] for k in by), []).append(r)
@@ -514,6 +520,7 @@ def parser() -> OneLineParser:
     p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
     p.add_argument("--agent", default="point", choices=list(AGENTS))
     add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
+    add_run_options(p, ["goal_points"], suffix=" (every cell; named in the cell id when not sampled)")
     add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
                                                "of w, d, k it reads)")
     p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
@@ -535,6 +542,7 @@ def cells_of(args) -> list[Cell]:
     """The cells of parsed sweep arguments (a relative ``--policy`` is taken from the working directory)."""
     return grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
+                goal_points=args.goal_points,
                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
 
 
