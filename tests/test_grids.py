@@ -68,8 +68,8 @@ def test_the_pinned_code_takes_the_grids_arguments(g):
     source = _git("show", f"{g.code}:{module}").stdout
     options = {a for i in range(len(g.parts)) for args in grids.sweep_args(g, i) for a in args if a.startswith("--")}
     # an option is spelled out ("--policy") or, for the RunConfig fields add_run_options turns into options, named
-    # ("episodes")
-    assert all(f'"{option}"' in source or f'"{option[2:]}"' in source for option in options), options
+    # ("episodes", "goal_points")
+    assert all(f'"{option}"' in source or f'"{option[2:].replace("-", "_")}"' in source for option in options), options
     assert "def is_done" in source and "_typed" in source
     for method in g.methods:
         assert _git("grep", "-q", f'"{method}"', g.code, "--", "specrefine").returncode == 0, method
