@@ -275,6 +275,18 @@ GRIDS = {g.name: g for g in (
         mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
         goal_points="centre", code="d3488cc", table="data/results/ant/centre.csv", out="runs/ant_centre"),
     ExperimentGrid(
+        "ant-scaling-centre", "docs/ant_experiments.md, section 5, 'Lever G' (run only if it helps)", "ant",
+        parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds", mazes=("u_chain_1", "u_chain_2", "u_chain_2_subgoals",
+                                                                      "u_chain_3_subgoals", "u_chain_4",
+                                                                      "u_chain_4_subgoals", "u_chain_5_subgoals"),
+                    table="data/results/ant/scaling/ours_centre.csv", out="ours_centre"),
+               Part(("vlm-oneshot",), (GEOMETRIC_48, "imperfect:moderate"),
+                    table="data/results/ant/scaling/oneshot_centre.csv", out="oneshot_centre")),
+        seeds=(0, 1, 2), mazes=U_CHAINS[:1] + tuple(m for n in range(2, 6) for m in (f"u_chain_{n}",
+                                                                                       f"u_chain_{n}_subgoals")),
+        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", code="d3488cc",
+        out="runs/ant_scaling_centre"),
+    ExperimentGrid(
         "antmaze", "docs/official_env.md, 'The AntMaze grid' (issue 28)", "ant",
         parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),
         seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
