@@ -208,3 +208,10 @@ def test_training_among_walls_runs_and_logs_wall_touches(tmp_path, capsys):
         assert main(["--agent", "point", "--out", str(tmp_path / "r"), "--train-maze", bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and ("train-maze" in err or "random maze" in err)
+
+
+def test_a_wall_penalty_without_walls_is_one_line_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "open"
+    assert main(["--agent", "point", "--out", str(out), "--wall-penalty", "5"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--wall-penalty needs --train-maze" in err and not out.exists()

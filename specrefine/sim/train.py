@@ -134,7 +134,10 @@ def config_arguments(parser: argparse.ArgumentParser) -> None:
 
 def make_config(agent: str, **overrides) -> Config:
     """The agent's training defaults (``specrefine.core.agents``) with ``overrides`` on top."""
-    return replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
+    cfg = replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
+    if cfg.wall_penalty is not None and cfg.train_maze is None:
+        raise SpecrefineError("--wall-penalty needs --train-maze (on the open floor there is no wall to touch)")
+    return cfg
 
 
 def training_maze(text: str | None):
