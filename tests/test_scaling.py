@@ -62,3 +62,16 @@ def test_the_command_writes_claims_legs_and_figure(tmp_path):
     assert "holds" in claims and "u_chain_5_subgoals" in claims
     assert (tmp_path / "out" / "figure5.png").stat().st_size > 0
     assert "| u_chain_3 |" in (tmp_path / "out" / "legs.md").read_text()
+
+
+def test_tables_of_two_goal_point_rules_are_refused(tmp_path):
+    from specrefine.core.errors import SpecrefineError
+    from specrefine.runs import sweep
+
+    for name, rule in (("sampled.csv", "sampled"), ("centre.csv", "centre")):
+        sweep._append(tmp_path / name, {k: 1 for k in sweep.COLUMNS} | {
+            "cell": f"u_chain_1__ant__ours__x__s0__{rule}", "maze": "u_chain_1", "agent": "ant", "method": "ours",
+            "proposer": scaling.ORACLE, "seed": 0, "status": "ok", "goal_points": rule})
+    assert len(scaling.read_rows([tmp_path / "centre.csv"])) == 1
+    with pytest.raises(SpecrefineError, match="mix goal-point rules"):
+        scaling.read_rows([tmp_path / "sampled.csv", tmp_path / "centre.csv"])
