@@ -48,3 +48,11 @@ def test_a_missing_table_is_one_line_exit_2(tmp_path, capsys):
                      "--baseline-method", "y", "--mazes", "u_chain_3", "--seeds", "0"])
     assert exit_.value.code == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_a_lever_aiming_at_centres_is_named_so(tmp_path):
+    _write(tmp_path / "t.csv", "ours", {("u_chain_3", 0): 0.9})
+    rows = levers._by_cell(tmp_path / "t.csv", "ours", None)
+    assert levers.label("ours", rows) == "ours"  # a table from before the column: the paper's rule
+    rows = {k: {**r, "goal_points": "centre"} for k, r in rows.items()}
+    assert levers.label("ours", rows) == "ours (centre goal points)"

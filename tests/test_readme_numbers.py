@@ -11,6 +11,8 @@ import math
 import re
 from pathlib import Path
 
+import pytest
+
 from specrefine.runs.sweep import read_table, summarise
 
 ROOT = Path(__file__).parents[1]
@@ -309,6 +311,13 @@ def _between(text: str, marker: str) -> str:
                          text.index(f"<!-- /{marker} -->")].split())
 
 
+def test_front_page_centre_lever_is_its_shipped_check():
+    check = (ROOT / "data/results/ant/centre_check.md").read_text()
+    lever, base, diff = re.search(r"Pooled ([0-9.]+) .*? against ([0-9.]+) .*?: difference (\S+ \[\S+ \S+\])",
+                                  check).groups()
+    assert _between(FRONT, "front centre") == f"{base} to {lever}, difference {diff}"
+
+
 def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
     import json
 
@@ -324,18 +333,22 @@ def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
     assert _between(FRONT, "front cost") == " and ".join(f"{r['wall_seconds']:.0f} s" for r in cost["runs"])
 
 
-def test_polish_check_is_the_levers_rule_on_the_shipped_tables():
+@pytest.mark.parametrize("table, method, check, marker", [
+    ("data/results/ant/polish.csv", "ours-polish", "data/results/ant/polish_check.md", "polish check"),
+    ("data/results/ant/centre.csv", "ours", "data/results/ant/centre_check.md", "centre check"),
+])
+def test_a_lever_check_is_the_levers_rule_on_the_shipped_tables(table, method, check, marker):
     from specrefine.experiments import levers
 
     def side(table, method):
         return levers._by_cell(ROOT / table, method, "geometric:max_waypoints=48")
 
     cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
-    text = levers.markdown(levers.lever_check(side("data/results/ant/polish.csv", "ours-polish"),
-                                              side("data/results/ant/scaling/ours_geometric.csv", "ours"), cells),
-                           "ours-polish", "ours")
-    assert (ROOT / "data/results/ant/polish_check.md").read_text() == text
-    assert "<!-- polish check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
+    lever, baseline = side(table, method), side("data/results/ant/scaling/ours_geometric.csv", "ours")
+    text = levers.markdown(levers.lever_check(lever, baseline, cells), levers.label(method, lever),
+                           levers.label("ours", baseline))
+    assert (ROOT / check).read_text() == text
+    assert f"<!-- {marker} -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
 
 
 def test_leg_profiles_table_is_the_shipped_profiles():

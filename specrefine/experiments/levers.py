@@ -27,6 +27,12 @@ def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], 
             if is_done(r) and r["method"] == method and proposer in (None, r["proposer"])}
 
 
+def label(method: str, rows: dict) -> str:
+    """The method's name, with its goal-point rule when its runs aimed at the sets' centres."""
+    rules = sorted({r.get("goal_points") or "sampled" for r in rows.values()})
+    return method if rules in ([], ["sampled"]) else f"{method} ({', '.join(rules)} goal points)"
+
+
 def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:
     """Pooled success of both sides on the cells both have; ``complete`` when both have every cell."""
     both = [c for c in cells if c in lever and c in baseline]
@@ -71,7 +77,8 @@ def main(argv=None) -> int:
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     cells = [(m, s) for m in args.mazes for s in args.seeds]
-    text = markdown(lever_check(lever, baseline, cells), args.method, args.baseline_method)
+    text = markdown(lever_check(lever, baseline, cells), label(args.method, lever),
+                    label(args.baseline_method, baseline))
     if args.out is not None:
         write_atomic(args.out, text)
     print(text, end="")
