@@ -53,3 +53,14 @@ def test_a_malformed_result_is_one_line_and_exit_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_:
         antmaze.main([str(tmp_path), "--out", str(tmp_path / "out")])
     assert exit_.value.code == 2 and len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_runs_aiming_at_centres_are_their_own_rows_from_their_own_folder(tmp_path):
+    _run(tmp_path / "paper", "a", "ours", "geometric", 0, 0.8, 0.8)
+    _run(tmp_path / "centre", "a", "ours", "geometric", 0, 0.9, 0.85)
+    result = tmp_path / "centre" / "cells" / "a" / "result.json"
+    result.write_text(json.dumps({**json.loads(result.read_text()), "goal_points": "centre"}))
+    rows = antmaze.run_rows([tmp_path / "paper", tmp_path / "centre"])
+    assert [k[1] for k in antmaze.groups(rows)] == ["ours", "ours (centre)"]
+    assert antmaze.main([str(tmp_path / "paper"), str(tmp_path / "centre"), "--out", str(tmp_path / "out")]) == 0
+    assert "| ours (centre) | geometric | 0 | 0.900" in (tmp_path / "out" / "table.md").read_text()

@@ -1,7 +1,8 @@
 """The AntMaze grid's table (docs/official_env.md, "The AntMaze grid"): each map and method in this package's
 simulator and in the official ``AntMaze_*-v5``, pooled over seeds, with Wilson 95 % intervals.
 
-    python -m specrefine.experiments.antmaze runs/antmaze --official 200 --out data/results/ant/antmaze
+    python -m specrefine.experiments.antmaze runs/antmaze runs/antmaze_centre --official 200 \\
+        --out data/results/ant/antmaze
 
 Reads every finished run folder of the grid's sweep (``RUN/result.json``); with ``--official N`` it first runs
 ``specrefine official RUN --episodes N`` where a run has no ``official.json`` yet (minutes per run). Writes
@@ -30,10 +31,11 @@ FIELDS = ["maze", "method", "proposer", "seed", "sim_successes", "sim_episodes",
           "official_episodes", "env_id"]
 
 
-def run_rows(sweep_dir, official_episodes: int | None = None, seed: int = 0) -> list[dict]:
-    """One row per finished run under ``sweep_dir/cells``; runs without official.json get one first if asked."""
+def run_rows(sweep_dirs, official_episodes: int | None = None, seed: int = 0) -> list[dict]:
+    """One row per finished run under each ``sweep_dir/cells``; runs without official.json get one first if asked."""
     rows = []
-    for run in sorted(Path(sweep_dir, "cells").glob("*/")):
+    folders = [sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs
+    for run in [r for folder in folders for r in sorted(Path(folder, "cells").glob("*/"))]:
         if not (run / "result.json").is_file():
             continue
         result = read_result(run / "result.json")
@@ -42,13 +44,19 @@ def run_rows(sweep_dir, official_episodes: int | None = None, seed: int = 0) -> 
             run_official(run, official_episodes, seed)
         off = json.loads(official.read_text()) if official.is_file() else None
         proposer = result["proposer"] if result["method"] in PROPOSER_METHODS else "none"  # as the sweep's table
-        rows.append({"maze": result["maze"], "method": result["method"], "proposer": proposer,
+        rows.append({"maze": result["maze"], "method": method_label(result), "proposer": proposer,
                      "seed": result["seed"], "sim_successes": round(result["success_rate"] * result["episodes"]),
                      "sim_episodes": result["episodes"],
                      "official_successes": "" if off is None else round(off["success_rate"] * off["episodes"]),
                      "official_episodes": "" if off is None else off["episodes"],
                      "env_id": "" if off is None else off["env_id"]})
     return rows
+
+
+def method_label(result: dict) -> str:
+    """The run's method, named with its goal-point rule when it aimed at the sets' centres (``--goal-points``)."""
+    rule = result.get("goal_points", "sampled")
+    return result["method"] if rule == "sampled" else f"{result['method']} ({rule})"
 
 
 def _pooled(rows, side: str) -> tuple[int, int]:
@@ -91,7 +99,7 @@ def figure(rows):
         x = np.arange(len(keys))
         for offset, side, hatch in ((-0.2, "sim", ""), (0.2, "official", "//")):
             rates = [(lambda k, n: k / n if n else np.nan)(*_pooled(by[k], side)) for k in keys]
-            ax.bar(x + offset, rates, 0.4, color=[METHOD_COLOURS.get(k[1], "grey") for k in keys], hatch=hatch,
+            ax.bar(x + offset, rates, 0.4, color=[METHOD_COLOURS.get(k[1].split()[0], "grey") for k in keys], hatch=hatch,
                    edgecolor="black", linewidth=0.5, label="this simulator" if side == "sim" else "official env")
         ax.set_xticks(x, [f"{k[1]}\n{k[2]}" for k in keys], fontsize=7)
         ax.set_ylim(0, 1.05)
@@ -104,14 +112,14 @@ def figure(rows):
 
 def main(argv=None) -> int:
     p = OneLineParser(prog="python -m specrefine.experiments.antmaze", description=__doc__.split("\n")[0])
-    p.add_argument("sweep_dir", help="the AntMaze grid's sweep folder (runs/antmaze)")
+    p.add_argument("sweep_dirs", nargs="+", help="the AntMaze grids' sweep folders (runs/antmaze runs/antmaze_centre)")
     p.add_argument("--official", type=int, default=None, metavar="N",
                    help="run the official environment on N episodes where a run has no official.json yet")
     p.add_argument("--seed", type=int, default=0, help="the official episodes' seed (default 0)")
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
     try:
-        rows = run_rows(args.sweep_dir, args.official, args.seed)
+        rows = run_rows(args.sweep_dirs, args.official, args.seed)
         out = ensure_dir(args.out)
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")

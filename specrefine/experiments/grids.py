@@ -296,6 +296,12 @@ GRIDS = {g.name: g for g in (
         seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
         policy_in_checkout=True, evaluation="adaptive", episodes=200, table="data/results/ant/antmaze.csv",
         out="runs/antmaze", code="59e5b8d"),
+    ExperimentGrid(
+        "antmaze-centre", "docs/official_env.md, 'The AntMaze grid': the best Ant method of the scaling work", "ant",
+        parts=(Part(("ours",), ("geometric", "imperfect:moderate")),), seeds=(0, 1, 2),
+        mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
+        policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre",
+        table="data/results/ant/antmaze_centre.csv", out="runs/antmaze_centre", code="d3488cc"),
 )}
 
 
