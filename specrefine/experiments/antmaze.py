@@ -99,8 +99,9 @@ def figure(rows):
         x = np.arange(len(keys))
         for offset, side, hatch in ((-0.2, "sim", ""), (0.2, "official", "//")):
             rates = [(lambda k, n: k / n if n else np.nan)(*_pooled(by[k], side)) for k in keys]
-            ax.bar(x + offset, rates, 0.4, color=[METHOD_COLOURS.get(k[1].split()[0], "grey") for k in keys], hatch=hatch,
-                   edgecolor="black", linewidth=0.5, label="this simulator" if side == "sim" else "official env")
+            colours = [METHOD_COLOURS.get(k[1].split()[0], "grey") for k in keys]  # "ours (centre)": ours's
+            ax.bar(x + offset, rates, 0.4, color=colours, hatch=hatch, edgecolor="black", linewidth=0.5,
+                   label="this simulator" if side == "sim" else "official env")
         ax.set_xticks(x, [f"{k[1]}\n{k[2]}" for k in keys], fontsize=7)
         ax.set_ylim(0, 1.05)
         ax.set_title(f"{maze} (offline proposers, not a VLM)", fontsize=9)
