@@ -337,14 +337,15 @@ def test_a_bad_mplbackend_is_one_line_before_any_work(tmp_path):
 
 
 @pytest.mark.parametrize("name,value", [("ROLLOUTS", -1), ("ROLLOUTS", 0), ("SEEDS", [0, -2]), ("AGENT", "walker"),
-                                        ("PROPOSER", "gpt"), ("EPISODES", 2.5)])
+                                        ("PROPOSER", "gpt"), ("EPISODES", 2.5), ("GOAL_POINTS", "corner")])
 def test_notebook_parameters_are_checked_by_the_cli_rules(name, value):
     from specrefine.core.errors import SpecrefineError
     from specrefine.runs.notebook import check_parameters
 
     with pytest.raises(SpecrefineError, match=f"notebook parameter {name} = "):
         check_parameters({"ROLLOUTS": 8, "SEED": 0, name: value})
-    check_parameters({"ROLLOUTS": 8, "SEEDS": [0, 1], "AGENT": "ant", "PROPOSER": "imperfect:mild"})  # all fine
+    check_parameters({"ROLLOUTS": 8, "SEEDS": [0, 1], "AGENT": "ant", "PROPOSER": "imperfect:mild",
+                      "GOAL_POINTS": "centre"})  # all fine
 
 
 def test_a_notebook_run_with_rollouts_0_names_the_parameter(tmp_path):

@@ -74,7 +74,7 @@ def record(name: str, value, *, tol: float | None = None, rel: float | None = No
 PARAMETER_RULES = {"ROLLOUTS": "rollouts", "EPISODES": "episodes", "EVAL_EPISODES": "episodes", "SEED": "seed",
                    "SEEDS": ["seed"], "W": "w", "D": "d", "K": "k", "WORKERS": "workers", "CHAIN": "chain",
                    "AGENT": "agent", "METHOD": "method", "METHODS": ["method"], "PROPOSER": "proposer",
-                   "PROPOSERS": ["proposer"]}
+                   "PROPOSERS": ["proposer"], "GOAL_POINTS": "goal_points"}
 
 
 def check_parameters(params: dict) -> None:
@@ -107,7 +107,9 @@ def _check_value(name: str, value, rule: str) -> None:
             raise _bad(name, value, "a whole number")
         check = bounded_int(rule)
     else:
-        names = {"agent": AGENTS, "method": METHODS}.get(rule)
+        from ..evaluation.evaluator import GOAL_POINTS
+
+        names = {"agent": AGENTS, "method": METHODS, "goal_points": GOAL_POINTS}.get(rule)
 
         def check(text):
             if names is not None and text not in names:
