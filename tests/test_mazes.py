@@ -300,3 +300,22 @@ def test_installed_entry_point_rejects_a_ragged_maze(tmp_path):
     assert proc.stdout == ""
     _assert_one_line(proc.stderr, path, where="4:4", words="ragged")
     assert proc.stderr.startswith("specrefine: error: ")
+
+
+def test_a_generated_maze_is_a_maze_argument_everywhere(tmp_path, capsys):
+    from specrefine.cli import main as cli_main
+    from specrefine.core.mazes import random_maze
+    from specrefine.runs import sweep
+
+    assert load_maze("random:3x4:2").grid == random_maze((3, 4), 2).grid
+    assert load_maze("random:3x4:2", cell_size=4.0).cell_size == 4.0
+    for bad in ("random:3x4", "random:axb:1", "random:1x4:0", "random:3x3:-1"):
+        with pytest.raises(MazeError, match="random maze"):
+            load_maze(bad)
+    out = tmp_path / "run"
+    assert cli_main(["refine", "random:3x3:0", "--method", "dirl", "--rollouts", "8", "--episodes", "16",
+                     "--out", str(out), "--quiet"]) == 0
+    assert cli_main(["refine", "random:3x:0", "--out", str(tmp_path / "bad")]) == 2
+    assert capsys.readouterr().err.strip().count("\n") == 0 and not (tmp_path / "bad").exists()
+    (cell,) = sweep.grid(["random:3x3:0"], ["dirl"], ["none"], [0])
+    assert cell.id.startswith("random-3x3-0__point__dirl")

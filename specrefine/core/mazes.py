@@ -295,14 +295,20 @@ def random_maze(rooms: tuple[int, int], seed: int, loops: float = 0.25, cell_siz
     return Maze(f"random_{rows}x{cols}_s{seed}", tuple("".join(line) for line in grid), cell_size)
 
 
+RANDOM_PREFIX = "random:"
+
+
 def load_maze(path, cell_size: float = 1.0) -> Maze:
-    """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/, and 'gr:NAME' is the
-    Gymnasium-Robotics map NAME (``specrefine.core.standard_maps``)."""
+    """Load a maze file; a bare name like 'u_maze' is looked up in data/mazes/, 'gr:NAME' is the
+    Gymnasium-Robotics map NAME (``specrefine.core.standard_maps``) and 'random:RxC:SEED' the generated corridor
+    maze of R x C rooms (:func:`random_maze`: S top-left, G bottom-right, none of the benchmark's layouts)."""
     from .standard_maps import PREFIX, standard_text
 
     if isinstance(path, str) and path.startswith(PREFIX):
         name, text = standard_text(path)
         return parse_maze(text, name, cell_size)
+    if isinstance(path, str) and path.startswith(RANDOM_PREFIX):
+        return _random_from_text(path, cell_size)
     path = Path(path)
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"
@@ -315,6 +321,18 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     except UnicodeDecodeError:
         raise MazeError(f"{path}:1:1: not a text file") from None
     return parse_maze(text, str(path), cell_size)
+
+
+def _random_from_text(text: str, cell_size: float) -> Maze:
+    try:
+        rooms, seed = text.removeprefix(RANDOM_PREFIX).split(":")
+        r, c = (int(k) for k in rooms.lower().split("x"))
+        seed = int(seed)
+    except ValueError:
+        raise MazeError(f"random maze {text!r}: expected random:RxC:SEED, e.g. random:4x6:0") from None
+    if seed < 0:
+        raise MazeError(f"random maze {text!r}: the seed must be >= 0")
+    return random_maze((r, c), seed, cell_size=cell_size)
 
 
 def benchmark_mazes() -> dict[str, Path]:

@@ -141,19 +141,11 @@ def make_config(agent: str, **overrides) -> Config:
 
 
 def training_maze(text: str | None):
-    """``--train-maze``: None (open floor), 'random:RxC:SEED' (``core.mazes.random_maze``) or a maze the CLI takes."""
-    from ..core.mazes import load_maze, random_maze
+    """``--train-maze``: None (open floor) or any maze the CLI takes, 'random:RxC:SEED' (``core.mazes.random_maze``)
+    among them."""
+    from ..core.mazes import load_maze
 
-    if text is None:
-        return None
-    if text.startswith("random:"):
-        try:
-            rooms, seed = text.removeprefix("random:").split(":")
-            r, c = (int(k) for k in rooms.lower().split("x"))
-            return random_maze((r, c), int(seed))
-        except ValueError:
-            raise SpecrefineError(f"--train-maze {text!r}: expected random:RxC:SEED, e.g. random:4x6:0") from None
-    return load_maze(text)
+    return None if text is None else load_maze(text)
 
 
 # --- networks ---------------------------------------------------------------------------------
