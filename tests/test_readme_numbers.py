@@ -325,6 +325,19 @@ def test_front_page_centre_lever_is_its_shipped_check():
     assert _between(FRONT, "front centre") == f"{base} to {lever}, difference {diff}"
 
 
+def test_front_page_centre_grid_is_its_claims():
+    import json
+
+    flat = json.loads((ROOT / "data/results/ant/scaling_centre/claims.json").read_text())["flat"]
+    rate = {maze: f"{m['success']:.3f}" for maze, m in flat["per_maze"].items()}
+    plain = ", ".join(rate[f"u_chain_{n}"] for n in range(1, 6))
+    subgoals = ", ".join(rate[f"u_chain_{n}_subgoals"] for n in range(2, 6))
+    lo, hi = flat["change_ci"]
+    assert _between(FRONT, "front centre grid") == (
+        f"{plain} for 1-5 rooms (with subgoals {subgoals}); change from 1 to 5 rooms {flat['change_1_to_5']:+.3f} "
+        f"[{lo:+.3f}, {hi:+.3f}]")
+
+
 def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
     import json
 
