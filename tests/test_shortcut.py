@@ -62,7 +62,14 @@ class _Proposer:
         return [[Disc(x, y, 0.3) for x, y in ((2, 0), (4, -2), (6, -2))]]
 
 
-def _search(reach):
+class _PerfectEvaluator(_LegsEvaluator):
+    """Every leg but the unsplit edge succeeds in every rollout: shortcuts tie with the legs they skip."""
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
+        return FakeResult(1.0 if isinstance(start, tuple) or goal.centre()[0] < 7 else 0.0)
+
+
+def _search(reach, evaluator=None):
     g = TaskGraph("S")
     g.add_vertex("S", Box(-0.5, -0.5, 0.5, 0.5))
     g.add_vertex("G", Disc(8, -2, 0.5))
@@ -70,7 +77,8 @@ def _search(reach):
     g.finals = {"G"}
     cfg = SearchConfig(w=1, d=1, vertex_refinement=False, shortcut_reach=reach)
     query = lambda graph, u, v, r: type("Q", (), {"goal": graph.region(v), "avoid": graph.avoid(u, v)})()
-    return g, RefinementSearch(g, _LegsEvaluator(), proposer=_Proposer(), config=cfg, query_for=query).run()
+    return g, RefinementSearch(g, evaluator or _LegsEvaluator(), proposer=_Proposer(), config=cfg,
+                               query_for=query).run()
 
 
 def test_the_search_takes_a_shortcut_when_its_estimate_is_better():
@@ -81,6 +89,13 @@ def test_the_search_takes_a_shortcut_when_its_estimate_is_better():
     assert np.isclose(short.predicted_success, 0.9 ** (len(short.path) - 1))
     assert check_refines(short.graph, g) == []
     assert any(s["event"] == "shortcut" for s in short.steps)
+
+
+def test_a_shortcut_that_ties_with_the_legs_it_skips_is_taken():
+    _, plain = _search(None, _PerfectEvaluator())
+    _, short = _search(5.0, _PerfectEvaluator())
+    assert len(plain.path) == 5 and len(short.path) < len(plain.path)  # all estimated 1.0: fewer legs win the tie
+    assert short.predicted_success == 1.0
 
 
 def test_shortcut_edges_are_named_by_the_graph_and_drawn_dashed():

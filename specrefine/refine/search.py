@@ -340,11 +340,13 @@ class RefinementSearch:
             for i in into[j]:
                 start = arrivals[i]
                 result = UNREACHED if start is None else self._evaluate(start, path[j], (path[i], path[j]))
-                options.append((cost[i] + weight(result.p, n), -i, result))
-            c, minus_i, result = min(options, key=lambda o: o[:2])  # a tie goes to the longer leg
+                options.append((cost[i] + weight(result.p, n), i, result))
+            # a tie goes to the longer leg (the smaller i): legs estimated 32 of 32 tie at weight 0, and fewer legs
+            # lose fewer episodes at their switches
+            c, i, result = min(options, key=lambda o: o[:2])
             cost.append(c)
             arrivals.append(start_of(result))
-            best[j] = (-minus_i, result)
+            best[j] = (i, result)
         chosen, j = [len(path) - 1], len(path) - 1
         while j:
             i, result = best[j]
