@@ -297,6 +297,12 @@ GRIDS = {g.name: g for g in (
         goal_points="centre", code="d3488cc", table="data/results/ant/shortcut_centre.csv",
         out="runs/ant_shortcut_centre"),
     ExperimentGrid(
+        "ant-shortcut-centre-ties", "docs/ant_experiments.md, section 5, 'B with G, the tie fixed'", "ant",
+        parts=(Part(("ours-shortcut",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
+        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", code="75e52f5", table="data/results/ant/shortcut_centre_ties.csv",
+        out="runs/ant_shortcut_centre_ties"),
+    ExperimentGrid(
         "antmaze", "docs/official_env.md, 'The AntMaze grid' (issue 28)", "ant",
         parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),
         seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
