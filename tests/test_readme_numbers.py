@@ -361,6 +361,8 @@ SCALING_OURS = "data/results/ant/scaling/ours_geometric.csv"
     ("data/results/ant/centre.csv", "ours", SCALING_OURS, "data/results/ant/centre_check.md", "centre check"),
     ("data/results/ant/shortcut_centre.csv", "ours-shortcut", "data/results/ant/centre.csv",
      "data/results/ant/shortcut_centre_check.md", "shortcut centre check"),
+    ("data/results/ant/shortcut_centre_ties.csv", "ours-shortcut", "data/results/ant/centre.csv",
+     "data/results/ant/shortcut_centre_ties_check.md", "shortcut ties check"),
 ])
 def test_a_lever_check_is_the_levers_rule_on_the_shipped_tables(table, method, baseline, check, marker):
     from specrefine.experiments import levers

@@ -91,11 +91,11 @@ def test_the_search_takes_a_shortcut_when_its_estimate_is_better():
     assert any(s["event"] == "shortcut" for s in short.steps)
 
 
-def test_a_shortcut_that_ties_with_the_legs_it_skips_is_taken():
+def test_a_shortcut_that_only_ties_with_the_legs_it_skips_is_not_taken():
     _, plain = _search(None, _PerfectEvaluator())
-    _, short = _search(5.0, _PerfectEvaluator())
-    assert len(plain.path) == 5 and len(short.path) < len(plain.path)  # all estimated 1.0: fewer legs win the tie
-    assert short.predicted_success == 1.0
+    _, tied = _search(5.0, _PerfectEvaluator())
+    assert len(plain.path) == 5 and tied.path == plain.path  # all estimated 1.0: the found path stays
+    assert any(s["event"] == "shortcut" for s in tied.steps)  # the shortcuts were added and estimated
 
 
 def test_shortcut_edges_are_named_by_the_graph_and_drawn_dashed():

@@ -341,9 +341,10 @@ class RefinementSearch:
                 start = arrivals[i]
                 result = UNREACHED if start is None else self._evaluate(start, path[j], (path[i], path[j]))
                 options.append((cost[i] + weight(result.p, n), i, result))
-            # a tie goes to the longer leg (the smaller i): legs estimated 32 of 32 tie at weight 0, and fewer legs
-            # lose fewer episodes at their switches
-            c, i, result = min(options, key=lambda o: o[:2])
+            # a tie keeps the found path's leg (the larger i): 32 of 32 rollouts cannot tell a leg that loses 2 % from
+            # one that loses none, and giving ties to the longer legs lost 0.207 of the Ant's episodes on U-chain 3
+            # and 5 (docs/ant_experiments.md section 5, 'B with G, the tie fixed')
+            c, i, result = min(options, key=lambda o: (o[0], -o[1]))
             cost.append(c)
             arrivals.append(start_of(result))
             best[j] = (i, result)
