@@ -13,6 +13,7 @@ class PaperSettings:
     k: int = 5  # subsets sampled per vertex refinement (Algorithm 2)
     rollouts: int = 32  # rollouts per subtask evaluation
     episodes: int = 200  # fresh end-to-end episodes of the final measurement
+    goal_points: str = "sampled"  # a leg aims at a point drawn in its goal vertex's set, a new one per rollout
 
 
 PAPER = PaperSettings()

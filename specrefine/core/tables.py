@@ -17,6 +17,12 @@ from .paths import regular_file
 KNOBS = ("w", "d", "k")  # the search settings a sweep can vary; a table from before their columns ran the paper's
 
 
+def goal_points_of(row: dict) -> str:
+    """Where a row's (or a result's, or a run configuration's) legs aimed: ``goal_points``, the paper's rule for
+    tables and results from before the option."""
+    return row.get("goal_points") or PAPER.goal_points
+
+
 def read_table(path) -> list[dict]:
     """The rows of a results table, typed (numbers as numbers); [] where there is no table yet.
 

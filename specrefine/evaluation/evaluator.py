@@ -87,7 +87,7 @@ class EvaluationFacts:
     horizon: int  # control steps per subtask
     control_period: float  # s per control step
     rollouts: int  # per subtask evaluation
-    goal_points: str = "sampled"  # GOAL_POINTS
+    goal_points: str = PAPER.goal_points  # GOAL_POINTS
 
     @property
     def horizon_seconds(self) -> float:
@@ -121,7 +121,8 @@ class Evaluator:
     MEMO_SIZE = 512  # results kept in memory (least recently used dropped; the disk cache keeps everything)
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = PAPER.rollouts, horizon: int | None = None,
-                 seed: int = 0, cache_dir=None, nthread: int | None = None, goal_points: str = "sampled"):
+                 seed: int = 0, cache_dir=None, nthread: int | None = None,
+                 goal_points: str = PAPER.goal_points):
         from ..sim.simulator import build_model, contact_margin, footprint_radius
 
         spec = get_agent(agent)
@@ -215,7 +216,7 @@ class Evaluator:
     def aim(self, goal: Region, point=None):
         """The fixed point a leg to ``goal`` aims at: ``point`` if given, else the goal's centre when
         ``goal_points`` is "centre"; None: a point is drawn per rollout (``sample_free``)."""
-        if point is not None or self.goal_points == "sampled":
+        if point is not None or self.goal_points != "centre":
             return point
         return np.asarray(goal.centre(), dtype=float)
 

@@ -21,8 +21,10 @@ import numpy as np
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
+from ..core.paper import PAPER
 from ..core.results import rate_text
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
+from ..core.tables import goal_points_of
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS
 from ..runs.official import OFFICIAL_JSON, run_official
@@ -55,8 +57,8 @@ def run_rows(sweep_dirs, official_episodes: int | None = None, seed: int = 0) ->
 
 def method_label(result: dict) -> str:
     """The run's method, named with its goal-point rule when it aimed at the sets' centres (``--goal-points``)."""
-    rule = result.get("goal_points", "sampled")
-    return result["method"] if rule == "sampled" else f"{result['method']} ({rule})"
+    rule = goal_points_of(result)
+    return result["method"] if rule == PAPER.goal_points else f"{result['method']} ({rule})"
 
 
 def _pooled(rows, side: str) -> tuple[int, int]:

@@ -59,13 +59,14 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal
     "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper); None: as the run measured
     it (its configuration's ``goal_points``)."""
     from ..core.graph import TaskGraph
+    from ..core.tables import goal_points_of
     from ..evaluation.evaluator import Evaluator, path_legs
     from ..runs.experiment import setup
 
     if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     if goal_points is None:
-        goal_points = (result.get("config") or {}).get("goal_points", "sampled")
+        goal_points = goal_points_of(result.get("config") or {})
     agent = result["agent"]
     exp = setup(result["maze"], agent=agent, seed=seed, policy=policy, goal_points=goal_points)
     try:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
+from ..runs.config import DEFAULTS
 from ..runs.sweep import Cell, grid
 
 ROOT = Path(__file__).resolve().parents[2]  # the checkout: a grid's paths are relative to it
@@ -168,7 +169,7 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      **_budget(g), **({"goal_points": g.goal_points} if g.goal_points else {}))
+                      goal_points=g.goal_points or DEFAULTS.goal_points, **_budget(g))
     return list(dict.fromkeys(cells))
 
 
@@ -189,6 +190,16 @@ CONTROLS = ("ours-novertex", "ours-notune", "ours-nofeedback")
 U_CHAINS = tuple(f"u_chain_{n}" for n in range(1, 6))
 SUBGOALS = tuple(f"u_chain_{n}_subgoals" for n in range(2, 6))
 GEOMETRIC_48 = "geometric:max_waypoints=48"
+SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
+
+def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
+    """A lever's six cells (docs/ant_experiments.md section 5): ``method`` x the oracle, stage 5, adaptive,
+    U-chain 3 and 5, seeds 0-2, one sweep per seed; ``grid``: the rest of the grid (code, table, out, ...)."""
+    return ExperimentGrid(name, f"docs/ant_experiments.md, section 5, {section}", "ant",
+                          parts=(Part((method,), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
+                          mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt",
+                          evaluation="adaptive", **grid)
+
 
 GRIDS = {g.name: g for g in (
     ExperimentGrid(
@@ -260,20 +271,12 @@ GRIDS = {g.name: g for g in (
                     table="data/results/ant/scaling/imperfect.csv", out="imperfect"),
                Part(("ours-repair",), (GEOMETRIC_48,), table="data/results/ant/scaling/repair_geometric.csv",
                     out="repair_geometric")),
-        seeds=(0, 1, 2), mazes=("u_chain_1", "u_chain_2", "u_chain_2_subgoals", "u_chain_3",
-                                          "u_chain_3_subgoals", "u_chain_4", "u_chain_4_subgoals", "u_chain_5",
-                                          "u_chain_5_subgoals"), policy="data/policies/ant_stage5.pt",
+        seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt",
         evaluation="adaptive", code="fc93db3", out="runs/ant_scaling"),
-    ExperimentGrid(
-        "ant-polish", "docs/ant_experiments.md, section 5, 'Lever E'", "ant",
-        parts=(Part(("ours-polish",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        code="1242800", table="data/results/ant/polish.csv", out="runs/ant_polish"),
-    ExperimentGrid(
-        "ant-centre", "docs/ant_experiments.md, section 5, 'Lever G'", "ant",
-        parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", code="d3488cc", table="data/results/ant/centre.csv", out="runs/ant_centre"),
+    six_cell_grid("ant-polish", "'Lever E'", "ours-polish", code="1242800", table="data/results/ant/polish.csv",
+                  out="runs/ant_polish"),
+    six_cell_grid("ant-centre", "'Lever G'", "ours", goal_points="centre", code="d3488cc",
+                  table="data/results/ant/centre.csv", out="runs/ant_centre"),
     ExperimentGrid(
         "ant-scaling-centre", "docs/ant_experiments.md, section 5, 'Lever G' (run only if it helps)", "ant",
         parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds", mazes=("u_chain_1", "u_chain_2", "u_chain_2_subgoals",
@@ -286,22 +289,13 @@ GRIDS = {g.name: g for g in (
                     table="data/results/ant/scaling/imperfect_centre.csv", out="imperfect_centre"),
                Part(("ours-repair",), (GEOMETRIC_48,), table="data/results/ant/scaling/repair_geometric_centre.csv",
                     out="repair_geometric_centre")),
-        seeds=(0, 1, 2), mazes=U_CHAINS[:1] + tuple(m for n in range(2, 6) for m in (f"u_chain_{n}",
-                                                                                       f"u_chain_{n}_subgoals")),
-        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", code="d3488cc",
-        out="runs/ant_scaling_centre"),
-    ExperimentGrid(
-        "ant-shortcut-centre", "docs/ant_experiments.md, section 5, 'On top of Lever G'", "ant",
-        parts=(Part(("ours-shortcut",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", code="d3488cc", table="data/results/ant/shortcut_centre.csv",
-        out="runs/ant_shortcut_centre"),
-    ExperimentGrid(
-        "ant-shortcut-centre-ties", "docs/ant_experiments.md, section 5, 'B with G, the tie fixed'", "ant",
-        parts=(Part(("ours-shortcut",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", code="75e52f5", table="data/results/ant/shortcut_centre_ties.csv",
-        out="runs/ant_shortcut_centre_ties"),
+        seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", code="d3488cc", out="runs/ant_scaling_centre"),
+    six_cell_grid("ant-shortcut-centre", "'On top of Lever G'", "ours-shortcut", goal_points="centre",
+                  code="d3488cc", table="data/results/ant/shortcut_centre.csv", out="runs/ant_shortcut_centre"),
+    six_cell_grid("ant-shortcut-centre-ties", "'B with G, the tie fixed'", "ours-shortcut", goal_points="centre",
+                  code="75e52f5", table="data/results/ant/shortcut_centre_ties.csv",
+                  out="runs/ant_shortcut_centre_ties"),
     ExperimentGrid(
         "antmaze", "docs/official_env.md, 'The AntMaze grid' (issue 28)", "ant",
         parts=(Part(("dirl", "vlm-oneshot", "ours"), ("geometric", "imperfect:moderate")),),

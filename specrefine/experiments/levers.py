@@ -16,8 +16,10 @@ from pathlib import Path
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
+from ..core.paper import PAPER
 from ..core.results import newcombe_ci, rate_text
 from ..core.runfolder import write_atomic
+from ..core.tables import goal_points_of
 from ..runs.sweep import is_done, read_checked_table
 from .legs import pooled
 
@@ -29,8 +31,8 @@ def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], 
 
 def label(method: str, rows: dict) -> str:
     """The method's name, with its goal-point rule when its runs aimed at the sets' centres."""
-    rules = sorted({r.get("goal_points") or "sampled" for r in rows.values()})
-    return method if rules in ([], ["sampled"]) else f"{method} ({', '.join(rules)} goal points)"
+    rules = sorted({goal_points_of(r) for r in rows.values()})
+    return method if rules in ([], [PAPER.goal_points]) else f"{method} ({', '.join(rules)} goal points)"
 
 
 def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:

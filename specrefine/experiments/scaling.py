@@ -21,9 +21,11 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
 from ..core.runfolder import ensure_dir, save_figure, write_atomic
+from ..core.tables import goal_points_of
 from ..runs.sweep import is_done, read_checked_table
 from . import comparison as cmp
 from .figures import figure5
+from .grids import SCALING_MAZES
 from .legs import HEADER as LEGS_HEADER
 from .legs import line as legs_line
 from .legs import pooled, rooms
@@ -31,22 +33,17 @@ from .legs import pooled, rooms
 ORACLE = "geometric:max_waypoints=48"
 ERRING = "imperfect:moderate"
 SEEDS = (0, 1, 2)
-MAZES = ("u_chain_1", *(f"u_chain_{n}{s}" for n in range(2, 6) for s in ("", "_subgoals")))
+MAZES = SCALING_MAZES  # the scaling grids' (experiments/grids.py)
 LEVEL = 0.90
 RATIO = 2.0
 ONESHOT_HIGH = 0.5
 METHODS = ("ours", "ours-repair", "vlm-oneshot")
 
 
-def goal_points(row) -> str:
-    """The row's goal-point rule (tables from before the column ran the paper's, sampled)."""
-    return row.get("goal_points") or "sampled"
-
-
 def read_rows(tables) -> list[dict]:
     """The done Ant rows of every table, all run with one goal-point rule (two would be two grids in one)."""
     rows = [r for t in tables for r in read_checked_table(t) if is_done(r) and r["agent"] == "ant"]
-    rules = sorted({goal_points(r) for r in rows})
+    rules = sorted({goal_points_of(r) for r in rows})
     if len(rules) > 1:
         raise SpecrefineError(f"the tables mix goal-point rules ({', '.join(rules)}): judge each grid on its own")
     return rows
@@ -179,7 +176,7 @@ def main(argv=None) -> int:
     if baseline is not None:
         write_atomic(out / "seeds.md", "\n\n".join(seed_table(baseline, rows, s) for s in SEEDS) + "\n")
     flat, erring = flat_claim(rows), erring_claim(rows)
-    rule = goal_points(rows[0]) if rows else "sampled"
+    rule = goal_points_of(rows[0] if rows else {})
     write_atomic(out / "claims.md", markdown(flat, erring, rule))
     write_atomic(out / "claims.json", json.dumps({"flat": flat, "erring": erring}, indent=1, default=float) + "\n")
     write_atomic(out / "legs.md", legs_table(rows) + "\n")

@@ -103,10 +103,11 @@ class RunConfig:
                                           "that cannot be chosen (same full budget for what is chosen; far fewer "
                                           "simulator steps)", choices=_evaluations,
                                     shown="the agent's: fixed for point, adaptive for ant")
-    goal_points: str = option("sampled", "where a subtask's policy aims when its goal vertex has no fixed point, in "
-                                         "the search, the measurement and the calibration alike: sampled (a point "
-                                         "drawn in the goal region per rollout, the paper's rule) or centre (the goal "
-                                         "region's centre in every rollout; beyond the paper)", choices=_goal_points)
+    goal_points: str = option(PAPER.goal_points,
+                              "where a subtask's policy aims when its goal vertex has no fixed point, in the search, "
+                              "the measurement and the calibration alike: sampled (a point drawn in the goal region "
+                              "per rollout, the paper's rule) or centre (the goal region's centre in every rollout; "
+                              "beyond the paper)", choices=_goal_points)
 
     def resolved(self) -> RunConfig:
         """This configuration with ``evaluation`` filled in: None becomes the agent's ``default_evaluation``."""

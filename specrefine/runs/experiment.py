@@ -58,7 +58,7 @@ def load_goal_policy(agent: str, policy="shipped"):
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = PAPER.rollouts,
           policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None,
-          spec: str | None = None, goal_points: str = "sampled") -> Experiment:
+          spec: str | None = None, goal_points: str = PAPER.goal_points) -> Experiment:
     """Everything an experiment starts from.
 
     maze: a name in ``data/mazes/``, a ``.maze`` path or a :class:`Maze`; agent: a registered agent
@@ -86,9 +86,8 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
         evaluator = Evaluator(maze, agent, goal_policy, n=rollouts, seed=seed, cache_dir=cache_dir,
                               goal_points=goal_points)
     else:
-        if getattr(evaluator, "goal_points", "sampled") != goal_points:
-            raise SpecrefineError(f"the evaluator given aims at {getattr(evaluator, 'goal_points', 'sampled')} goal "
-                                  f"points, the run asks for {goal_points}")
+        if (given := getattr(evaluator, "goal_points", PAPER.goal_points)) != goal_points:
+            raise SpecrefineError(f"the evaluator given aims at {given} goal points, the run asks for {goal_points}")
         goal_policy, policy_name = getattr(evaluator, "policy", None), "given with the evaluator"
     chosen = None
     if proposer is not None:
