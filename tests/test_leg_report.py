@@ -36,3 +36,41 @@ def test_leg_profiles_say_how_the_lost_episodes_spread_over_the_legs(tmp_path):
     assert json.loads((tmp_path / "p.json").read_text()) == [profile]
     path.write_text("[1, 2]")
     assert legs.main([str(path), "--profiles"]) == 2  # not a result.json: one line, exit 2
+
+
+def _turning_result():
+    """S -> a -> b -> G: east 4 m, east 4 m, then north 4 m (discs at the aims, b fixed at a point)."""
+    def disc(name, x, y, point=None):
+        return {"name": name, "region": {"type": "disc", "cx": x, "cy": y, "r": 1.0}, "point": point,
+                "refines": name, "label": None}
+
+    avoid = {"type": "box", "xmin": 20, "ymin": 20, "xmax": 21, "ymax": 21}
+    graph = {"initial": "S", "finals": ["G"],
+             "vertices": [disc("S", 0, 0), disc("a", 4, 0), disc("b", 7, 7, point=[8.0, 0.0]), disc("G", 8, 4)],
+             "edges": [{"u": u, "v": v, "avoid": avoid, "parent": [u, v]} for u, v in ("Sa", "ab", "bG")]}
+    return {"maze": "u_chain_1", "agent": "ant", "method": "ours", "proposer": "geometric", "seed": 0, "episodes": 200,
+            "path": ["S", "a", "b", "G"], "graph": graph, "leg_success": [1.0, 0.99, 0.95],
+            "edge_probabilities": [1.0, 1.0, 1.0], "episode_outcomes": {"success": 188, "flipped": 12}}
+
+
+def test_legs_are_told_apart_by_their_turn_and_lost_episodes_pool_by_kind():
+    profile = legs.leg_profile(_turning_result())
+    assert profile["turn_degrees"] == [None, 0.0, 90.0]  # b's fixed point, not its disc's centre, is its aim
+    assert legs.leg_episodes(profile) == [(200, 0), (200, 2), (198, 10)]
+    table = legs.turn_table([profile, profile]).splitlines()
+    assert table[2].startswith("| first leg | 2 | 400 | 0 | 0.0000 [")
+    assert table[3].startswith("| straight | 2 | 400 | 4 | 0.0100 [")
+    assert table[4].startswith("| turning | 2 | 396 | 20 | 0.0505 [")
+
+
+def test_a_profile_without_turns_is_refused_in_one_line(tmp_path, capsys):
+    import json
+
+    with pytest.raises(legs.SpecrefineError, match="no turns"):
+        legs.turn_table([{"maze": "u_chain_2", "seed": 0, "leg_failure": [0.1]}])
+    path = tmp_path / "result.json"
+    path.write_text(json.dumps(_turning_result()))
+    assert legs.main([str(path), "--profiles", "--turns"]) == 0
+    assert "| turning | 1 | 198 | 10 |" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        legs.main([str(path), "--turns"])  # --turns alone: argparse's usage line, exit 2

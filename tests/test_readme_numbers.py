@@ -388,6 +388,21 @@ def test_leg_profiles_table_is_the_shipped_profiles():
     assert "<!-- leg profiles -->\n" + profile_table(profiles) + "\n" in doc
 
 
+def test_centre_leg_profiles_and_turns_are_the_shipped_profiles():
+    import json
+
+    from specrefine.experiments.legs import profile_table, turn_table
+
+    doc = (ROOT / "docs" / "ant_experiments.md").read_text()
+    profiles = json.loads((ROOT / "data/results/ant/scaling_centre/leg_profiles.json").read_text())
+    assert "<!-- centre turns -->\n" + turn_table(profiles) + "\n" in doc
+    assert "<!-- centre leg profiles -->\n" + profile_table(profiles) + "\n" in doc
+    lost = {k: sum(p["episode_outcomes"].get(k, 0) for p in profiles) for k in ("flipped", "avoid", "timeout")}
+    episodes = sum(p["episodes"] for p in profiles)
+    assert (f"lose {sum(lost.values())} of {episodes:,} episodes: {lost['flipped']} flips, {lost['avoid']} wall "
+            f"contacts, {lost['timeout']} timeouts") in " ".join(doc.split())
+
+
 def test_antmaze_table_is_its_official_csv():
     import csv
 

@@ -9,15 +9,18 @@ each leg would lose if legs failed independently and alike. Rooms: N of a ``u_ch
 
 Leg profiles (``--profiles RUN/result.json ... --out FILE.json``): each run's measured per-leg failure (among the
 episodes that started the leg) beside the search's estimate of that leg, small enough to ship, and
-``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few.
+``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few, and ``turn_table``:
+the legs that turn against the straight ones, lost episodes pooled over the runs.
 """
 import argparse
 import json
+import math
 import re
 import sys
 
 from ..core.argtypes import exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
+from ..core.graph import TaskGraph
 from ..core.results import wilson_ci
 from ..core.runfolder import read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
@@ -60,11 +63,62 @@ def report(tables, method=None, proposer=None) -> str:
     return "\n".join([HEADER, *(line(k, groups[k]) for k in order)])
 
 
+def leg_turns(result: dict) -> list[float | None]:
+    """Each leg's turn from the leg before it, in degrees between the lines joining its vertices' aims (a vertex's
+    fixed point, else its set's centre); None for the first leg."""
+    path = result.get("path") or []
+    if len(path) < 2 or not result.get("graph"):
+        return []
+    nodes = TaskGraph.from_dict(result["graph"]).g.nodes
+    aims = [nodes[v]["point"] if nodes[v]["point"] is not None else nodes[v]["region"].centre() for v in path]
+    headings = [math.atan2(b[1] - a[1], b[0] - a[0]) for a, b in zip(aims, aims[1:], strict=False)]
+    return [None] + [round(abs(math.degrees((h2 - h1 + math.pi) % (2 * math.pi) - math.pi)), 1)
+                     for h1, h2 in zip(headings, headings[1:], strict=False)]
+
+
 def leg_profile(result: dict) -> dict:
-    """One run's legs: measured failure (1 - leg success on the 200 fresh episodes), the search's estimate."""
-    return {k: result.get(k) for k in ("maze", "method", "proposer", "seed", "episode_outcomes")} | {
+    """One run's legs: measured failure (1 - leg success on the 200 fresh episodes), the search's estimate and each
+    leg's turn (:func:`leg_turns`)."""
+    return {k: result.get(k) for k in ("maze", "method", "proposer", "seed", "episodes", "episode_outcomes")} | {
         "leg_failure": [round(1.0 - float(p), 6) for p in result.get("leg_success") or []],
-        "search_estimate": [float(p) for p in result.get("edge_probabilities") or []]}
+        "search_estimate": [float(p) for p in result.get("edge_probabilities") or []],
+        "turn_degrees": leg_turns(result)}
+
+
+def leg_episodes(profile: dict) -> list[tuple[int, int]]:
+    """(episodes that started the leg, episodes it lost) per leg, from the run's episodes and per-leg failures."""
+    started, out = int(profile["episodes"]), []
+    for failure in profile["leg_failure"]:
+        lost = round(started * failure)
+        out.append((started, lost))
+        started -= lost
+    return out
+
+
+def turn_kind(turn: float | None, straight_below: float = 45.0) -> str:
+    return "first leg" if turn is None else "straight" if turn < straight_below else "turning"
+
+
+TURN_HEADER = ("| legs | count | episodes started | lost | failure per leg [95 % CI] |\n|---|---|---|---|---|")
+
+
+def turn_table(profiles) -> str:
+    """Lost episodes pooled by the kind of leg (first, straight, turning at 45 degrees or more)."""
+    pooled_by: dict[str, list[int]] = {}
+    for p in profiles:
+        if not p.get("turn_degrees") or p.get("episodes") is None:
+            raise SpecrefineError(f"profile of {p.get('maze')} seed {p.get('seed')} has no turns or episodes: make "
+                                  "it again with --profiles from the run's result.json")
+        for turn, (started, lost) in zip(p["turn_degrees"], leg_episodes(p), strict=True):
+            acc = pooled_by.setdefault(turn_kind(turn), [0, 0, 0])
+            acc[0], acc[1], acc[2] = acc[0] + 1, acc[1] + started, acc[2] + lost
+    lines = [TURN_HEADER]
+    for kind in ("first leg", "straight", "turning"):
+        if kind in pooled_by:
+            count, started, lost = pooled_by[kind]
+            lo, hi = wilson_ci(lost, started)
+            lines.append(f"| {kind} | {count} | {started:,} | {lost} | {lost / started:.4f} [{lo:.4f}, {hi:.4f}] |")
+    return "\n".join(lines)
 
 
 def worst_share(failures, share: float = 0.2) -> float:
@@ -100,13 +154,19 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles", action="store_true", help="the inputs are result.json files: write their leg "
                                                             "profiles to --out and print profile_table")
     ap.add_argument("--out", help="with --profiles: the JSON file to write")
+    ap.add_argument("--turns", action="store_true", help="with --profiles: also print the lost episodes pooled by "
+                                                         "straight and turning legs")
     args = ap.parse_args(argv)
+    if args.turns and not args.profiles:
+        ap.error("--turns needs --profiles")
     try:
         if args.profiles:
             profiles = [leg_profile(read_result(path)) for path in args.tables]
             if args.out:
                 write_atomic(args.out, json.dumps(profiles, indent=1) + "\n")
             print(profile_table(profiles))
+            if args.turns:
+                print("\n" + turn_table(profiles))
             return 0
         print(report(args.tables, args.method, args.proposer))
     except SpecrefineError as exc:  # a missing or malformed table: one line
