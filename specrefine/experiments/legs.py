@@ -12,13 +12,12 @@ episodes that started the leg) beside the search's estimate of that leg, small e
 ``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few, and ``turn_table``:
 the legs that turn against the straight ones, lost episodes pooled over the runs.
 """
-import argparse
 import json
 import math
 import re
 import sys
 
-from ..core.argtypes import exit_code_quiet_on_broken_pipe
+from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
 from ..core.results import wilson_ci
@@ -147,7 +146,7 @@ def profile_table(profiles) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
+    ap = OneLineParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
     ap.add_argument("tables", nargs="+", help="sweep tables (with --profiles: runs' result.json files)")
     ap.add_argument("--method")
     ap.add_argument("--proposer")
