@@ -123,3 +123,23 @@ def test_sweep_cells_name_the_rule_and_old_tables_refuse_it(tmp_path):
                        "16", "--workers", "1", "--goal-points", "centre", "--out", str(tmp_path / "s")]) == 0
     (row,) = sweep.read_table(tmp_path / "s" / "results.csv")
     assert row["cell"] == cell.id and row["goal_points"] == "centre"
+
+
+def _figure_rows(rule):
+    return [{"maze": f"u_chain_{n}", "method": "ours", "proposer": "geometric", "seed": s, "status": "ok",
+             "success_rate": 0.9, "graph_vertices": 5, "goal_points": rule} for n in (1, 2) for s in (0, 1)]
+
+
+@pytest.mark.parametrize("rules, labels", [
+    (["centre"], ["ours, centre goal points (no subgoals)", "ours, centre goal points (with subgoals)"]),
+    (["", "centre"], ["ours (no subgoals)", "ours (with subgoals)", "ours, centre goal points (no subgoals)",
+                      "ours, centre goal points (with subgoals)"]),  # "": a table from before the option
+])
+def test_figures_draw_runs_that_aimed_at_centres_under_their_method(rules, labels):
+    from specrefine.experiments.figures import figure4, figure5
+
+    rows = [r for rule in rules for r in _figure_rows(rule)]
+    ax = figure5(rows, methods=["ours"]).axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == labels
+    bars = figure4(rows, tasks=["u_chain_1", "u_chain_2"], methods=["ours"]).axes[0].patches
+    assert len(bars) == 2 * len(rules) and all(b.get_height() == pytest.approx(0.9) for b in bars)

@@ -2,7 +2,8 @@
 
 Each figure shows mean and population standard deviation over seeds (``np.std``, as in
 the paper) and names the proposer on every panel: results from the offline proposers
-are labelled as such and never as a VLM's.
+are labelled as such and never as a VLM's. Runs whose legs aimed at the goal sets' centres
+(``--goal-points centre``) are their method's, labelled with the rule.
 """
 
 from __future__ import annotations
@@ -11,7 +12,9 @@ import re
 
 import numpy as np
 
+from ..core.paper import PAPER
 from ..core.runfolder import save_figure, write_atomic
+from ..core.tables import goal_points_of
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS  # colours: each method's registry entry
 from ..runs.sweep import summarise
@@ -35,9 +38,26 @@ def _proposers(rows) -> list[str]:
     return sorted({r["proposer"] for r in rows if r.get("status") == "ok" and r["proposer"] != "none"})
 
 
-def _select(summary, maze, method, proposer):
+def _summary(rows) -> list[dict]:
+    """Mean and std over seeds per maze, method, proposer and goal-point rule."""
+    return summarise([{**r, "goal_points": goal_points_of(r)} for r in rows],
+                     by=("maze", "method", "proposer", "goal_points"))
+
+
+def _series(summary, methods) -> list[tuple[str, str]]:
+    """(method, goal-point rule) for each method and each rule in the runs, the paper's rule first."""
+    rules = sorted({s["goal_points"] for s in summary} or {PAPER.goal_points}, key=lambda g: g != PAPER.goal_points)
+    return [(method, rule) for method in methods for rule in rules]
+
+
+def _label(method: str, rule: str) -> str:
+    return method if rule == PAPER.goal_points else f"{method}, {rule} goal points"
+
+
+def _select(summary, maze, method, proposer, rule=PAPER.goal_points):
     prop = proposer if method in PROPOSER_METHODS else "none"
-    return next((s for s in summary if s["maze"] == maze and s["method"] == method and s["proposer"] == prop), None)
+    return next((s for s in summary if (s["maze"], s["method"], s["proposer"], s["goal_points"])
+                 == (maze, method, prop, rule)), None)
 
 
 def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=None, legend_outside=False):
@@ -46,19 +66,21 @@ def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=
     ``proposers``: the panels (default: every proposer in ``rows``). ``legend_outside``: the legend right of
     the panels (for many methods or long panel titles, which the legend above the first panel would cover).
     """
-    summary = summarise(rows)
+    summary = _summary(rows)
     tasks = tasks or [t for t in CORE_TASKS + EXTRA_TASKS if any(s["maze"] == t for s in summary)]
     proposers = proposers or _proposers(rows) or ["none"]
+    series = _series(summary, methods)
     fig, axes = subplots(len(proposers), 1, figsize=(max(8.5, 1.4 * len(tasks) + 2), 3.2 * len(proposers)),
                          squeeze=False)
-    width = 0.8 / len(methods)
+    width = 0.8 / len(series)
     for ax, proposer in zip(axes[:, 0], proposers):
-        for i, method in enumerate(methods):
-            stats = [_select(summary, t, method, proposer) for t in tasks]
+        for i, (method, rule) in enumerate(series):
+            stats = [_select(summary, t, method, proposer, rule) for t in tasks]
             mean = [s[f"{metric}_mean"] if s else np.nan for s in stats]
             std = [s[f"{metric}_std"] if s else 0 for s in stats]
-            x = np.arange(len(tasks)) + (i - (len(methods) - 1) / 2) * width
-            ax.bar(x, mean, width, yerr=std, capsize=2, label=method, color=METHOD_COLOURS[method])
+            x = np.arange(len(tasks)) + (i - (len(series) - 1) / 2) * width
+            ax.bar(x, mean, width, yerr=std, capsize=2, label=_label(method, rule), color=METHOD_COLOURS[method],
+                   hatch=None if rule == PAPER.goal_points else "//")
         ax.set_xticks(np.arange(len(tasks)), tasks, rotation=15)
         ax.set_ylabel("success rate" if metric == "success" else "task-graph vertices")
         if metric == "success":
@@ -68,7 +90,7 @@ def figure4(rows, tasks=None, metric="success", methods=METHOD_ORDER, proposers=
     if legend_outside:
         axes[0, 0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     else:  # above the first panel, right of its title: inside, it would cover the bars that reach 1.0
-        axes[0, 0].legend(ncol=len(methods), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
+        axes[0, 0].legend(ncol=len(series), fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0),
                           frameon=False, borderaxespad=0.2)
     fig.suptitle("Figure 4: success of the output compositional policy (mean ± std over seeds)"
                  if metric == "success" else "Figure 6: size of the output task graph (mean ± std over seeds)",
@@ -87,22 +109,23 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
 
     ``legend_outside``: one legend right of the last panel instead of one in each (for many methods).
     """
-    summary = summarise(rows)
+    summary = _summary(rows)
     proposers = proposers or _proposers(rows) or ["none"]
     fig, axes = subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
     for ax, proposer in zip(axes[0], proposers):
-        for method in methods:
+        for method, rule in _series(summary, methods):
             for subgoals, style in ((False, "-"), (True, "--")):
                 prop = proposer if method in PROPOSER_METHODS else "none"
-                pts = _rooms(summary, method, prop, subgoals)
+                pts = _rooms(summary, method, prop, subgoals, rule)
                 if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
-                    pts += [p for p in _rooms(summary, method, prop, False) if p[0] == 1]
+                    pts += [p for p in _rooms(summary, method, prop, False, rule) if p[0] == 1]
                 if not pts:
                     continue
                 pts.sort()
                 r, mu, sd = map(np.array, zip(*pts))
-                ax.errorbar(r, mu, yerr=sd, ls=style, marker="o", capsize=3, color=METHOD_COLOURS[method],
-                            label=f"{method} ({'with' if subgoals else 'no'} subgoals)")
+                ax.errorbar(r, mu, yerr=sd, ls=style, marker="o" if rule == PAPER.goal_points else "s", capsize=3,
+                            color=METHOD_COLOURS[method],
+                            label=f"{_label(method, rule)} ({'with' if subgoals else 'no'} subgoals)")
         ax.set_xlabel("rooms")
         ax.set_ylabel("success rate")
         ax.set_ylim(0, 1.05)
@@ -121,11 +144,12 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
     return fig
 
 
-def _rooms(summary, method, proposer, subgoals):
+def _rooms(summary, method, proposer, subgoals, rule=PAPER.goal_points):
     out = []
     for s in summary:
         m = _UCHAIN.match(s["maze"])
-        if m and bool(m.group(2)) == subgoals and s["method"] == method and s["proposer"] == proposer:
+        if (m and bool(m.group(2)) == subgoals and (s["method"], s["proposer"], s["goal_points"])
+                == (method, proposer, rule)):
             out.append((int(m.group(1)), s["success_mean"], s["success_std"]))
     return out
 
