@@ -22,7 +22,7 @@ import numpy as np
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
-from ..core.results import rate_text
+from ..core.results import rate_text, wilson_ci
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
 from ..core.tables import goal_points_of
 from ..pictures.render import subplots
@@ -100,16 +100,20 @@ def figure(rows):
         keys = [k for k in by if k[0] == maze]
         x = np.arange(len(keys))
         for offset, side, hatch in ((-0.2, "sim", ""), (0.2, "official", "//")):
-            rates = [(lambda k, n: k / n if n else np.nan)(*_pooled(by[k], side)) for k in keys]
+            counts = [_pooled(by[k], side) for k in keys]
+            rates = np.array([k / n if n else np.nan for k, n in counts])
+            bounds = np.array([wilson_ci(k, n) if n else (np.nan, np.nan) for k, n in counts]).reshape(-1, 2)
             colours = [METHOD_COLOURS.get(k[1].split()[0], "grey") for k in keys]  # "ours (centre)": ours's
             ax.bar(x + offset, rates, 0.4, color=colours, hatch=hatch, edgecolor="black", linewidth=0.5,
+                   yerr=np.abs(bounds.T - rates), capsize=2, error_kw={"linewidth": 0.8},
                    label="this simulator" if side == "sim" else "official env")
-        ax.set_xticks(x, [f"{k[1]}\n{k[2]}" for k in keys], fontsize=7)
+        ax.set_xticks(x, [f"{k[1]}\n{k[2]}" for k in keys], fontsize=7, rotation=30, ha="right")
         ax.set_ylim(0, 1.05)
         ax.set_title(f"{maze} (offline proposers, not a VLM)", fontsize=9)
         ax.grid(axis="y", alpha=0.3)
-    axes[0, 0].set_ylabel("success rate (pooled over seeds)")
+    axes[0, 0].set_ylabel("success rate, pooled over seeds (Wilson 95 %)")
     axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
     return fig
 
 
