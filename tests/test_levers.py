@@ -56,3 +56,16 @@ def test_a_lever_aiming_at_centres_is_named_so(tmp_path):
     assert levers.label("ours", rows) == "ours"  # a table from before the column: the paper's rule
     rows = {k: {**r, "goal_points": "centre"} for k, r in rows.items()}
     assert levers.label("ours", rows) == "ours (centre goal points)"
+
+
+def test_a_layout_is_paired_with_another_maze_of_the_baseline_seed_by_seed(tmp_path, capsys):
+    _write(tmp_path / "lever.csv", "ours", {("u_chain_3_rotated-1a2b", s): 0.95 for s in (0, 1)})
+    _write(tmp_path / "base.csv", "ours", {("u_chain_3", 0): 0.90, ("u_chain_3", 1): 0.96, ("u_chain_5", 0): 0.5})
+    common = [str(tmp_path / "lever.csv"), "--method", "ours", "--baseline", str(tmp_path / "base.csv"),
+              "--baseline-method", "ours", "--mazes", "u_chain_3_rotated-1a2b", "--seeds", "0", "1"]
+    assert levers.main([*common, "--baseline-mazes", "u_chain_3"]) == 0
+    text = capsys.readouterr().out
+    assert "2 of 2 cells" in text and "| u_chain_3_rotated-1a2b | 0 | 0.950 | 0.900 |" in text
+    with pytest.raises(SystemExit) as exit_:
+        levers.main([*common, "--baseline-mazes", "u_chain_3", "u_chain_5"])
+    assert exit_.value.code == 2 and "names 2 mazes for the 1" in capsys.readouterr().err

@@ -70,14 +70,21 @@ def main(argv=None) -> int:
     p.add_argument("--baseline-method", required=True)
     p.add_argument("--proposer", default=None, help="both sides' proposer (default: any)")
     p.add_argument("--mazes", nargs="+", required=True)
+    p.add_argument("--baseline-mazes", nargs="+", default=None, metavar="MAZE",
+                   help="the baseline's maze paired with each of --mazes, in order (default: the same mazes), e.g. "
+                        "a layout turned round against the shipped one")
     p.add_argument("--seeds", nargs="+", type=int, required=True)
     p.add_argument("--out", type=Path, default=None, help="write the markdown here (default: print it only)")
     args = p.parse_args(argv)
+    pairs = dict(zip(args.mazes, args.baseline_mazes or args.mazes, strict=False))
+    if len(args.baseline_mazes or args.mazes) != len(args.mazes):
+        p.error(f"--baseline-mazes names {len(args.baseline_mazes)} mazes for the {len(args.mazes)} of --mazes")
     try:
         lever = _by_cell(args.table, args.method, args.proposer)
-        baseline = _by_cell(args.baseline, args.baseline_method, args.proposer)
+        by_maze = _by_cell(args.baseline, args.baseline_method, args.proposer)
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
+    baseline = {(m, s): by_maze[(b, s)] for m, b in pairs.items() for s in args.seeds if (b, s) in by_maze}
     cells = [(m, s) for m in args.mazes for s in args.seeds]
     text = markdown(lever_check(lever, baseline, cells), label(args.method, lever),
                     label(args.baseline_method, baseline))
