@@ -4,11 +4,12 @@
     cp runs/unseen/results.csv data/results/unseen/
 
 Why not ``python -m specrefine.runs.sweep --mazes data/mazes/unseen/*.maze``: it works now (a maze file outside
-data/mazes/ is named by its stem plus a hash of its path), but the shipped table was written when the sweep could
+data/mazes/ gets cells named by its stem and a hash of its path), but the shipped table was written when the sweep could
 not load subfolders, with the bare stems as names; this script keeps those names. It runs the cells one at a time
-with the full path and writes the same layout as the sweep: ``OUT/results.csv`` (columns ``specrefine.runs.sweep.COLUMNS``, one
-row per run, built by ``specrefine.runs.sweep.result_row``) and ``OUT/cells/<cell id>/`` (each run's
-``result.json``, pictures, step log, cache). Cells that already have an ``ok`` row are skipped.
+with the full path and writes the same layout as the sweep: ``OUT/results.csv`` (columns
+``specrefine.runs.sweep.COLUMNS``, one row per run, built by ``specrefine.runs.sweep.result_row``) and
+``OUT/cells/<cell id>/`` (each run's ``result.json``, pictures, step log, cache). Cells that already have an ``ok``
+row are skipped.
 """
 
 from __future__ import annotations

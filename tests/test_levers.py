@@ -65,7 +65,9 @@ def test_a_layout_is_paired_with_another_maze_of_the_baseline_seed_by_seed(tmp_p
               "--baseline-method", "ours", "--mazes", "u_chain_3_rotated-1a2b", "--seeds", "0", "1"]
     assert levers.main([*common, "--baseline-mazes", "u_chain_3"]) == 0
     text = capsys.readouterr().out
-    assert "2 of 2 cells" in text and "| u_chain_3_rotated-1a2b | 0 | 0.950 | 0.900 |" in text
+    assert "ours against ours on u_chain_3, 2 of 2 cells" in text
+    assert "| u_chain_3_rotated-1a2b | 0 | 0.950 | 0.900 |" in text
+    assert levers.shown("/x/held_out/u_chain_3_rotated.maze") == "u_chain_3_rotated"
     with pytest.raises(SystemExit) as exit_:
         levers.main([*common, "--baseline-mazes", "u_chain_3", "u_chain_5"])
     assert exit_.value.code == 2 and "names 2 mazes for the 1" in capsys.readouterr().err

@@ -378,6 +378,24 @@ def test_a_lever_check_is_the_levers_rule_on_the_shipped_tables(table, method, b
     assert f"<!-- {marker} -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
 
 
+def test_the_rotated_check_is_the_levers_rule_on_the_shipped_tables(tmp_path, capsys):
+    import csv
+
+    from specrefine.experiments import levers
+
+    table = ROOT / "data/results/ant/rotated_centre.csv"
+    with table.open(newline="") as fh:
+        (maze,) = {row["maze"] for row in csv.DictReader(fh)}  # the run's full path to the file
+    assert maze.endswith("held_out/u_chain_3_rotated.maze")
+    out = tmp_path / "check.md"
+    assert levers.main([str(table), "--method", "ours", "--baseline", str(ROOT / "data/results/ant/centre.csv"),
+                        "--baseline-method", "ours", "--proposer", "geometric:max_waypoints=48", "--mazes", maze,
+                        "--baseline-mazes", "u_chain_3", "--seeds", "0", "1", "2", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert (ROOT / "data/results/ant/rotated_centre_check.md").read_text() == text
+    assert "<!-- rotated check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
+
+
 def test_leg_profiles_table_is_the_shipped_profiles():
     import json
 

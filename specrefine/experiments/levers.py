@@ -49,6 +49,11 @@ def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> di
             "rows": [(c, lever[c]["success_rate"], baseline[c]["success_rate"]) for c in both]}
 
 
+def shown(maze: str) -> str:
+    """A maze as a table shows it: a file outside data/mazes/ (recorded by its full path) by its file name."""
+    return Path(maze).stem if maze.endswith(".maze") else maze
+
+
 def markdown(check: dict, lever_name: str, baseline_name: str) -> str:
     if not check["cells"]:
         return f"**{lever_name} against {baseline_name}: no cell yet** (0 of {check['expected']}).\n"
@@ -58,7 +63,7 @@ def markdown(check: dict, lever_name: str, baseline_name: str) -> str:
              f"difference "
              f"{check['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe 95 %).", "",
              f"| maze | seed | {lever_name} | {baseline_name} |", "|---|---|---|---|"]
-    lines += [f"| {maze} | {seed} | {a:.3f} | {b:.3f} |" for (maze, seed), a, b in check["rows"]]
+    lines += [f"| {shown(maze)} | {seed} | {a:.3f} | {b:.3f} |" for (maze, seed), a, b in check["rows"]]
     return "\n".join(lines) + "\n"
 
 
@@ -86,8 +91,9 @@ def main(argv=None) -> int:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     baseline = {(m, s): by_maze[(b, s)] for m, b in pairs.items() for s in args.seeds if (b, s) in by_maze}
     cells = [(m, s) for m in args.mazes for s in args.seeds]
+    other = sorted({shown(b) for m, b in pairs.items() if b != m})
     text = markdown(lever_check(lever, baseline, cells), label(args.method, lever),
-                    label(args.baseline_method, baseline))
+                    label(args.baseline_method, baseline) + (f" on {', '.join(other)}" if other else ""))
     if args.out is not None:
         write_atomic(args.out, text)
     print(text, end="")
