@@ -325,6 +325,13 @@ def test_front_page_centre_lever_is_its_shipped_check():
     assert _between(FRONT, "front centre") == f"{base} to {lever}, difference {diff}"
 
 
+def test_front_page_rotated_check_is_its_shipped_check():
+    check = (ROOT / "data/results/ant/rotated_centre_check.md").read_text()
+    lever, base, diff = re.search(r"Pooled ([0-9.]+) .*? against ([0-9.]+) .*?: difference (\S+ \[\S+ \S+\])",
+                                  check).groups()
+    assert _between(FRONT, "front rotated") == f"{lever} against {base}, difference {diff}"
+
+
 def test_front_page_centre_grid_is_its_claims():
     import json
 
