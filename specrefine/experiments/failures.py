@@ -42,6 +42,12 @@ def turn_angles(points) -> list[float | None]:
     return out
 
 
+def path_aims(graph, path: list[str]) -> list:
+    """Where each vertex of ``path`` is aimed at when its set's centre stands for it: its fixed point, else the
+    centre (the start vertex's centre is where its legs come from on average)."""
+    return [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
+
+
 def leg_table(run, n_legs: int) -> list[dict]:
     """Per leg: episodes that started it and how the ones that ended on it ended (CompositionalResult)."""
     rows = []
@@ -75,7 +81,7 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
     start = graph.region(path[0])
-    centres = [graph.goal_point(v) if graph.goal_point(v) is not None else graph.region(v).centre() for v in path]
+    centres = path_aims(graph, path)
     turns = turn_angles(centres)
     lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
     out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,

@@ -13,7 +13,6 @@ episodes that started the leg) beside the search's estimate of that leg, small e
 the legs that turn against the straight ones, lost episodes pooled over the runs.
 """
 import json
-import math
 import re
 import sys
 
@@ -65,14 +64,13 @@ def report(tables, method=None, proposer=None) -> str:
 def leg_turns(result: dict) -> list[float | None]:
     """Each leg's turn from the leg before it, in degrees between the lines joining its vertices' aims (a vertex's
     fixed point, else its set's centre); None for the first leg."""
+    from .failures import path_aims, turn_angles
+
     path = result.get("path") or []
     if len(path) < 2 or not result.get("graph"):
         return []
-    nodes = TaskGraph.from_dict(result["graph"]).g.nodes
-    aims = [nodes[v]["point"] if nodes[v]["point"] is not None else nodes[v]["region"].centre() for v in path]
-    headings = [math.atan2(b[1] - a[1], b[0] - a[0]) for a, b in zip(aims, aims[1:], strict=False)]
-    return [None] + [round(abs(math.degrees((h2 - h1 + math.pi) % (2 * math.pi) - math.pi)), 1)
-                     for h1, h2 in zip(headings, headings[1:], strict=False)]
+    return [None if t is None else round(t, 1)
+            for t in turn_angles(path_aims(TaskGraph.from_dict(result["graph"]), path))]
 
 
 def leg_profile(result: dict) -> dict:
