@@ -97,3 +97,20 @@ def test_goal_points_at_the_centres_aim_every_leg_at_its_sets_centre(monkeypatch
                for p, v in zip(points, result["path"][1:]))
     with pytest.raises(SpecrefineError, match="goal points"):
         failures.path_failures(result, episodes=8, seed=1, goal_points="corner")
+
+
+def test_the_legs_are_estimated_again_along_the_chain_once_per_seed(tmp_path, capsys):
+    from specrefine.experiments.failures import leg_estimates
+
+    data = refine_maze("u_chain_1", agent="point", method="ours", proposer="geometric", seed=0, rollouts=8,
+                       episodes=20, out=tmp_path / "run").data
+    report = leg_estimates(data, [3, 4, 3])
+    legs = len(data["path"]) - 1
+    assert report["rollouts"] == 8 and report["search"] == data["edge_probabilities"]
+    assert [len(run) for run in report["fresh"]] == [legs] * 3 and report["fresh"][0] == report["fresh"][2]
+    assert all(p in {k / 8 for k in range(9)} for run in report["fresh"] for p in run)  # 8 rollouts a leg
+    out = tmp_path / "estimates.json"
+    assert main([str(tmp_path / "run" / "result.json"), "--estimates", "3", "4", "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["fresh"] == report["fresh"][:2]
+    text = capsys.readouterr().out.splitlines()
+    assert "seed 3  seed 4" in text[1] and len(text) == 2 + legs

@@ -403,6 +403,21 @@ def test_the_rotated_check_is_the_levers_rule_on_the_shipped_tables(tmp_path, ca
     assert "<!-- rotated check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
 
 
+def test_fresh_estimates_table_is_the_shipped_reports():
+    import json
+    import math
+
+    lines = ["| run (seed 0) | legs | search's product of leg estimates | fresh products, seeds 101, 202, 303 | "
+             "measured product of leg successes |", "|---|---|---|---|---|"]
+    for path in sorted((ROOT / "data/results/ant/scaling_centre/estimates").glob("*.json")):
+        r = json.loads(path.read_text())
+        assert r["seeds"] == [101, 202, 303] and r["rollouts"] == 32
+        lines.append(f"| {path.stem} | {len(r['search'])} | {math.prod(r['search']):.3f} | "
+                     f"{', '.join(f'{math.prod(run):.3f}' for run in r['fresh'])} | {math.prod(r['measured']):.3f} |")
+    assert len(lines) == 5
+    assert "<!-- fresh estimates -->\n" + "\n".join(lines) + "\n" in (ROOT / "docs/ant_experiments.md").read_text()
+
+
 def test_leg_profiles_table_is_the_shipped_profiles():
     import json
 

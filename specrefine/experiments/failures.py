@@ -8,6 +8,13 @@ turn the agent makes where the leg starts.  Run again on the same maze with ever
 on a corner) from failures of the policy on open floor (a flip in a sharp turn)::
 
     python -m specrefine.experiments.failures runs/X/result.json --episodes 300 --seed 77 --out failures.json
+
+``--estimates SEED ...`` instead estimates every leg of the path again as the search does (the run's rollouts per
+subtask, each leg started from the end states of the previous leg's successes), once per seed, beside the search's
+own estimates and the measured per-leg success: how far the estimates the search chose the path on are from fresh
+ones (a path picked as the best of many noisy estimates looks better to the search than it is)::
+
+    python -m specrefine.experiments.failures runs/X/result.json --estimates 101 202 303 --out estimates.json
 """
 
 from __future__ import annotations
@@ -64,22 +71,10 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal
     ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
     "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper); None: as the run measured
     it (its configuration's ``goal_points``)."""
-    from ..core.graph import TaskGraph
-    from ..core.tables import goal_points_of
-    from ..evaluation.evaluator import Evaluator, path_legs
-    from ..runs.experiment import setup
+    from ..evaluation.evaluator import Evaluator
 
-    if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
-        raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
-    if goal_points is None:
-        goal_points = goal_points_of(result.get("config") or {})
-    agent = result["agent"]
-    exp = setup(result["maze"], agent=agent, seed=seed, policy=policy, goal_points=goal_points)
-    try:
-        graph = TaskGraph.from_dict(result["graph"])
-        path, legs = result["path"], path_legs(graph, result["path"])
-    except (KeyError, TypeError, ValueError, AttributeError) as exc:
-        raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
+    exp, graph, path, legs = _path_setup(result, seed, policy, goal_points)
+    agent, goal_points = result["agent"], exp.evaluator.goal_points
     start = graph.region(path[0])
     centres = path_aims(graph, path)
     turns = turn_angles(centres)
@@ -99,6 +94,57 @@ def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal
         out[name] = {"success": run.successes, "rate": run.p, "ci": list(run.ci), "outcomes": dict(counts),
                      "per_leg": leg_table(run, len(legs))}
     return out
+
+
+def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
+    """(experiment, graph, path, legs) of ``result``'s selected path, run as it was measured unless told."""
+    from ..core.graph import TaskGraph
+    from ..core.tables import goal_points_of
+    from ..evaluation.evaluator import path_legs
+    from ..runs.experiment import setup
+
+    if not isinstance(result, dict) or not result.get("path") or "graph" not in result:
+        raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
+    if goal_points is None:
+        goal_points = goal_points_of(result.get("config") or {})
+    rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation") or 32)
+    exp = setup(result["maze"], agent=result["agent"], seed=seed, policy=policy, goal_points=goal_points,
+                rollouts=rollouts)
+    try:
+        graph = TaskGraph.from_dict(result["graph"])
+        path, legs = result["path"], path_legs(graph, result["path"])
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SpecrefineError(f"the result's graph or path is malformed ({type(exc).__name__}: {exc})") from None
+    return exp, graph, path, legs
+
+
+def leg_estimates(result: dict, seeds, policy="shipped", goal_points: str | None = None) -> dict:
+    """Every leg of ``result``'s path estimated again along the chain, once per seed (see the module docstring)."""
+    from ..refine.common import Leg, estimate_legs
+
+    exp, graph, path, legs = _path_setup(result, seeds[0], policy, goal_points)
+    chain = [Leg(goal, avoid, point) for goal, avoid, point in legs]
+    fresh = []
+    for seed in seeds:
+        exp.evaluator.seed = seed
+        fresh.append([r.p for r in estimate_legs(exp.evaluator, graph.region(path[0]), chain).results])
+    return {"maze": exp.maze.name, "agent": result["agent"], "policy": exp.policy_name,
+            "goal_points": exp.evaluator.goal_points, "rollouts": exp.evaluator.n, "seeds": list(seeds),
+            "search": result.get("edge_probabilities"), "measured": result.get("leg_success"), "fresh": fresh}
+
+
+def estimates_summary(report: dict) -> str:
+    lines = [f"{report['maze']} ({report['agent']}): each leg's estimate on {report['rollouts']} rollouts along the "
+             f"chain; search = the run's own, measured = among the run's episodes that started the leg",
+             "  leg  search  measured  " + "  ".join(f"seed {s}" for s in report["seeds"])]
+    def cell(values, k: int, width: int) -> str:
+        return f"{values[k]:>{width}.2f}" if values and k < len(values) else " " * (width - 1) + "-"
+
+    widths = [len(f"seed {s}") for s in report["seeds"]]
+    for k in range(len(report["fresh"][0])):
+        lines.append(f"  {k:3d}  {cell(report['search'], k, 6)}  {cell(report['measured'], k, 8)}  " +
+                     "  ".join(cell(run, k, w) for run, w in zip(report["fresh"], widths)))
+    return "\n".join(lines)
 
 
 def summary(report: dict) -> str:
@@ -130,6 +176,8 @@ def main(argv=None) -> int:
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
                         "centre: at the set's centre (beyond the paper) (default: as the run measured it)")
+    p.add_argument("--estimates", type=bounded_int("seed"), nargs="+", default=None, metavar="SEED",
+                   help="instead of re-running episodes: estimate every leg again along the chain, once per seed")
     p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
     args = p.parse_args(argv)
     try:
@@ -137,13 +185,16 @@ def main(argv=None) -> int:
             writable_parent(args.out)  # before the re-run, not after it
         result = read_result(args.result)
         maze = recorded_maze(args.result, result["maze"])
-        report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
+        if args.estimates:
+            report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
+        else:
+            report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
         if args.out is not None:
             write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:
         print(f"{p.prog}: error: {e}", file=sys.stderr)
         return 2
-    print(summary(report))
+    print(estimates_summary(report) if args.estimates else summary(report))
     return 0
 
 
