@@ -392,8 +392,8 @@ def test_the_rotated_check_is_the_levers_rule_on_the_shipped_tables(tmp_path, ca
 
     table = ROOT / "data/results/ant/rotated_centre.csv"
     with table.open(newline="") as fh:
-        (maze,) = {row["maze"] for row in csv.DictReader(fh)}  # the run's full path to the file
-    assert maze.endswith("held_out/u_chain_3_rotated.maze")
+        (maze,) = {row["maze"] for row in csv.DictReader(fh)}
+    assert maze == "held_out/u_chain_3_rotated"
     out = tmp_path / "check.md"
     assert levers.main([str(table), "--method", "ours", "--baseline", str(ROOT / "data/results/ant/centre.csv"),
                         "--baseline-method", "ours", "--proposer", "geometric:max_waypoints=48", "--mazes", maze,

@@ -89,6 +89,17 @@ def test_sweep_runs_maze_files_from_their_path(tmp_path, capsys):
     assert ran["maze_grid"] == ROOM.splitlines()[1:]  # the file's maze, not the shipped u_maze
 
 
+def test_a_maze_in_a_folder_of_data_mazes_has_the_same_name_and_cell_on_every_machine(monkeypatch, tmp_path):
+    from specrefine.core.mazes import MAZE_DIR
+
+    by_path = sweep.maze_ref(str(MAZE_DIR / "held_out" / "u_chain_3_rotated.maze"))
+    monkeypatch.chdir(tmp_path)  # from anywhere, by its path there or by its name
+    assert by_path == sweep.maze_ref("held_out/u_chain_3_rotated") == "held_out/u_chain_3_rotated"
+    assert sweep.maze_ref(str(MAZE_DIR / "u_maze.maze")) == "u_maze"
+    cell = sweep.Cell(by_path, "ant", "ours", "geometric", 0)
+    assert cell.id == "held_out-u_chain_3_rotated__ant__ours__geometric__s0"
+
+
 def test_sweep_refuses_a_rerun_with_other_parameters(tmp_path, capsys):
     out = tmp_path / "s"
     assert sweep.main(["--mazes", "u_maze", "--out", str(out), *SWEEP]) == 0

@@ -299,6 +299,12 @@ GRIDS = {g.name: g for g in (
         mazes=("data/mazes/held_out/u_chain_3_rotated.maze",), policy="data/policies/ant_stage5.pt",
         evaluation="adaptive", goal_points="centre", workers=1, code="ba73885",
         table="data/results/ant/rotated_centre.csv", out="runs/ant_rotated_centre"),
+    ExperimentGrid(
+        "ant-polish-erring", "docs/ant_experiments.md, section 5, 'Lever E with the erring proposer'", "ant",
+        parts=(Part(("ours-polish",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
+        mazes=("u_chain_3", "u_chain_4"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", code="d3488cc", table="data/results/ant/polish_erring.csv",
+        out="runs/ant_polish_erring"),
     six_cell_grid("ant-shortcut-centre-ties", "'B with G, the tie fixed'", "ours-shortcut", goal_points="centre",
                   code="75e52f5", table="data/results/ant/shortcut_centre_ties.csv",
                   out="runs/ant_shortcut_centre_ties"),

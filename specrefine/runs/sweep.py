@@ -22,9 +22,10 @@ before them reads as the paper's values; cells with other values are refused int
 
 A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
 ``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
-ids and tables stay valid).  ``OUT/sweep.json`` records each cell's ``rollouts`` and ``episodes`` (not part
-of the id): a rerun into the same ``OUT`` with other values is refused (exit 2) rather than silently
-keeping rows measured with the old ones.  A row counts as done only when its status is ``ok`` and its
+ids and tables stay valid; one in a folder of ``data/mazes/`` is named by its path there, ``held_out/x``, id
+``held_out-x``, the same on every machine).  ``OUT/sweep.json`` records each cell's ``rollouts`` and
+``episodes`` (not part of the id): a rerun into the same ``OUT`` with other values is refused (exit 2) rather
+than silently keeping rows measured with the old ones.  A row counts as done only when its status is ``ok`` and its
 numbers are all there (a row cut short by a kill is redone), and at the end the table holds one row per
 cell (the last ``ok`` one, else the last failure).  Ctrl-C ends the sweep with one line and exit 130,
 keeping every finished row; pool workers die with the sweep's process.  Exit 1 when every cell failed.
@@ -103,7 +104,8 @@ class Cell:
         name = self.maze
         if Path(name).is_absolute():  # a file outside data/mazes: unique by its path
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
-        name = name.replace(":", "-")  # a standard map 'gr:NAME' -> 'gr-NAME' (a folder name on every system)
+        # a standard map 'gr:NAME' -> 'gr-NAME', a shipped folder's 'held_out/x' -> 'held_out-x' (folder names)
+        name = name.replace(":", "-").replace("/", "-")
         task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
         tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
@@ -128,16 +130,20 @@ def spec_slug(spec: str) -> str:
 
 
 def maze_ref(arg: str) -> str:
-    """What a cell runs: a shipped maze (a name, or a path to the file in data/mazes) by its name; any other
-    existing file by its absolute path; anything else as given (loading it reports the error)."""
+    """What a cell runs: a shipped maze (a name, or a path to the file in data/mazes or a folder of it) by its name
+    there (``u_maze``, ``held_out/u_chain_3_rotated``: the same on every machine); any other existing file by its
+    absolute path; anything else as given (loading it reports the error)."""
     from ..core.mazes import MAZE_DIR
 
     path = Path(arg)
     if not path.exists():
         return arg
     resolved = path.resolve()
-    shipped = MAZE_DIR / f"{path.stem}.maze"
-    return path.stem if shipped.exists() and shipped.resolve() == resolved else str(resolved)
+    try:
+        inside = resolved.relative_to(MAZE_DIR.resolve())
+    except ValueError:
+        return str(resolved)
+    return inside.with_suffix("").as_posix() if resolved.suffix == ".maze" else str(resolved)
 
 
 def split_maze_arg(arg: str) -> tuple[str, str]:
