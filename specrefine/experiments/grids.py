@@ -297,7 +297,7 @@ GRIDS = {g.name: g for g in (
         "ant-rotated-centre", "docs/ant_experiments.md, section 5, 'Held out: the adopted settings travelling west'",
         "ant", parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2),
         mazes=("data/mazes/held_out/u_chain_3_rotated.maze",), policy="data/policies/ant_stage5.pt",
-        evaluation="adaptive", goal_points="centre", workers=1, code="4ff4cf0",  # rows run by ba73885, renamed here
+        evaluation="adaptive", goal_points="centre", workers=1, code="ba73885",  # complete; rows renamed at 4ff4cf0
         table="data/results/ant/rotated_centre.csv", out="runs/ant_rotated_centre"),
     ExperimentGrid(
         "ant-polish-erring", "docs/ant_experiments.md, section 5, 'Lever E with the erring proposer'", "ant",
