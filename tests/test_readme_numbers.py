@@ -418,6 +418,15 @@ def test_fresh_estimates_table_is_the_shipped_reports():
     assert "<!-- fresh estimates -->\n" + "\n".join(lines) + "\n" in (ROOT / "docs/ant_experiments.md").read_text()
 
 
+def test_erring_seed_0_table_is_the_shipped_tables():
+    from specrefine.experiments import scaling
+
+    tables = [ROOT / "data/results/ant/centre.csv", *sorted((ROOT / "data/results/ant/scaling").glob("*_centre.csv"))]
+    table = scaling.erring_seed_table(scaling.read_rows(tables), 0)
+    assert "—" not in table  # seed 0 is complete
+    assert "<!-- erring seed 0 -->\n" + table + "\n" in (ROOT / "docs/ant_experiments.md").read_text()
+
+
 def test_leg_profiles_table_is_the_shipped_profiles():
     import json
 

@@ -62,6 +62,15 @@ def test_the_command_writes_claims_legs_and_figure(tmp_path):
     assert "holds" in claims and "u_chain_5_subgoals" in claims
     assert (tmp_path / "out" / "figure5.png").stat().st_size > 0
     assert "| u_chain_3 |" in (tmp_path / "out" / "legs.md").read_text()
+    seeds = (tmp_path / "out" / "erring_seeds.md").read_text()
+    assert "| maze | ours, seed 2 | ours-repair, seed 2 | vlm-oneshot, seed 2 |" in seeds
+    assert "| u_chain_3 | 0.930 (10) | 0.500 (10) | 0.300 (10) |" in seeds
+
+
+def test_the_erring_seed_table_marks_a_cell_not_run_yet():
+    rows = [r for r in _rows(0.93, repair_rate=0.5) if not (r["maze"] == "u_chain_4" and r["method"] == "ours-repair")]
+    line = next(x for x in scaling.erring_seed_table(rows, 1).splitlines() if x.startswith("| u_chain_4 |"))
+    assert line == "| u_chain_4 | 0.930 (10) | — | 0.300 (10) |"
 
 
 def test_tables_of_two_goal_point_rules_are_refused(tmp_path):
