@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import SpecrefineError
+from ..core.paper import PAPER
 from ..core.results import OUTCOMES
 
 
@@ -107,7 +108,8 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     if goal_points is None:
         goal_points = goal_points_of(result.get("config") or {})
-    rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation") or 32)
+    rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation")
+                   or PAPER.rollouts)
     exp = setup(result["maze"], agent=result["agent"], seed=seed, policy=policy, goal_points=goal_points,
                 rollouts=rollouts)
     try:
@@ -121,13 +123,12 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
 def leg_estimates(result: dict, seeds, policy="shipped", goal_points: str | None = None) -> dict:
     """Every leg of ``result``'s path estimated again along the chain, once per seed (see the module docstring)."""
     from ..refine.common import Leg, estimate_legs
+    from ..refine.polish import Rollouts
 
     exp, graph, path, legs = _path_setup(result, seeds[0], policy, goal_points)
     chain = [Leg(goal, avoid, point) for goal, avoid, point in legs]
-    fresh = []
-    for seed in seeds:
-        exp.evaluator.seed = seed
-        fresh.append([r.p for r in estimate_legs(exp.evaluator, graph.region(path[0]), chain).results])
+    fresh = [[r.p for r in estimate_legs(Rollouts(exp.evaluator, exp.evaluator.n, seed), graph.region(path[0]),
+                                         chain).results] for seed in seeds]
     return {"maze": exp.maze.name, "agent": result["agent"], "policy": exp.policy_name,
             "goal_points": exp.evaluator.goal_points, "rollouts": exp.evaluator.n, "seeds": list(seeds),
             "search": result.get("edge_probabilities"), "measured": result.get("leg_success"), "fresh": fresh}

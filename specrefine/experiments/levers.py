@@ -81,9 +81,10 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", nargs="+", type=int, required=True)
     p.add_argument("--out", type=Path, default=None, help="write the markdown here (default: print it only)")
     args = p.parse_args(argv)
-    pairs = dict(zip(args.mazes, args.baseline_mazes or args.mazes, strict=False))
-    if len(args.baseline_mazes or args.mazes) != len(args.mazes):
-        p.error(f"--baseline-mazes names {len(args.baseline_mazes)} mazes for the {len(args.mazes)} of --mazes")
+    baseline_mazes = args.baseline_mazes or args.mazes
+    if len(baseline_mazes) != len(args.mazes):
+        p.error(f"--baseline-mazes names {len(baseline_mazes)} mazes for the {len(args.mazes)} of --mazes")
+    pairs = dict(zip(args.mazes, baseline_mazes, strict=True))
     try:
         lever = _by_cell(args.table, args.method, args.proposer)
         by_maze = _by_cell(args.baseline, args.baseline_method, args.proposer)
