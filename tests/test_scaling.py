@@ -51,6 +51,16 @@ def test_erring_rule_takes_the_better_method_per_maze_and_counts_zeros_where_the
     assert zero["zeros"] == ["u_chain_2 seed 1"] and zero["verdict"] == "not met"  # ratio 1.5 too
 
 
+def test_the_erring_ratio_carries_a_bootstrap_interval_over_paired_cells():
+    rows = _rows(0.6, oneshot_rate=0.2)
+    flat = scaling.erring_claim(rows)
+    assert flat["ratio_ci"] == pytest.approx([3.0, 3.0]) and flat["cells"] == 8 * len(scaling.SEEDS)
+    rows = [dict(r, success_rate=0.0) if (r["method"], r["seed"]) == ("vlm-oneshot", 0) else r for r in rows]
+    spread = scaling.erring_claim(rows)  # the one-shot at 0 on every seed-0 cell: the ratio rises, its interval widens
+    low, high = spread["ratio_ci"]
+    assert spread["ratio"] == pytest.approx(0.6 / (0.2 * 2 / 3)) and low < spread["ratio"] < high
+
+
 def test_the_command_writes_claims_legs_and_figure(tmp_path):
     table = tmp_path / "t.csv"
     with table.open("w", newline="") as fh:
@@ -60,6 +70,8 @@ def test_the_command_writes_claims_legs_and_figure(tmp_path):
     assert scaling.main([str(table), "--out", str(tmp_path / "out")]) == 0
     claims = (tmp_path / "out" / "claims.md").read_text()
     assert "holds" in claims and "u_chain_5_subgoals" in claims
+    assert "Ratio 3.10 [3.10, 3.10] (95 % bootstrap, 24 paired cells resampled)" in claims
+    assert "runs at 0 where the one-shot is above 0.5: none." in claims
     assert (tmp_path / "out" / "figure5.png").stat().st_size > 0
     assert "| u_chain_3 |" in (tmp_path / "out" / "legs.md").read_text()
     seeds = (tmp_path / "out" / "erring_seeds.md").read_text()
