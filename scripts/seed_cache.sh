@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Seed each cell's evaluation cache with a copy of another method's cell of the same maze, proposer and seed.
+#
+#   FROM=ours TO=ours-repair DEST=runs/ant_scaling_centre/repair_geometric_centre/cells \
+#       bash scripts/seed_cache.sh runs/ant_centre/cells runs/ant_scaling_centre/ours_centre/cells
+#
+# Cache entries are content-addressed (the SHA-256 of start distribution, legs, policy fingerprint, n, horizon,
+# seed, maze and code version: specrefine/evaluation/cache.py), so an entry found there is the evaluation the
+# new cell would have simulated; what the new method asks beyond them is simulated as usual, and the
+# measurement and calibration episodes are never cached. Existing entries are kept (cp -n). The new rows'
+# evaluations and cache_hits columns say how much was simulated; their wall times compare with nothing.
+set -euo pipefail
+: "${FROM:?FROM=method whose caches are copied}" "${TO:?TO=method that receives them}" "${DEST:?DEST=cells folder}"
+copied=0
+for src_root in "$@"; do
+  for src in "$src_root"/*__"$FROM"__*; do
+    [ -d "$src/cache" ] || continue
+    name=$(basename "$src")
+    dest="$DEST/${name/__${FROM}__/__${TO}__}"
+    mkdir -p "$dest/cache"
+    cp -rn "$src/cache/." "$dest/cache/"
+    copied=$((copied + 1))
+  done
+done
+echo "seeded $copied cell caches of $TO from $FROM into $DEST"
