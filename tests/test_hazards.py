@@ -14,8 +14,9 @@ from specrefine import cli
 from specrefine.core.errors import MazeError
 from specrefine.core.mazes import load_maze, parse_maze
 from specrefine.core.regions import is_subset
+from specrefine.core.results import AVOID
 from specrefine.core.spec import maze_task
-from specrefine.evaluation.evaluator import AVOID, Evaluator
+from specrefine.evaluation.evaluator import Evaluator
 from specrefine.evaluation.monitor import satisfies
 from specrefine.pictures.render import render_task, to_png
 from specrefine.proposers import EdgeQuery, environment_text, make_proposer, segment_clear

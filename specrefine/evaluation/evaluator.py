@@ -16,7 +16,8 @@ legs it then runs; :meth:`Evaluator.aim`).  :class:`EvaluationFacts` says the ru
 All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
 :class:`~specrefine.sim.simulator.BatchedSim` (one per batch size, built lazily and reused); a rollout that
 has finished is frozen (zero action, excluded from the checks, its trajectory padded with its last
-point) and the loop stops once all have finished.
+point) and the loop stops once all have finished. The evaluator places the episodes (start states, goal points);
+the loop that runs them is :mod:`specrefine.evaluation.rollouts`.
 
 Reproducible: the seed fixes start states, goal points and (through them) the deterministic policy
 and physics, so the same seed gives the same numbers: bit for bit when the same call runs again on
@@ -46,16 +47,11 @@ from pathlib import Path
 import numpy as np
 
 from ..core.agents import get_agent
-from ..core.errors import PolicyError, SpecrefineError
+from ..core.errors import SpecrefineError
 from ..core.mazes import Maze
 from ..core.paper import PAPER
 from ..core.regions import CompiledRegion, Region
 from ..core.results import (
-    AVOID,
-    FLIPPED,
-    SUCCESS,
-    TIMEOUT,
-    UNFINISHED,
     CompositionalResult,
     EdgeResult,
     StartStates,
@@ -63,6 +59,7 @@ from ..core.results import (
     wilson_ci,
 )
 from .cache import ResultCache
+from .rollouts import Controls, Plan, RolloutLoop
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
@@ -346,7 +343,7 @@ class Evaluator:
         """``run_compositional`` along a vertex path of a task graph, from I(path[0])."""
         return self.run_compositional(graph.region(path[0]), path_legs(graph, path), n=n, seed=seed)
 
-    # --- the hot loop --------------------------------------------------------------------------
+    # --- placing and running rollouts ------------------------------------------------------------
     def _rollout(self, start, legs, n: int, seed) -> dict:
         return self._rollout_many([(start, legs, n, seed)])[0]
 
@@ -365,23 +362,15 @@ class Evaluator:
             sim.reset(xy=self.spawn_points(start, n, rng), rng=rng, idx=rows)
 
     def _rollout_batches(self, tasks: list[tuple]) -> list[dict]:
-        """Run every task's n episodes through its legs; the core loop behind ``evaluate`` and ``run_compositional``.
-
-        Episodes of all tasks live in rows of one BatchedSim (each task seeded on its own, so a task's
-        start states and goal points do not depend on its neighbours).  When at most half of the rows
-        are still running, the running ones are moved (full physics states, bit-exact) into a smaller
-        BatchedSim (a power of two, at least ``MIN_BATCH``), so finished rollouts stop costing physics.
-        """
+        """Place every task's n episodes (start states, goal points; each task seeded on its own, so they do not
+        depend on its neighbours) in rows of one BatchedSim and run them (:class:`~.rollouts.RolloutLoop`)."""
         counts = np.array([n for _, _, n, _ in tasks])
         first = np.concatenate([[0], np.cumsum(counts)])
         N, n_legs = int(first[-1]), np.array([len(legs) for _, legs, _, _ in tasks])
-        L = int(n_legs.max())
-        task_of = np.repeat(np.arange(len(tasks)), counts)
-        L_of = n_legs[task_of]
         sim = self.sim(-(-N // self.MIN_BATCH) * self.MIN_BATCH)
-        goal_pts = np.zeros((L, N, 2))
-        goal_id = np.zeros((len(tasks), L), dtype=np.int64)  # (task, leg) -> index into goals / avoids
-        avoid_id = np.zeros((len(tasks), L), dtype=np.int64)
+        goal_pts = np.zeros((int(n_legs.max()), N, 2))
+        goal_id = np.zeros((len(tasks), int(n_legs.max())), dtype=np.int64)  # (task, leg) -> index into goals
+        avoid_id = np.zeros_like(goal_id)
         goals, avoids = [], []
         for j, (start, legs, n, seed) in enumerate(tasks):
             rng = np.random.default_rng(seed)
@@ -394,110 +383,11 @@ class Evaluator:
                 avoid_id[j, k] = _index_of(avoids, self.compiled(avoid))
         if sim.n > N:  # padding rows: copies of row 0, never checked
             sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
-        H, r = self.horizon, self.clearance
-        T = L * H + 1
-        traj = np.empty((N, T, 2), dtype=np.float32)
-        leg = np.zeros(N, dtype=np.int64)
-        t_leg = np.zeros(N, dtype=np.int64)
-        active = np.ones(N, dtype=bool)
-        lengths = np.full(N, T, dtype=np.int64)
-        outcome = np.full(N, UNFINISHED, dtype=np.int8)
-        end_states = np.zeros((N, sim.state_dim))
-        end_xy = np.zeros((N, 2))
-        episode = np.concatenate([np.arange(N), np.full(sim.n - N, -1)])  # episode held by each sim row (-1: padding)
-        row = np.arange(N)  # sim row of each episode (-1: not in the sim any more)
-        xy, flipped = sim.xy[:N], sim.flipped[:N]
-        traj[:, 0] = xy
-        steps = np.zeros(len(tasks), dtype=np.int64)  # rows held by each task's episodes, per step
-        padding_steps = 0
-
-        def classify(sel, ids, regions, test):
-            """test(region, points) for the episodes ``sel``, grouped by the region each one is in."""
-            out = np.zeros(len(sel), dtype=bool)
-            for i in np.unique(ids):
-                m = ids == i
-                out[m] = test(regions[i], xy[sel[m]])
-            return out
-
-        def check(t: int) -> None:
-            """Classify the running episodes at time t (after the step that led there)."""
-            idx = np.flatnonzero(active)
-            for _ in range(L + 1):  # a point may lie in several consecutive goals: advance through all of them
-                if not len(idx):
-                    break
-                task, k = task_of[idx], leg[idx]
-                bad = classify(idx, avoid_id[task, k], avoids, lambda a, p: a.below(p, r)) | flipped[idx]
-                reached = ~bad & classify(idx, goal_id[task, k], goals, lambda g, p: g.contains(p))
-                if bad.any():
-                    b = idx[bad]
-                    outcome[b] = np.where(flipped[b], FLIPPED, AVOID)
-                    active[b] = False
-                    lengths[b] = t + 1
-                g = idx[reached]
-                leg[g] += 1
-                t_leg[g] = 0
-                done = g[leg[g] == L_of[g]]
-                if len(done):
-                    outcome[done] = SUCCESS
-                    active[done] = False
-                    lengths[done] = t + 1
-                    end_states[done] = sim.get_state()[row[done]]
-                    end_xy[done] = xy[done]
-                idx = g[leg[g] < L_of[g]]
-
-        check(0)
-        import torch
-
-        with torch.inference_mode():
-            for t in range(1, T):
-                running = int(active.sum())
-                if not running:
-                    break
-                size = max(self.MIN_BATCH, 1 << (running - 1).bit_length())
-                if size <= sim.n // 2:  # compact: move the running episodes into a smaller batch
-                    ids = np.flatnonzero(active)
-                    states = sim.get_state()[row[ids]]
-                    states = np.concatenate([states, np.repeat(states[:1], size - len(ids), axis=0)])
-                    sim = self.sim(size)
-                    sim.reset(states=states)
-                    episode = np.concatenate([ids, np.full(size - len(ids), -1)])
-                    row[:] = -1
-                    row[ids] = np.arange(len(ids))
-                live = episode >= 0
-                ep = np.where(live, episode, episode[0])
-                obs = sim.observe(goal_pts[np.minimum(leg[ep], L_of[ep] - 1), ep], self.observation_frame)
-                act = np.asarray(self._act(obs), dtype=np.float64)
-                if not np.isfinite(act).all():  # MuJoCo would warn per step and write MUJOCO_LOG.TXT into the cwd
-                    raise PolicyError("the policy acts with NaN or infinite values on these observations: "
-                                      "retrain it or restore its checkpoint")
-                act[~(live & active[ep])] = 0.0  # finished rollouts stay still
-                sim.step(act)
-                steps += np.bincount(task_of[episode[live]], minlength=len(tasks))
-                padding_steps += int((~live).sum())
-                xy[episode[live]] = sim.xy[live]
-                flipped[episode[live]] = sim.flipped[live]
-                traj[:, t] = xy
-                t_leg[active] += 1
-                check(t)
-                late = active & (t_leg >= H)
-                if late.any():
-                    outcome[late] = TIMEOUT
-                    active[late] = False
-                    lengths[late] = t + 1
-        self.sim_steps += int(steps.sum()) + padding_steps
-        if len(tasks) == 1:
-            steps[0] += padding_steps
-        return [self._task_output(slice(first[j], first[j + 1]), traj, lengths, leg, outcome, end_states, end_xy,
-                                  int(steps[j])) for j in range(len(tasks))]
-
-    @staticmethod
-    def _task_output(rows: slice, traj, lengths, leg, outcome, end_states, end_xy, steps: int) -> dict:
-        lengths = lengths[rows]
-        n = len(lengths)
-        used = int(lengths.max(initial=1))
-        pad = np.minimum(np.arange(used)[None, :], lengths[:, None] - 1)
-        return {"legs_done": leg[rows], "trajectories": traj[rows][np.arange(n)[:, None], pad], "lengths": lengths,
-                "outcome": outcome[rows], "end_states": end_states[rows], "end_xy": end_xy[rows], "steps": steps}
+        plan = Plan(first, n_legs, goal_pts, goal_id, avoid_id, goals, avoids)
+        controls = Controls(self._act, self.observation_frame, self.sim, self.horizon, self.clearance, self.MIN_BATCH)
+        loop = RolloutLoop(plan, sim, controls).run()
+        self.sim_steps += loop.sim_steps
+        return loop.outputs()
 
 
 def _edge_result(out: dict, n: int) -> EdgeResult:
