@@ -143,3 +143,13 @@ def test_figures_draw_runs_that_aimed_at_centres_under_their_method(rules, label
     assert [t.get_text() for t in ax.get_legend().get_texts()] == labels
     bars = figure4(rows, tasks=["u_chain_1", "u_chain_2"], methods=["ours"]).axes[0].patches
     assert len(bars) == 2 * len(rules) and all(b.get_height() == pytest.approx(0.9) for b in bars)
+
+
+def test_figure5_keeps_equal_series_apart():
+    from specrefine.experiments.figures import figure5
+
+    rows = [dict(r, method=m) for m in ("ours", "ours-repair") for r in _figure_rows("centre")]
+    bars = figure5(rows, methods=["ours", "ours-repair"]).axes[0].containers  # one errorbar per series
+    xs = [tuple(bar.lines[0].get_xdata()) for bar in bars]
+    assert len(xs) == 4 and len(set(xs)) == 4  # same successes, four series, each visible
+    assert all(abs(x - round(x)) < 0.1 for line in xs for x in line)  # still read as whole rooms

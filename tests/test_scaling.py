@@ -51,6 +51,14 @@ def test_erring_rule_takes_the_better_method_per_maze_and_counts_zeros_where_the
     assert zero["zeros"] == ["u_chain_2 seed 1"] and zero["verdict"] == "not met"  # ratio 1.5 too
 
 
+def test_tables_without_the_erring_runs_say_so():
+    rows = [r for r in _rows(0.93) if r["proposer"] == scaling.ORACLE]
+    erring = scaling.erring_claim(rows)
+    assert erring["verdict"] == "not run"
+    text = scaling.markdown(scaling.flat_claim(rows), erring)
+    assert text.rstrip().endswith("not run** (no ours or ours-repair x imperfect:moderate run in these tables).")
+
+
 def test_the_erring_ratio_carries_a_bootstrap_interval_over_paired_cells():
     rows = _rows(0.6, oneshot_rate=0.2)
     flat = scaling.erring_claim(rows)

@@ -104,28 +104,34 @@ def figure6(rows, tasks=None, methods=METHOD_ORDER, proposers=None, legend_outsi
                    legend_outside=legend_outside)
 
 
+DODGE = 0.04  # rooms between neighbouring series in Figure 5
+
+
 def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
     """U-chain with 1-5 rooms, with and without subgoals: success vs rooms, one panel per proposer.
 
-    ``legend_outside``: one legend right of the last panel instead of one in each (for many methods).
+    ``legend_outside``: one legend right of the last panel instead of one in each (for many methods). Each series
+    is shifted sideways by a few hundredths of a room, so that series with equal values do not hide each other.
     """
     summary = _summary(rows)
     proposers = proposers or _proposers(rows) or ["none"]
     fig, axes = subplots(1, len(proposers), figsize=(6 * len(proposers), 4), squeeze=False)
+    series = [(method, rule, subgoals, style) for method, rule in _series(summary, methods)
+              for subgoals, style in ((False, "-"), (True, "--"))]
     for ax, proposer in zip(axes[0], proposers):
-        for method, rule in _series(summary, methods):
-            for subgoals, style in ((False, "-"), (True, "--")):
-                prop = proposer if method in PROPOSER_METHODS else "none"
-                pts = _rooms(summary, method, prop, subgoals, rule)
-                if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
-                    pts += [p for p in _rooms(summary, method, prop, False, rule) if p[0] == 1]
-                if not pts:
-                    continue
-                pts.sort()
-                r, mu, sd = map(np.array, zip(*pts))
-                ax.errorbar(r, mu, yerr=sd, ls=style, marker="o" if rule == PAPER.goal_points else "s", capsize=3,
-                            color=METHOD_COLOURS[method],
-                            label=f"{_label(method, rule)} ({'with' if subgoals else 'no'} subgoals)")
+        for i, (method, rule, subgoals, style) in enumerate(series):
+            dodge = DODGE * (i - (len(series) - 1) / 2)  # equal series (ours = ours-repair) stay visible
+            prop = proposer if method in PROPOSER_METHODS else "none"
+            pts = _rooms(summary, method, prop, subgoals, rule)
+            if subgoals:  # one room has no doorway: its "with subgoals" task is the plain one
+                pts += [p for p in _rooms(summary, method, prop, False, rule) if p[0] == 1]
+            if not pts:
+                continue
+            pts.sort()
+            r, mu, sd = map(np.array, zip(*pts))
+            ax.errorbar(r + dodge, mu, yerr=sd, ls=style, marker="o" if rule == PAPER.goal_points else "s",
+                        capsize=3, color=METHOD_COLOURS[method],
+                        label=f"{_label(method, rule)} ({'with' if subgoals else 'no'} subgoals)")
         ax.set_xlabel("rooms")
         ax.set_ylabel("success rate")
         ax.set_ylim(0, 1.05)

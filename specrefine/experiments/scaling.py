@@ -103,7 +103,8 @@ def erring_claim(rows) -> dict:
     met = ratio >= RATIO and not zeros
     return {"claim": f"better of ours / ours-repair x {ERRING} >= {RATIO:g}x vlm-oneshot on multi-room mazes, no "
                      f"run at 0 where the one-shot is above {ONESHOT_HIGH}",
-            "verdict": ("holds" if met else "not met") if complete else "partial", "complete": complete,
+            "verdict": "not run" if not chosen else ("holds" if met else "not met") if complete else "partial",
+            "complete": complete,
             "ratio": ratio, "ratio_ci": list(ci), "cells": len(pairs), "mazes": len({m for m, _, _ in pairs}),
             "zeros": zeros, "chosen": chosen}
 
@@ -177,6 +178,9 @@ def markdown(flat: dict, erring: dict, rule: str = "sampled") -> str:
     for maze, m in flat["per_maze"].items():
         lines.append(f"| {maze} | {m['seeds']} | {m['success']:.3f} [{m['ci'][0]:.3f}, {m['ci'][1]:.3f}] | "
                      f"{', '.join(f'{x:.3f}' for x in m['runs'])} |")
+    if not erring["chosen"]:
+        return "\n".join(lines + ["", f"**{erring['claim']}: not run** (no ours or ours-repair x {ERRING} run in "
+                                       "these tables)."]) + "\n"
     lo, hi = erring["ratio_ci"]
     lines += ["", f"**{erring['claim']}: {erring['verdict']}.** Ratio {erring['ratio']:.2f} [{lo:.2f}, {hi:.2f}] "
                   f"(95 % bootstrap, {erring['cells']} paired cells resampled) over {erring['mazes']} multi-room "
@@ -209,10 +213,11 @@ def main(argv=None) -> int:
     write_atomic(out / "claims.md", markdown(flat, erring, rule))
     write_atomic(out / "claims.json", json.dumps({"flat": flat, "erring": erring}, indent=1, default=float) + "\n")
     write_atomic(out / "legs.md", legs_table(rows) + "\n")
-    write_atomic(out / "erring_seeds.md", "\n\n".join(erring_seed_table(rows, s) for s in SEEDS) + "\n")
+    if erring["chosen"]:
+        write_atomic(out / "erring_seeds.md", "\n\n".join(erring_seed_table(rows, s) for s in SEEDS) + "\n")
     save_figure(figure5(rows, methods=list(METHODS), proposers=[ORACLE, ERRING]), out / "figure5.png", dpi=110)
-    print(f"{len(rows)} rows -> {out}: claims.md ({flat['verdict']}; {erring['verdict']}), legs.md, "
-          "erring_seeds.md, figure5.png")
+    seeds = ", erring_seeds.md" if erring["chosen"] else ""
+    print(f"{len(rows)} rows -> {out}: claims.md ({flat['verdict']}; {erring['verdict']}), legs.md{seeds}, figure5.png")
     return 0
 
 
