@@ -4,6 +4,8 @@
 #   FROM=ours TO=ours-repair DEST=runs/ant_scaling_centre/repair_geometric_centre/cells \
 #       bash scripts/seed_cache.sh runs/ant_centre/cells runs/ant_scaling_centre/ours_centre/cells
 #
+# MAZES="u_chain_3 u_chain_4" (optional) seeds only those mazes' cells.
+#
 # Cache entries are content-addressed (the SHA-256 of start distribution, legs, policy fingerprint, n, horizon,
 # seed, maze and code version: specrefine/evaluation/cache.py), so an entry found there is the evaluation the
 # new cell would have simulated; what the new method asks beyond them is simulated as usual, and the
@@ -16,6 +18,7 @@ for src_root in "$@"; do
   for src in "$src_root"/*__"$FROM"__*; do
     [ -d "$src/cache" ] || continue
     name=$(basename "$src")
+    if [ -n "${MAZES:-}" ] && [[ " $MAZES " != *" ${name%%__*} "* ]]; then continue; fi
     dest="$DEST/${name/__${FROM}__/__${TO}__}"
     mkdir -p "$dest/cache"
     cp -rn "$src/cache/." "$dest/cache/"
