@@ -49,6 +49,9 @@ def test_erring_rule_takes_the_better_method_per_maze_and_counts_zeros_where_the
     assert {c["method"] for c in repaired["chosen"].values()} == {"ours-repair"}
     zero = scaling.erring_claim(_rows(0.9, oneshot_rate=0.6, repair_rate=0.1, zero=("u_chain_2", 1)))
     assert zero["zeros"] == ["u_chain_2 seed 1"] and zero["verdict"] == "not met"  # ratio 1.5 too
+    assert zero["ours_at_zero"] == [{"maze": "u_chain_2", "seed": 1, "ours_repair": 0.1}]
+    assert "`ours` runs at 0: 1 of 27; `ours-repair` on the same cells: above 0 on 1 of 1 (u_chain_2 seed 1 0.100)." \
+        in scaling.markdown(scaling.flat_claim(_rows(0.9)), zero)
 
 
 def test_tables_without_the_erring_runs_say_so():

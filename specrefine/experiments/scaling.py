@@ -84,10 +84,13 @@ def _mean(runs) -> float | None:
 
 def erring_claim(rows) -> dict:
     """The second rule on ERRING: the better of ours / ours-repair per maze against the one-shot."""
-    chosen, zeros, pairs, complete = {}, [], [], True
+    chosen, zeros, pairs, complete, at_zero = {}, [], [], True, []
     for maze in MAZES:
         by = {m: _runs(rows, maze, m, ERRING) for m in METHODS}
         complete &= all(len(v) == len(SEEDS) for v in by.values())
+        repaired = {r["seed"]: r["success_rate"] for r in by["ours-repair"]}
+        at_zero += [{"maze": maze, "seed": r["seed"], "ours_repair": repaired.get(r["seed"])}
+                    for r in by["ours"] if r["success_rate"] == 0.0]
         means = {m: _mean(by[m]) for m in ("ours", "ours-repair") if by[m]}
         if not means:
             continue
@@ -106,7 +109,15 @@ def erring_claim(rows) -> dict:
             "verdict": "not run" if not chosen else ("holds" if met else "not met") if complete else "partial",
             "complete": complete,
             "ratio": ratio, "ratio_ci": list(ci), "cells": len(pairs), "mazes": len({m for m, _, _ in pairs}),
-            "zeros": zeros, "chosen": chosen}
+            "zeros": zeros, "chosen": chosen, "ours_runs": sum(len(_runs(rows, m, "ours", ERRING)) for m in MAZES),
+            "ours_at_zero": at_zero}
+
+
+def _repaired_text(at_zero) -> str:
+    ran = [z for z in at_zero if z["ours_repair"] is not None]
+    lifted = [z for z in ran if z["ours_repair"] > 0]
+    cells = ", ".join(f"{z['maze']} seed {z['seed']} {z['ours_repair']:.3f}" for z in ran)
+    return f"above 0 on {len(lifted)} of {len(ran)}" + (f" ({cells})" if cells else "")
 
 
 def _ratio_with_ci(pairs) -> tuple[float, tuple[float, float]]:
@@ -186,6 +197,8 @@ def markdown(flat: dict, erring: dict, rule: str = "sampled") -> str:
                   f"(95 % bootstrap, {erring['cells']} paired cells resampled) over {erring['mazes']} multi-room "
                   f"mazes; runs at 0 where the one-shot is above {ONESHOT_HIGH}: "
                   f"{', '.join(erring['zeros']) or 'none'}.", "",
+              f"`ours` runs at 0: {len(erring['ours_at_zero'])} of {erring['ours_runs']}; `ours-repair` on the same "
+              f"cells: {_repaired_text(erring['ours_at_zero'])}.", "",
               "| maze | chosen | its mean | one-shot mean |", "|---|---|---|---|"]
     for maze, c in erring["chosen"].items():
         shot = "—" if c["oneshot"] is None else f"{c['oneshot']:.3f}"
