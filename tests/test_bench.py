@@ -22,6 +22,25 @@ def test_evaluator_benchmark_prints_one_json_line():
     out = json.loads(lines[0])
     assert out["bench"] == "evaluator" and out["agent"] == "point" and out["batch"] == 32
     assert out["env_steps_per_s"] > 0 and out["env_steps"] > 0 and out["horizon"] == 20
+    assert out["raw_same_work_steps_per_s"] > 0 and out["ratio_vs_same_work"] > 0
+
+
+def test_the_same_work_ceiling_replays_exactly_what_the_evaluator_simulated():
+    import numpy as np
+
+    from specrefine.bench.evaluator import _policy, _recorded_steps, _replay, open_room
+    from specrefine.evaluation.evaluator import Evaluator
+
+    maze = open_room("point")
+    ev = Evaluator(maze, "point", _policy("point")[0], n=16, horizon=12, seed=0)
+    ev.evaluate(maze.start, maze.goal, maze.walls, seed=1)  # builds the sim the recording wraps
+    before = ev.sim_steps
+    calls = _recorded_steps(ev, maze, seed=2)
+    assert sum(n for n, *_ in calls) == ev.sim_steps - before  # every simulated row-step, padding included
+    first, second = calls[0][1], calls[1][1]
+    assert not np.array_equal(first, second)  # the states move on, so the replay redoes real steps
+    wall, cpu = _replay(ev.sim(16).model, calls, nthread=1)
+    assert wall > 0 and cpu > 0
 
 
 @pytest.mark.parametrize("what", ["evaluator", "gymenv", "train", "refine"])

@@ -95,6 +95,45 @@ def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) 
     return long_call, per_step, long_cpu
 
 
+def _recorded_steps(ev, maze, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """One evaluation's physics calls as (states before, controls) per control step, for :func:`_replay`."""
+    calls = []
+    sims = list(ev._sims.values())
+    originals = [sim._pool.rollout for sim in sims]
+
+    def recorder(original):
+        def rollout(models, datas, initial, ctrl, **kw):
+            calls.append((len(models), np.array(initial), np.array(ctrl), kw["nstep"]))
+            return original(models, datas, initial, ctrl, **kw)
+        return rollout
+
+    for sim, original in zip(sims, originals, strict=True):
+        sim._pool.rollout = recorder(original)
+    try:
+        ev.evaluate(maze.start, maze.goal, maze.walls, seed=seed)
+    finally:
+        for sim, original in zip(sims, originals, strict=True):
+            sim._pool.rollout = original
+    return calls
+
+
+def _replay(model, calls, nthread: int) -> tuple[float, float]:
+    """Steps/s (wall, CPU) of mujoco.rollout redoing exactly the recorded calls: the same states, controls and
+    batch sizes, one call per control step as the evaluator makes them; the evaluator's own ceiling."""
+    import mujoco
+    from mujoco import rollout
+
+    datas = [mujoco.MjData(model) for _ in range(nthread)]
+    outs = {}
+    with rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
+        t, c = time.perf_counter(), time.process_time()
+        for n, initial, ctrl, nstep in calls:
+            out = outs.setdefault((n, nstep), np.zeros((n, nstep, initial.shape[1])))
+            pool.rollout([model] * n, datas, initial, ctrl, nstep=nstep, state=out, skip_checks=True)
+        steps = sum(n for n, *_ in calls)
+        return steps / (time.perf_counter() - t), steps / (time.process_time() - c)
+
+
 def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0, horizon: int | None = None,
                     torch_threads: int = 1, nthread: int | None = None, scenario: str = "open",
                     rounds: int = 3) -> dict:
@@ -112,7 +151,8 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
     ev.evaluate(maze.start, maze.goal, maze.walls, seed=10_000)  # warm-up: builds the sims, touches every path
     rng = np.random.default_rng(0)
     evals, raws, per_steps, outcomes, seed, total_steps, total_time = [], [], [], {}, 0, 0, 0.0
-    evals_cpu, raws_cpu = [], []
+    evals_cpu, raws_cpu, replays, replays_cpu = [], [], [], []
+    calls = _recorded_steps(ev, maze, seed=20_000)  # the work of one evaluation, replayed raw each round
     for _ in range(rounds):
         ev.sim_steps = 0
         t0, c0 = time.perf_counter(), time.process_time()
@@ -132,8 +172,11 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
         raws.append(raw_long)
         raws_cpu.append(raw_cpu)
         per_steps.append(raw_step)
-    env_sps, raw_long, raw_step, env_cpu, raw_cpu = (float(np.median(x)) for x in
-                                                     (evals, raws, per_steps, evals_cpu, raws_cpu))
+        replay, replay_cpu = _replay(sim.model, calls, sim.nthread)
+        replays.append(replay)
+        replays_cpu.append(replay_cpu)
+    env_sps, raw_long, raw_step, env_cpu, raw_cpu, same, same_cpu = (
+        float(np.median(x)) for x in (evals, raws, per_steps, evals_cpu, raws_cpu, replays, replays_cpu))
     return {
         "bench": "evaluator", "agent": agent, "batch": batch, "env_steps_per_s": round(env_sps, 1),
         "raw_rollout_steps_per_s": round(raw_long, 1), "ratio_vs_raw_rollout": round(env_sps / raw_long, 3),
@@ -141,6 +184,10 @@ def bench_evaluator(agent: str = "point", batch: int = 32, seconds: float = 6.0,
         # per CPU-second of this process (all threads): robust when other jobs share the cores
         "env_steps_per_cpu_s": round(env_cpu, 1), "raw_rollout_steps_per_cpu_s": round(raw_cpu, 1),
         "cpu_ratio_vs_raw_rollout": round(env_cpu / raw_cpu, 3),
+        # the same physics (the evaluator's recorded states, controls and batch sizes) through mujoco.rollout alone:
+        # random controls keep an Ant standing, a policy makes it run, and running costs more per step
+        "raw_same_work_steps_per_s": round(same, 1), "ratio_vs_same_work": round(env_sps / same, 3),
+        "cpu_ratio_vs_same_work": round(env_cpu / same_cpu, 3),
         "rounds": rounds, "per_round_ratio": [round(e / r, 3) for e, r in zip(evals, raws, strict=True)],
         "evaluations": seed, "env_steps": total_steps, "seconds": round(total_time, 2), "horizon": ev.horizon,
         "scenario": maze.name, "outcomes": outcomes, "policy": policy_note,
