@@ -297,22 +297,6 @@ def _grid_tables(name: str) -> list[Path]:
     return [ROOT / t for t in grids.get(name).tables if (ROOT / t).exists()]
 
 
-def test_front_page_scaling_line_is_seed_0_of_both_grids():
-    from specrefine.experiments import scaling
-
-    text = " ".join(FRONT[FRONT.index("<!-- front scaling -->"):FRONT.index("<!-- /front scaling -->")].split())
-    rows = scaling.read_rows(_grid_tables("ant-scaling"))
-    baseline = scaling.read_rows([ROOT / "data/results/ant/comparison.csv"])
-
-    def seed0(table, proposer):
-        rate = {r["maze"]: r["success_rate"] for r in table if (r["method"], r["proposer"], r["seed"]) ==
-                ("ours", proposer, 0)}
-        return ", ".join(f"{rate[f'u_chain_{n}']:.3f}" for n in range(1, 6))
-
-    assert text == (f"<!-- front scaling -->{seed0(rows, scaling.ORACLE)} for 1-5 rooms (stage 4, seed 0: "
-                    f"{seed0(baseline, 'geometric')})")
-
-
 def _between(text: str, marker: str) -> str:
     return " ".join(text[text.index(f"<!-- {marker} -->") + len(f"<!-- {marker} -->"):
                          text.index(f"<!-- /{marker} -->")].split())
@@ -345,17 +329,43 @@ def test_front_page_centre_grid_is_its_claims():
         f"[{lo:+.3f}, {hi:+.3f}]")
 
 
-def test_front_page_five_rooms_and_cost_are_the_shipped_runs():
+def test_front_page_leg_losses_and_legs_per_room_are_the_centre_grids():
     import json
 
     from specrefine.experiments import scaling
-    from specrefine.experiments.legs import pooled
+    from specrefine.experiments.legs import turn_table
 
-    rows = scaling.read_rows([ROOT / "data/results/ant/scaling/ours_geometric.csv"])
-    runs = [r for r in rows if (r["maze"], r["method"], r["proposer"]) == ("u_chain_5", "ours", scaling.ORACLE)]
-    assert sorted(r["seed"] for r in runs) == [0, 1, 2]
-    k, n = pooled(runs)
-    assert _between(FRONT, "front five") == f"{k / n:.3f} ({k} of {n} episodes)"
+    profiles = json.loads((ROOT / "data/results/ant/scaling_centre/leg_profiles.json").read_text())
+    rate = {line.split(" | ")[0].strip("| "): float(line.split(" | ")[-1].split()[0])
+            for line in turn_table(profiles).splitlines()[2:]}
+    assert " ".join(_between(FRONT, "front turns").split()) == (
+        f"{100 * rate['straight']:.2f} % of the episodes that start it when it runs straight and "
+        f"{100 * rate['turning']:.2f} % when it turns, against {100 * rate['first leg']:.2f} % for a path's first leg")
+    per_room = [float(line.split(" | ")[7]) for line in
+                (ROOT / "data/results/ant/scaling_centre/legs.md").read_text().splitlines()[2:]
+                if f"| ours | {scaling.ORACLE} |" in line]
+    assert len(per_room) == len(scaling.MAZES)
+    assert _between(FRONT, "front legs") == f"{min(per_room):.1f}-{max(per_room):.1f} legs per room"
+
+
+def front_erring_text() -> str:
+    import json
+
+    erring = json.loads((ROOT / "data/results/ant/scaling_centre/claims.json").read_text())["erring"]
+    lo, hi = erring["ratio_ci"]
+    lifted = sum(1 for z in erring["ours_at_zero"] if (z["ours_repair"] or 0) > 0)
+    return (f"{erring['ratio']:.1f}x the one-shot [{lo:.1f}, {hi:.1f}] on the multi-room mazes ({erring['cells']} "
+            f"paired runs; the rule: {erring['verdict']}); `ours` ends at 0 in {len(erring['ours_at_zero'])} of "
+            f"{erring['ours_runs']} runs and `ours-repair` lifts {lifted} of them above 0")
+
+
+def test_front_page_erring_line_is_the_centre_grids_claims():
+    assert _between(FRONT, "front erring") == front_erring_text()
+
+
+def test_front_page_cost_is_the_shipped_runs():
+    import json
+
     cost = json.loads((ROOT / "data/results/ant/scaling/cost_u_chain_5.json").read_text())
     assert _between(FRONT, "front cost") == " and ".join(f"{r['wall_seconds']:.0f} s" for r in cost["runs"])
 
@@ -418,13 +428,21 @@ def test_fresh_estimates_table_is_the_shipped_reports():
     assert "<!-- fresh estimates -->\n" + "\n".join(lines) + "\n" in (ROOT / "docs/ant_experiments.md").read_text()
 
 
-def test_erring_seed_0_table_is_the_shipped_tables():
+def test_erring_seed_tables_and_verdict_are_the_shipped_tables():
     from specrefine.experiments import scaling
 
     tables = [ROOT / "data/results/ant/centre.csv", *sorted((ROOT / "data/results/ant/scaling").glob("*_centre.csv"))]
-    table = scaling.erring_seed_table(scaling.read_rows(tables), 0)
-    assert "—" not in table  # seed 0 is complete
-    assert "<!-- erring seed 0 -->\n" + table + "\n" in (ROOT / "docs/ant_experiments.md").read_text()
+    rows = scaling.read_rows(tables)
+    doc = (ROOT / "docs/ant_experiments.md").read_text()
+    for seed in scaling.SEEDS:
+        table = scaling.erring_seed_table(rows, seed)
+        assert "—" not in table  # part 3 is complete
+        assert f"<!-- erring seed {seed} -->\n" + table + "\n" in doc
+    erring = scaling.erring_claim(rows)
+    lo, hi = erring["ratio_ci"]
+    assert erring["verdict"] == "holds" and "the erring-proposer claim holds" in doc
+    assert (f"reaches {erring['ratio']:.1f} times the one-shot's mean success on the multi-room mazes (95 % bootstrap "
+            f"interval [{lo:.1f}, {hi:.1f}] over the {erring['cells']} paired runs") in " ".join(doc.split())
 
 
 def test_leg_profiles_table_is_the_shipped_profiles():
