@@ -363,6 +363,16 @@ def test_front_page_erring_line_is_the_centre_grids_claims():
     assert _between(FRONT, "front erring") == front_erring_text()
 
 
+def test_front_page_evaluator_ratio_is_the_shipped_benchmark():
+    import json
+
+    runs = [json.loads(line) for line in (ROOT / "data/results/bench/evaluator_ant.jsonl").read_text().splitlines()]
+    wall = sorted(r["ratio_vs_raw_rollout"] for r in runs)
+    assert _between(FRONT, "front evaluator") == f"{wall[0]:.2f}-{wall[-1]:.2f}"
+    same_cpu = sorted(r["cpu_ratio_vs_same_work"] for r in runs)
+    assert f"{same_cpu[0]:.2f}-{same_cpu[-1]:.2f} by CPU time against its own physics" in " ".join(FRONT.split())
+
+
 def test_front_page_cost_is_the_shipped_runs():
     import json
 
