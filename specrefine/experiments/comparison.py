@@ -131,15 +131,19 @@ def ratio_claim(cells, failed, proposer, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) ->
     if not pairs:
         return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", math.nan, (math.nan, math.nan),
                       "undecided", n_expected, used_seeds, missing, "no cell with both methods")
-    ours, oneshot = np.array(pairs).T
-    idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(pairs), (BOOTSTRAP_RESAMPLES, len(pairs)))
-    boot = _ratio(ours[idx].mean(axis=1), oneshot[idx].mean(axis=1))
-    ci = _percentile_ci(boot)
-    undefined = int(np.isnan(boot).sum())  # both means 0: no interval, whatever the other resamples say
+    ratio, ci, undefined = bootstrap_ratio(*np.array(pairs, dtype=float).T)
     note = f"ratio undefined (0/0: both methods at 0) in {undefined} of {BOOTSTRAP_RESAMPLES} resamples" \
         if undefined else ""
-    return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", _ratio(ours.mean(), oneshot.mean()), ci,
+    return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", ratio, ci,
                   threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note)
+
+
+def bootstrap_ratio(num: np.ndarray, den: np.ndarray) -> tuple[float, tuple[float, float], int]:
+    """mean(num) / mean(den) over paired cells, its 95 % percentile bootstrap interval (cells resampled, the claims'
+    seed) and how many resamples left it undefined (0/0: both means 0, which makes the interval undefined)."""
+    idx = np.random.default_rng(BOOTSTRAP_SEED).integers(0, len(num), (BOOTSTRAP_RESAMPLES, len(num)))
+    boot = _ratio(num[idx].mean(axis=1), den[idx].mean(axis=1))
+    return float(_ratio(num.mean(), den.mean())), _percentile_ci(boot), int(np.isnan(boot).sum())
 
 
 def paired_difference(cells, failed, proposer, first, second, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) -> dict:

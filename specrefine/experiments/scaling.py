@@ -126,10 +126,8 @@ def _ratio_with_ci(pairs) -> tuple[float, tuple[float, float]]:
     on the point estimate)."""
     if not pairs:
         return float("nan"), (float("nan"), float("nan"))
-    chosen, oneshot = np.array([(a, b) for _, a, b in pairs], dtype=float).T
-    idx = np.random.default_rng(cmp.BOOTSTRAP_SEED).integers(0, len(pairs), (cmp.BOOTSTRAP_RESAMPLES, len(pairs)))
-    boot = cmp._ratio(chosen[idx].mean(axis=1), oneshot[idx].mean(axis=1))
-    return float(cmp._ratio(chosen.mean(), oneshot.mean())), cmp._percentile_ci(boot)
+    ratio, ci, _ = cmp.bootstrap_ratio(*np.array([(a, b) for _, a, b in pairs], dtype=float).T)
+    return ratio, ci
 
 
 def legs_table(rows) -> str:
