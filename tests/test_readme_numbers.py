@@ -423,6 +423,19 @@ def test_the_rotated_check_is_the_levers_rule_on_the_shipped_tables(tmp_path, ca
     assert "<!-- rotated check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
 
 
+def test_the_polish_erring_check_is_the_levers_rule_on_the_shipped_tables(tmp_path):
+    from specrefine.experiments import levers
+
+    out = tmp_path / "check.md"
+    assert levers.main([str(ROOT / "data/results/ant/polish_erring.csv"), "--method", "ours-polish", "--baseline",
+                        str(ROOT / "data/results/ant/scaling/imperfect_centre.csv"), "--baseline-method", "ours",
+                        "--proposer", "imperfect:moderate", "--mazes", "u_chain_3", "u_chain_4", "--seeds", "0", "1",
+                        "2", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert (ROOT / "data/results/ant/polish_erring_check.md").read_text() == text
+    assert "<!-- polish erring check -->\n" + text in (ROOT / "docs" / "ant_experiments.md").read_text()
+
+
 def test_fresh_estimates_table_is_the_shipped_reports():
     import json
     import math
