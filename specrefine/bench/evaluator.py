@@ -95,8 +95,9 @@ def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) 
     return long_call, per_step, long_cpu
 
 
-def _recorded_steps(ev, maze, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """One evaluation's physics calls as (states before, controls) per control step, for :func:`_replay`."""
+def _recorded_steps(ev, maze, seed: int) -> list[tuple[int, np.ndarray, np.ndarray, int]]:
+    """One evaluation's physics calls as (rows, states before, controls, physics steps) per control step, for
+    :func:`_replay` (each of the evaluator's built sims has its rollout pool wrapped while it runs)."""
     calls = []
     sims = list(ev._sims.values())
     originals = [sim._pool.rollout for sim in sims]

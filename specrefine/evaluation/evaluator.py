@@ -367,9 +367,10 @@ class Evaluator:
         counts = np.array([n for _, _, n, _ in tasks])
         first = np.concatenate([[0], np.cumsum(counts)])
         N, n_legs = int(first[-1]), np.array([len(legs) for _, legs, _, _ in tasks])
+        L = int(n_legs.max())
         sim = self.sim(-(-N // self.MIN_BATCH) * self.MIN_BATCH)
-        goal_pts = np.zeros((int(n_legs.max()), N, 2))
-        goal_id = np.zeros((len(tasks), int(n_legs.max())), dtype=np.int64)  # (task, leg) -> index into goals
+        goal_pts = np.zeros((L, N, 2))
+        goal_id = np.zeros((len(tasks), L), dtype=np.int64)  # (task, leg) -> index into goals
         avoid_id = np.zeros_like(goal_id)
         goals, avoids = [], []
         for j, (start, legs, n, seed) in enumerate(tasks):

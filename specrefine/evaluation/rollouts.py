@@ -64,7 +64,8 @@ class RolloutLoop:
         N = plan.episodes
         self.task_of = plan.task_of
         self.L_of = plan.n_legs[self.task_of]
-        self.T = int(plan.n_legs.max()) * controls.horizon + 1
+        self.L = int(plan.n_legs.max())  # legs of the longest task
+        self.T = self.L * controls.horizon + 1
         self.traj = np.empty((N, self.T, 2), dtype=np.float32)
         self.leg = np.zeros(N, dtype=np.int64)
         self.t_leg = np.zeros(N, dtype=np.int64)
@@ -75,7 +76,7 @@ class RolloutLoop:
         self.end_xy = np.zeros((N, 2))
         self.episode = np.concatenate([np.arange(N), np.full(sim.n - N, -1)])  # episode of each sim row (-1: padding)
         self.row = np.arange(N)  # sim row of each episode (-1: not in the sim any more)
-        self.xy, self.flipped = sim.xy[:N].copy(), sim.flipped[:N].copy()
+        self.xy, self.flipped = sim.xy[:N], sim.flipped[:N]  # BatchedSim hands out copies
         self.traj[:, 0] = self.xy
         self.steps = np.zeros(len(plan.n_legs), dtype=np.int64)  # rows held by each task's episodes, per step
         self.padding_steps = 0
@@ -121,7 +122,7 @@ class RolloutLoop:
         """Classify the running episodes at time t (after the step that led there)."""
         p, r = self.plan, self.c.clearance
         idx = np.flatnonzero(self.active)
-        for _ in range(int(p.n_legs.max()) + 1):
+        for _ in range(self.L + 1):  # a point may lie in several consecutive goals: advance through all of them
             if not len(idx):
                 break
             task, k = self.task_of[idx], self.leg[idx]
