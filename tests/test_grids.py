@@ -163,3 +163,25 @@ def test_status_counts_each_parts_done_rows_and_names_the_rest(tmp_path, capsys)
     grids.main(["status", "ant-scaling"])
     out = capsys.readouterr().out.splitlines()
     assert len(out) == len(g.parts) and out[0].startswith("part 0: ours x geometric:max_waypoints=48: ")
+
+
+def test_seed_cache_copies_entries_whole_and_keeps_existing_ones(tmp_path):
+    src = tmp_path / "from" / "u_chain_3__ant__ours__geometric__s0__adaptive" / "cache" / "ab"
+    src.mkdir(parents=True)
+    (src / "ab01.npz").write_bytes(b"source one")
+    (src / "ab02.npz").write_bytes(b"source two")
+    other = tmp_path / "from" / "u_chain_4__ant__ours__geometric__s0__adaptive" / "cache" / "cd"
+    other.mkdir(parents=True)
+    (other / "cd01.npz").write_bytes(b"other maze")
+    dest = tmp_path / "to"
+    kept = dest / "u_chain_3__ant__ours-repair__geometric__s0__adaptive" / "cache" / "ab"
+    kept.mkdir(parents=True)
+    (kept / "ab02.npz").write_bytes(b"already here")
+    env = {**os.environ, "FROM": "ours", "TO": "ours-repair", "DEST": str(dest), "MAZES": "u_chain_3"}
+    done = subprocess.run(["bash", str(ROOT / "scripts" / "seed_cache.sh"), str(tmp_path / "from")],
+                          capture_output=True, text=True, env=env, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "seeded 1 cell caches" in done.stdout
+    assert (kept / "ab01.npz").read_bytes() == b"source one"
+    assert (kept / "ab02.npz").read_bytes() == b"already here"
+    assert sorted(p.name for p in dest.rglob("*") if p.is_file()) == ["ab01.npz", "ab02.npz"]  # no .part left
