@@ -97,24 +97,20 @@ def _raw_rollout(model, n: int, frame_skip: int, nthread: int, steps: int, rng) 
 
 def _recorded_steps(ev, maze, seed: int) -> list[tuple[int, np.ndarray, np.ndarray, int]]:
     """One evaluation's physics calls as (rows, states before, controls, physics steps) per control step, for
-    :func:`_replay` (each of the evaluator's built sims has its rollout pool wrapped while it runs)."""
+    :func:`_replay` (each of the evaluator's built sims reports its physics calls while it runs)."""
     calls = []
-    sims = list(ev._sims.values())
-    originals = [sim._pool.rollout for sim in sims]
 
-    def recorder(original):
-        def rollout(models, datas, initial, ctrl, **kw):
-            calls.append((len(models), np.array(initial), np.array(ctrl), kw["nstep"]))
-            return original(models, datas, initial, ctrl, **kw)
-        return rollout
+    def record(states, ctrl, nstep):
+        calls.append((len(states), states.copy(), ctrl.copy(), nstep))
 
-    for sim, original in zip(sims, originals, strict=True):
-        sim._pool.rollout = recorder(original)
+    sims = ev.built_sims
+    for sim in sims:
+        sim.physics_observer = record
     try:
         ev.evaluate(maze.start, maze.goal, maze.walls, seed=seed)
     finally:
-        for sim, original in zip(sims, originals, strict=True):
-            sim._pool.rollout = original
+        for sim in sims:
+            sim.physics_observer = None
     return calls
 
 

@@ -197,6 +197,11 @@ class Evaluator:
             self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread, model=self._model)
         return self._sims[batch]
 
+    @property
+    def built_sims(self) -> tuple:
+        """The BatchedSims built so far (one per batch size the evaluations have used)."""
+        return tuple(self._sims.values())
+
     def compiled(self, region: Region) -> CompiledRegion:
         c = self._compiled.get(region)
         if c is None:

@@ -159,6 +159,10 @@ class BatchedSim:
         self._models = [m] * self.n  # skip_checks=True wants the per-rollout list already expanded
         self._out = np.zeros((self.n, self.frame_skip, self.state_dim))
         self._state = np.zeros((self.n, self.state_dim))
+        #: called as ``physics_observer(states, ctrl, nstep)`` before each physics call of :meth:`step` (the rows'
+        #: full-physics states and the controls they are stepped with; copy what you keep): lets a benchmark
+        #: record and replay the exact physics work of an evaluation.  None: no call.
+        self.physics_observer = None
         self.reset()
 
     # --- state -------------------------------------------------------------------------------
@@ -241,6 +245,8 @@ class BatchedSim:
         if self._spec.action_in_disc:  # force bounded in norm, not per axis: then straight is the fastest way to a goal
             ctrl /= np.maximum(np.linalg.norm(ctrl, axis=-1, keepdims=True), 1.0)
         ctrl = np.ascontiguousarray(np.broadcast_to(ctrl, (self.n, self.frame_skip, self.act_dim)))
+        if self.physics_observer is not None:
+            self.physics_observer(self._state, ctrl, self.frame_skip)
         self._pool.rollout(self._models, self._datas, self._state, ctrl, nstep=self.frame_skip,
                            state=self._out, skip_checks=True)
         self._state[:] = self._out[:, -1]
