@@ -31,8 +31,8 @@ def test_the_table_pools_seeds_in_both_simulators_and_names_no_proposer_for_dirl
                                                                         ("ours", "geometric", 1), ("dirl", "none", 0)]
     table = antmaze.table(rows).splitlines()
     assert table[2] == ("| gr:U_MAZE | ours | geometric | 0,1 | 0.850 [0.812, 0.882] (400) | "
-                        "0.750 [0.686, 0.805] (200) |")  # 340 of 400 and 150 of 200, Wilson intervals
-    assert table[3].endswith("| — |") and "| dirl | none | 0 (official: none yet) |" in table[3]
+                        "0.750 [0.686, 0.805] (200) | -0.100 [-0.172, -0.033] |")  # 340/400, 150/200; Newcombe
+    assert table[3].endswith("| — | — |") and "| dirl | none | 0 (official: none yet) |" in table[3]
     assert antmaze.main([str(tmp_path), "--out", str(tmp_path / "out")]) == 0
     with (tmp_path / "out" / "official.csv").open() as fh:
         assert [r["official_successes"] for r in csv.DictReader(fh)] == ["80", "70", ""]
@@ -64,3 +64,11 @@ def test_runs_aiming_at_centres_are_their_own_rows_from_their_own_folder(tmp_pat
     assert [k[1] for k in antmaze.groups(rows)] == ["ours", "ours (centre)"]
     assert antmaze.main([str(tmp_path / "paper"), str(tmp_path / "centre"), "--out", str(tmp_path / "out")]) == 0
     assert "| ours (centre) | geometric | 0 | 0.900" in (tmp_path / "out" / "table.md").read_text()
+
+
+def test_the_difference_pools_only_the_runs_measured_in_both_simulators(tmp_path):
+    _run(tmp_path, "a", "ours", "geometric", 0, 0.9, 0.9)
+    _run(tmp_path, "b", "ours", "geometric", 1, 0.1)  # no official run yet: left out of the difference
+    line = antmaze.table(antmaze.run_rows(tmp_path)).splitlines()[2]
+    assert "| 0,1 (official: 0) | 0.500 [0.451, 0.549] (400) |" in line  # this simulator: both runs
+    assert line.endswith("| +0.000 [-0.082, +0.067] |")  # 90/100 official vs 180/200 here

@@ -6,8 +6,9 @@ simulator and in the official ``AntMaze_*-v5``, pooled over seeds, with Wilson 9
 
 Reads every finished run folder of the grid's sweep (``RUN/result.json``); with ``--official N`` it first runs
 ``specrefine official RUN --episodes N`` where a run has no ``official.json`` yet (minutes per run). Writes
-``official.csv`` (one row per run: both simulators' success), ``table.md`` (pooled per map, method and proposer)
-and ``figure.png``. Every proposer here is offline, NOT a VLM.
+``official.csv`` (one row per run: both simulators' success), ``table.md`` (pooled per map, method and proposer,
+with the difference official - this simulator over the runs measured in both) and ``figure.png``. Every proposer
+here is offline, NOT a VLM.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
-from ..core.results import rate_text, wilson_ci
+from ..core.results import newcombe_ci, rate_text, wilson_ci
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
 from ..core.tables import goal_points_of
 from ..pictures.render import subplots
@@ -80,7 +81,7 @@ def groups(rows) -> dict[tuple, list[dict]]:
 
 def table(rows) -> str:
     lines = ["| map | method | proposer | seeds | this simulator [95 % CI] (episodes) | official [95 % CI] "
-             "(episodes) |", "|---|---|---|---|---|---|"]
+             "(episodes) | official - this simulator [95 % CI] |", "|---|---|---|---|---|---|---|"]
     for (maze, method, proposer), runs in groups(rows).items():
         runs = sorted(runs, key=lambda r: int(r["seed"]))
         seeds = ",".join(str(r["seed"]) for r in runs)
@@ -88,8 +89,18 @@ def table(rows) -> str:
         if len(official) < len(runs):
             seeds += f" (official: {','.join(official) or 'none yet'})"
         lines.append(f"| {maze} | {method} | {proposer} | {seeds} | {rate_text(*_pooled(runs, 'sim'))} | "
-                     f"{rate_text(*_pooled(runs, 'official'))} |")
+                     f"{rate_text(*_pooled(runs, 'official'))} | {_difference(runs)} |")
     return "\n".join(lines)
+
+
+def _difference(runs) -> str:
+    """Official minus this simulator over the runs measured in both, with Newcombe's 95 % interval."""
+    both = [r for r in runs if r["official_episodes"] != ""]
+    if not both:
+        return "—"
+    (ks, ns), (ko, no) = _pooled(both, "sim"), _pooled(both, "official")
+    lo, hi = newcombe_ci(ko, no, ks, ns)
+    return f"{ko / no - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}]"
 
 
 def figure(rows):
