@@ -16,7 +16,7 @@ import os
 import tempfile
 from pathlib import Path
 
-MAZES = ["u_maze", "gr:MEDIUM_MAZE"]
+MAZES = ["u_maze", "gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"]
 SIM_SEED = 777  # fresh episodes: neither the search's seed nor the run's measurement seed
 
 
@@ -32,6 +32,21 @@ def sim_side(run: Path, episodes: int) -> dict:
     k = int(m.success.sum())
     return {"success_rate": k / episodes, "success_ci": list(wilson_ci(k, episodes)), "episodes": episodes,
             "outcomes": m.path_result.counts()}
+
+
+def gap_table(record: dict) -> str:
+    """The record as docs/official_env.md shows it: both simulators per maze, and official - this simulator."""
+    from specrefine.core.results import newcombe_ci, rate_text
+
+    lines = ["| maze | official environment | legs | this simulator [95 % CI] (episodes) | official [95 % CI] "
+             "(episodes) | official - this simulator [95 % CI] |", "|---|---|---|---|---|---|"]
+    for row in record["rows"]:
+        here, there = row["this_simulator"], row["official"]
+        (ks, ns), (ko, no) = [(round(s["success_rate"] * s["episodes"]), s["episodes"]) for s in (here, there)]
+        lo, hi = newcombe_ci(ko, no, ks, ns)
+        lines.append(f"| `{row['maze']}` | `{row['env_id']}` | {len(row['path']) - 1} | {rate_text(ks, ns)} | "
+                     f"{rate_text(ko, no)} | {ko / no - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}] |")
+    return "\n".join(lines)
 
 
 def main() -> None:
@@ -60,7 +75,7 @@ def main() -> None:
     tmp_out = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     tmp_out.write_text(json.dumps(record, indent=1) + "\n")
     os.replace(tmp_out, out)
-    print(json.dumps(rows, indent=1))
+    print(gap_table(record))
 
 
 if __name__ == "__main__":

@@ -514,3 +514,20 @@ def test_the_goal_point_reruns_in_the_docs_are_the_shipped_reruns():
         for gp in ("sampled", "centre"):
             walls = json.loads((folder / f"{maze}_s0_{gp}.json").read_text())["walls"]
             assert f"{walls['success']} of 200 = {walls['rate']:.3f}" in text, (maze, gp)
+
+
+def test_the_point_mass_gap_table_is_its_record():
+    import json
+
+    spec = importlib.util.spec_from_file_location("official_gap", ROOT / "scripts" / "official_gap.py")
+    official_gap = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(official_gap)
+    record = json.loads((ROOT / "data/official/point_gap.json").read_text())
+    assert [r["maze"] for r in record["rows"]] == official_gap.MAZES
+    doc = (ROOT / "docs" / "official_env.md").read_text()
+    assert "<!-- point gap table -->\n" + official_gap.gap_table(record) + "\n" in doc
+    flat = " ".join(doc.split())
+    for row in record["rows"]:  # the counts the text quotes
+        here, there = (row[side]["outcomes"].get("avoid", 0) for side in ("this_simulator", "official"))
+        if row["maze"] in ("u_maze", "gr:MEDIUM_MAZE"):
+            assert f"{there} against {here} on `{row['maze']}`" in flat
