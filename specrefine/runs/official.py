@@ -27,14 +27,15 @@ from __future__ import annotations
 import contextlib
 import io
 import json
-import os
 import time
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
+from ..core.runfolder import write_atomic
 from ..core.standard_maps import to_gymnasium
 from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
 
@@ -100,7 +101,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
     rng = np.random.default_rng(seed)
     success, outcomes = [], {}
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
-        for episode in range(episodes):
+        for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
             options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
             obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
             traj, outcome = _episode(env, policy, obs, rng)
@@ -117,10 +118,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs), "max_episode_steps": max_steps,
                          "continuing_task": True, "reset_target": False, "clearance": policy.clearance},
             "wall_seconds": time.time() - t0}
-    target = run_dir / OFFICIAL_JSON
-    tmp = target.with_name(f".{OFFICIAL_JSON}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")
-    os.replace(tmp, target)
+    write_atomic(run_dir / OFFICIAL_JSON, json.dumps(data, indent=2))
     return data
 
 
