@@ -2,7 +2,8 @@
 
     specrefine refine MAZE_FILE --agent {point,ant} --method {ours,vlm-oneshot,symbolic,dirl,...}
         --proposer {geometric,random,imperfect:PRESET,replay:PATH,litellm:MODEL} --seed N --out DIR [--spec EXPR]
-    specrefine official RUN_DIR [--episodes N] [--seed S]
+    specrefine official RUN_DIR [--episodes N] [--seed S] [--start {official,package}]
+        [--reset-noise {official,package}] [--out FILE]
 
 The options of ``refine`` are the fields of :class:`specrefine.runs.config.RunConfig` (defaults, help, bounds).
 
@@ -19,6 +20,7 @@ from .core.agents import AGENTS as _AGENT_REGISTRY
 from .core.argtypes import OneLineParser, bounded_int, out_path, silence_stdout
 from .core.errors import SpecrefineError
 from .runs.config import DEFAULTS, RunConfig, add_run_options, proposer_arg
+from .runs.official import RESET_RULES
 
 AGENTS = tuple(_AGENT_REGISTRY)
 
@@ -50,6 +52,14 @@ def build_parser() -> argparse.ArgumentParser:
     o.add_argument("--episodes", type=bounded_int("episodes"), default=DEFAULTS.episodes,
                    help=f"episodes (default: {DEFAULTS.episodes})")
     o.add_argument("--seed", type=bounded_int("seed"), default=0, help="random seed of the episodes (default: 0)")
+    o.add_argument("--start", choices=RESET_RULES, default="official",
+                   help="where an episode starts: the environment's reset (official, the default) or this "
+                        "package's spawn rule (uniform in S, clear of walls), to isolate a gap")
+    o.add_argument("--reset-noise", choices=RESET_RULES, default="official",
+                   help="the environment's reset noise (official, the default; none for AntMaze) or this "
+                        "package's (the Ant's qpos +-0.1, qvel 0.1 N(0,1))")
+    o.add_argument("--out", type=out_path, default=None, help="where to write the result (default: "
+                                                              "RUN_DIR/official.json)")
     return parser
 
 
@@ -75,12 +85,13 @@ def official(args) -> int:
     def work():
         from .runs.official import run_official
 
-        return run_official(args.run_dir, episodes=args.episodes, seed=args.seed)
+        return run_official(args.run_dir, episodes=args.episodes, seed=args.seed, start=args.start,
+                            reset_noise=args.reset_noise, out=args.out)
 
     def show(data):
         from .runs.official import summary
 
-        return summary(data) + f"\n  -> {args.run_dir / 'official.json'}"
+        return summary(data) + f"\n  -> {args.out or args.run_dir / 'official.json'}"
 
     return _command(work, show, "nothing written")
 

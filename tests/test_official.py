@@ -67,3 +67,61 @@ def test_the_official_env_starts_in_the_start_cell_and_observes_what_the_policy_
     assert tuple(ant.xy_to_cell(obs["achieved_goal"])) == (1, 1)
     assert obs["observation"].shape == (27,)  # qpos without x, y (13) + qvel (14): contact forces off
     env.close()
+
+
+def test_the_package_start_is_the_evaluators_spawn_point_and_writes_where_asked(point_run, tmp_path):
+    from specrefine.core.graph import TaskGraph
+    from specrefine.evaluation.compositional import CompositionalPolicy
+    from specrefine.runs.official import _reset_as_package
+
+    before = (point_run / "official.json").read_text() if (point_run / "official.json").exists() else None
+    out = tmp_path / "package_start.json"
+    assert main(["official", str(point_run), "--episodes", "4", "--start", "package", "--out", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["settings"]["start"] == "package" and data["settings"]["reset_noise"] == "official"
+    assert sum(data["outcomes"].values()) == 4
+    after = (point_run / "official.json").read_text() if (point_run / "official.json").exists() else None
+    assert after == before  # --out: the run's own official.json is left alone
+
+    policy = CompositionalPolicy.load(point_run)
+    result = json.loads((point_run / "result.json").read_text())
+    original = TaskGraph.from_dict(result["input_graph"])
+    region = original.region(original.initial)
+    env = make_env(policy.maze, "point", 10)
+    env.reset(seed=0, options={"reset_cell": np.array(policy.maze.cells("S")[0]),
+                               "goal_cell": np.array(policy.maze.cells("G")[0])})
+    obs = _reset_as_package(env, policy, region, True, np.random.default_rng(5))
+    expected = policy.spawn_point(region, np.random.default_rng(5))
+    np.testing.assert_allclose(obs["achieved_goal"], expected)  # the point mass has no reset noise to add
+    np.testing.assert_allclose(obs["observation"][:2], expected)
+    env.close()
+
+
+def test_the_package_reset_noise_perturbs_the_ants_pose_and_not_its_position():
+    from specrefine.runs.official import _reset_as_package
+
+    class AntStandIn:  # _reset_as_package reads the agent's name only when no start region is asked for
+        agent = "ant"
+
+    env = make_env(load_maze("gr:U_MAZE").for_agent("ant"), "ant", 10)
+    obs, _ = env.reset(seed=0, options={"reset_cell": np.array([1, 1]), "goal_cell": np.array([3, 1])})
+    data = env.unwrapped.ant_env.data
+    qpos, qvel = data.qpos.copy(), data.qvel.copy()
+    noisy = _reset_as_package(env, AntStandIn(), None, True, np.random.default_rng(0))
+    np.testing.assert_allclose(noisy["achieved_goal"], obs["achieved_goal"])
+    shift = data.qpos[2:] - qpos[2:]
+    assert np.all(np.abs(shift) <= 0.1) and np.count_nonzero(shift) == len(shift)
+    assert np.count_nonzero(data.qvel - qvel) == len(qvel)
+    np.testing.assert_allclose(noisy["observation"], np.concatenate([data.qpos[2:], data.qvel]))
+    env.close()
+
+
+def test_an_unknown_reset_rule_is_one_line_and_exit_2(point_run, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["official", str(point_run), "--start", "mine"])
+    assert exit_.value.code == 2 and len(capsys.readouterr().err.strip().splitlines()) == 1
+    from specrefine.core.errors import SpecrefineError
+    from specrefine.runs.official import run_official
+
+    with pytest.raises(SpecrefineError, match="reset_noise 'x'"):
+        run_official(point_run, 1, reset_noise="x")

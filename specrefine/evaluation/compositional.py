@@ -81,6 +81,11 @@ class CompositionalPolicy:
         self.env_dt = None if env_dt is None else float(env_dt)
         self.hold = 1 if env_dt is None else max(1, round(self.control_period / self.env_dt))
 
+    def spawn_point(self, region: Region, rng: np.random.Generator) -> np.ndarray:
+        """Where this package's evaluator starts an episode in ``region``: uniform in it, clear of walls by the
+        evaluator's spawn radius (the Ant: its legs' reach) where the region allows it."""
+        return self._sampler.spawn_points(region, 1, rng)[0]
+
     # --- the loop ------------------------------------------------------------------------------
     def reset(self, observation=None, *, seed=None) -> None:
         """Start an episode: draw the goal points (``seed``: an int or a numpy Generator) and take leg 0."""

@@ -17,7 +17,14 @@ evaluator, when the agent touches the current leg's avoid set (closer than the r
 environment step is then judged by this package's monitor on the ORIGINAL task (``result.json``'s
 ``input_graph``: walls and hazards avoided, the original goal reached); a flipped Ant fails.
 
-``RUN_DIR/official.json`` (written atomically): ``env_id``, ``episodes``, ``success_rate``,
+Two of this package's reset rules can replace the environment's, one at a time or both, to find where a gap
+between the simulators comes from (docs/official_env.md): ``start="package"`` moves the agent, after the
+environment's reset, to a point drawn as this package's evaluator spawns (uniform in the original task's start
+region, clear of walls by the spawn radius), and ``reset_noise="package"`` adds this package's reset noise
+(``Agent.reset_noise``: the Ant's qpos[2:] +-0.1 uniform, qvel 0.1 N(0, 1); none for the point mass).  Their
+draws come from a stream of their own, so the episodes' start cells and goal points stay those of the plain run.
+
+``RUN_DIR/official.json`` (written atomically; ``out`` elsewhere): ``env_id``, ``episodes``, ``success_rate``,
 ``success_ci`` (95 % Wilson), ``sim_success_rate`` / ``sim_success_ci`` / ``sim_episodes`` (the run's
 own measurement in this package's simulator), ``outcomes``, ``seed`` and the settings used.
 """
@@ -33,6 +40,7 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
+from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
 from ..core.runfolder import write_atomic
@@ -40,6 +48,7 @@ from ..core.standard_maps import to_gymnasium
 from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
 
 OFFICIAL_JSON = "official.json"
+RESET_RULES = ("official", "package")  # whose start / reset noise an episode begins with (module docstring)
 #: agent -> (registered environment family, version, extra keyword arguments)
 ENVIRONMENTS = {"point": ("PointMaze", "v3", {}), "ant": ("AntMaze", "v5", {"include_cfrc_ext_in_observation": False})}
 
@@ -75,13 +84,19 @@ def make_env(maze, agent: str, max_episode_steps: int):
                     reset_target=False, max_episode_steps=max_episode_steps, **extra)
 
 
-def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
-    """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``."""
+def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "official",
+                 reset_noise: str = "official", out=None) -> dict:
+    """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``
+    (or ``out``).  ``start`` / ``reset_noise``: "official" (the environment's own) or "package" (this package's
+    rule, module docstring)."""
     from ..core.graph import TaskGraph
     from ..evaluation.evaluator import _torch_threads
     from ..evaluation.monitor import satisfies
 
     t0 = time.time()
+    for name, rule in (("start", start), ("reset_noise", reset_noise)):
+        if rule not in RESET_RULES:
+            raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
     run_dir = Path(run_dir)
     result = _read_result(run_dir)
     policy = CompositionalPolicy.load(run_dir)
@@ -99,11 +114,16 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
     env = make_env(maze, agent, max_steps)
     starts, goal = maze.cells("S"), maze.cells("G")[0]
     rng = np.random.default_rng(seed)
+    reset_rng = np.random.default_rng([seed, 1])  # the package's reset rules draw apart from the episodes
+    start_region = original.region(original.initial)
     success, outcomes = [], {}
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
         for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
             options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
             obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
+            if start == "package" or reset_noise == "package":
+                obs = _reset_as_package(env, policy, start_region if start == "package" else None,
+                                        reset_noise == "package", reset_rng)
             traj, outcome = _episode(env, policy, obs, rng)
             ok = outcome != "flipped" and bool(satisfies(original, traj[None], clearance=policy.clearance)[0])
             success.append(ok)
@@ -116,10 +136,27 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0) -> dict:
             "outcomes": outcomes, "seed": seed, "agent": agent, "maze": maze.name,
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs), "max_episode_steps": max_steps,
-                         "continuing_task": True, "reset_target": False, "clearance": policy.clearance},
+                         "continuing_task": True, "reset_target": False, "clearance": policy.clearance,
+                         "start": start, "reset_noise": reset_noise},
             "wall_seconds": time.time() - t0}
-    write_atomic(run_dir / OFFICIAL_JSON, json.dumps(data, indent=2))
+    write_atomic(run_dir / OFFICIAL_JSON if out is None else out, json.dumps(data, indent=2))
     return data
+
+
+def _reset_as_package(env, policy: CompositionalPolicy, start_region, noise: bool, rng) -> dict:
+    """After the environment's reset: the agent moved to a package spawn point in ``start_region`` (if given)
+    and/or given the package's reset noise; the observation of that state."""
+    inner = _inner(env)
+    qpos, qvel = inner.data.qpos.copy(), inner.data.qvel.copy()
+    if start_region is not None:
+        qpos[:2] = policy.spawn_point(start_region, rng)
+    scale = get_agent(policy.agent).reset_noise
+    if noise and scale:
+        qpos[2:] += rng.uniform(-scale, scale, size=len(qpos) - 2)
+        qvel += scale * rng.standard_normal(len(qvel))
+    inner.set_state(qpos, qvel)
+    inner_obs = inner._get_obs()  # PointEnv returns (obs, info), the Ant's env the array
+    return env.unwrapped._get_obs(inner_obs[0] if isinstance(inner_obs, tuple) else inner_obs)
 
 
 def _episode(env, policy: CompositionalPolicy, obs, rng) -> tuple[np.ndarray, str]:

@@ -1,0 +1,65 @@
+"""Where the Ant's gap between this package's simulator and the official AntMaze comes from: each run's policy in
+the official environment with this package's reset rules put in, one at a time and together.
+
+    PYTHONPATH=$PWD python scripts/official_gap_ant.py [--episodes 200] [--out data/official/ant_gap.json]
+
+Runs (fixed before any ran, docs/official_env.md "The Ant's gap"): the AntMaze grid's six gr:LARGE_MAZE `ours`
+runs (geometric and imperfect:moderate, seeds 0-2), first with both package rules (``--start package
+--reset-noise package``) on all six, then each rule alone on the three imperfect:moderate runs. Seed 0 as the
+runs' plain official episodes, so start cells and goal points are paired with them. Resumable: the record is
+rewritten whole after every variant and a variant already in it is skipped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+RUNS = "runs/antmaze/cells/gr-LARGE_MAZE__ant__ours__{proposer}__s{seed}__adaptive"
+PROPOSERS = ("geometric", "imperfect-moderate")
+#: (start, reset_noise) in the order they run: both rules on every run, then each alone on the erring runs
+VARIANTS = [(("package", "package"), PROPOSERS), (("package", "official"), ("imperfect-moderate",)),
+            (("official", "package"), ("imperfect-moderate",))]
+KEEP = ("success_rate", "success_ci", "episodes", "outcomes")
+
+
+def variant_name(start: str, noise: str) -> str:
+    return f"start={start},reset_noise={noise}"
+
+
+def main() -> None:
+    from specrefine.core.runfolder import write_atomic
+    from specrefine.runs.official import run_official
+
+    p = argparse.ArgumentParser()
+    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--out", type=Path, default=Path("data/official/ant_gap.json"))
+    args = p.parse_args()
+    record = json.loads(args.out.read_text()) if args.out.exists() else {
+        "command": f"PYTHONPATH=$PWD python scripts/official_gap_ant.py --episodes {args.episodes}",
+        "episodes": args.episodes, "seed": 0, "runs": {}}
+    for (start, noise), proposers in VARIANTS:
+        for proposer in proposers:
+            for seed in (0, 1, 2):
+                run = Path(RUNS.format(proposer=proposer, seed=seed))
+                entry = record["runs"].setdefault(run.name, {})
+                if not entry:
+                    result = json.loads((run / "result.json").read_text())
+                    plain = json.loads((run / "official.json").read_text())
+                    entry["this_simulator"] = {k: result[k] for k in ("success_rate", "success_ci", "episodes")}
+                    entry["this_simulator"]["outcomes"] = result["episode_outcomes"]
+                    entry[variant_name("official", "official")] = {k: plain[k] for k in KEEP}
+                name = variant_name(start, noise)
+                if name in entry:
+                    continue
+                tmp = args.out.with_name(f".{run.name}.official.json")
+                data = run_official(run, args.episodes, 0, start=start, reset_noise=noise, out=tmp)
+                tmp.unlink()
+                entry[name] = {k: data[k] for k in KEEP}
+                write_atomic(args.out, json.dumps(record, indent=1) + "\n")
+                print(run.name, name, data["success_rate"], data["outcomes"], flush=True)
+
+
+if __name__ == "__main__":
+    main()
