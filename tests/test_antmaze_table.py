@@ -72,3 +72,11 @@ def test_the_difference_pools_only_the_runs_measured_in_both_simulators(tmp_path
     line = antmaze.table(antmaze.run_rows(tmp_path)).splitlines()[2]
     assert "| 0,1 (official: 0) | 0.500 [0.451, 0.549] (400) |" in line  # this simulator: both runs
     assert line.endswith("| +0.000 [-0.082, +0.067] |")  # 90/100 official vs 180/200 here
+
+
+def test_the_headline_quotes_one_method_per_map_in_both_simulators(tmp_path):
+    _run(tmp_path, "a", "ours", "geometric", 0, 0.9, 0.8)
+    _run(tmp_path, "b", "ours", "geometric", 0, 0.5, maze="gr:LARGE_MAZE")  # no official run yet
+    _run(tmp_path, "c", "dirl", "none", 0, 0.0, 0.0)
+    rows = antmaze.run_rows(tmp_path)
+    assert antmaze.headline(rows, "ours", "geometric") == "U_MAZE 0.900 / 0.800, LARGE_MAZE 0.500 / —"

@@ -93,6 +93,17 @@ def table(rows) -> str:
     return "\n".join(lines)
 
 
+def headline(rows, method: str, proposer: str) -> str:
+    """'MAP here / official' pooled success per map of one method and proposer, as the README quotes it."""
+    parts = []
+    for (maze, m, p), runs in groups(rows).items():
+        if (m, p) == (method, proposer):
+            (ks, ns), (ko, no) = _pooled(runs, "sim"), _pooled(runs, "official")
+            official = f"{ko / no:.3f}" if no else "—"
+            parts.append(f"{maze.removeprefix('gr:')} {ks / ns:.3f} / {official}")
+    return ", ".join(parts)
+
+
 def _difference(runs) -> str:
     """Official minus this simulator over the runs measured in both, with Newcombe's 95 % interval."""
     both = [r for r in runs if r["official_episodes"] != ""]
