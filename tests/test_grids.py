@@ -17,7 +17,9 @@ from specrefine.runs import sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the grids whose every cell has a row (decided from the tables: these ran to the end)
-COMPLETE = {"paper-sweep", "point-comparison", "controls", "repair", "ant-comparison"}
+COMPLETE = {"paper-sweep", "point-comparison", "controls", "repair", "repair-tuned", "ant-comparison", "ant-polish",
+            "ant-centre", "ant-scaling-centre", "ant-shortcut-centre", "ant-rotated-centre", "ant-polish-erring",
+            "ant-shortcut-centre-ties", "antmaze", "antmaze-centre"}
 SHIPPED = [(g, t) for g in grids.GRIDS.values() for t in g.tables if (ROOT / t).exists()]
 
 
