@@ -28,6 +28,40 @@ def variant_name(start: str, noise: str) -> str:
     return f"start={start},reset_noise={noise}"
 
 
+LABELS = {"this_simulator": "this simulator", variant_name("official", "official"): "official",
+          variant_name("package", "package"): "official, package start and reset noise",
+          variant_name("package", "official"): "official, package start",
+          variant_name("official", "package"): "official, package reset noise"}
+
+
+def gap_table(record: dict) -> str:
+    """Per proposer and variant, pooled over the runs that have it: success, and its difference from this
+    simulator on the same runs (Newcombe 95 %)."""
+    from specrefine.core.results import newcombe_ci, rate_text
+
+    def counts(entry, key):
+        side = entry[key]
+        return round(side["success_rate"] * side["episodes"]), side["episodes"]
+
+    lines = ["| proposer | simulator and reset | seeds | success [95 % CI] (episodes) | minus this simulator "
+             "[95 % CI] |", "|---|---|---|---|---|"]
+    for proposer in PROPOSERS:
+        entries = {name.split("__s")[1][0]: e for name, e in sorted(record["runs"].items())
+                   if f"__{proposer}__" in name}
+        for key, label in LABELS.items():
+            have = {seed: e for seed, e in entries.items() if key in e}
+            if not have:
+                continue
+            k, n = map(sum, zip(*(counts(e, key) for e in have.values())))
+            ks, ns = map(sum, zip(*(counts(e, "this_simulator") for e in have.values())))
+            diff = "—"
+            if key != "this_simulator":
+                lo, hi = newcombe_ci(k, n, ks, ns)
+                diff = f"{k / n - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+            lines.append(f"| {proposer.replace('-', ':')} | {label} | {','.join(have)} | {rate_text(k, n)} | {diff} |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     from specrefine.core.runfolder import write_atomic
     from specrefine.runs.official import run_official

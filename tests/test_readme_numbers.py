@@ -531,3 +531,32 @@ def test_the_point_mass_gap_table_is_its_record():
         here, there = (row[side]["outcomes"].get("avoid", 0) for side in ("this_simulator", "official"))
         if row["maze"] in ("u_maze", "gr:MEDIUM_MAZE"):
             assert f"{there} against {here} on `{row['maze']}`" in flat
+
+
+def test_the_antmaze_results_quoted_are_its_official_csv():
+    import csv
+
+    from specrefine.core.results import newcombe_ci
+    from specrefine.experiments.antmaze import groups, headline
+
+    with (ROOT / "data/results/ant/antmaze/official.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    for marker, method, proposer in (("front antmaze centre", "ours (centre)", "geometric"),
+                                     ("front antmaze ours", "ours", "imperfect:moderate"),
+                                     ("front antmaze oneshot", "vlm-oneshot", "imperfect:moderate")):
+        assert _between(FRONT, marker) == headline(rows, method, proposer), marker
+
+    def rate(runs, side):
+        return sum(int(r[f"{side}_successes"]) for r in runs) / sum(int(r[f"{side}_episodes"]) for r in runs)
+
+    by = groups(rows)
+    agree = sum(lo <= 0 <= hi for lo, hi in (
+        newcombe_ci(*(sum(int(r[f"{side}_{x}"]) for r in runs) for side in ("official", "sim")
+                      for x in ("successes", "episodes"))) for runs in by.values()))
+    assert f"agree within their intervals on {agree} of the {len(by)} rows" in " ".join(FRONT.split())
+    doc = " ".join((ROOT / "docs" / "official_env.md").read_text().split())
+    assert f"**The two simulators agree on {agree} of the {len(by)} rows**" in doc
+    centre = {m: by[(m, "ours (centre)", "geometric")] for m in ("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE")}
+    assert (f"({rate(centre['gr:U_MAZE'], 'sim'):.3f} and {rate(centre['gr:MEDIUM_MAZE'], 'sim'):.3f} here, "
+            f"{rate(centre['gr:U_MAZE'], 'official'):.3f} and {rate(centre['gr:MEDIUM_MAZE'], 'official'):.3f} "
+            "official") in doc
