@@ -152,7 +152,7 @@ def _pool_started(pgid: int) -> bool:
 
 
 def _sweep_proc(out: Path):
-    seeds = [str(s) for s in range(40)]  # enough cells that the sweep is still running when the test interrupts it
+    seeds = [str(s) for s in range(400)]  # far more cells than a loaded machine finishes before the interrupt
     cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", *seeds,
            "--rollouts", "8", "--episodes", "16", "--workers", "2", "--out", str(out)]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
