@@ -560,3 +560,20 @@ def test_the_antmaze_results_quoted_are_its_official_csv():
     assert (f"({rate(centre['gr:U_MAZE'], 'sim'):.3f} and {rate(centre['gr:MEDIUM_MAZE'], 'sim'):.3f} here, "
             f"{rate(centre['gr:U_MAZE'], 'official'):.3f} and {rate(centre['gr:MEDIUM_MAZE'], 'official'):.3f} "
             "official") in doc
+
+
+def test_the_ant_gap_table_is_its_record():
+    import json
+
+    spec = importlib.util.spec_from_file_location("official_gap_ant", ROOT / "scripts" / "official_gap_ant.py")
+    official_gap_ant = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(official_gap_ant)
+    record = json.loads((ROOT / "data/official/ant_gap.json").read_text())
+    doc = (ROOT / "docs" / "official_env.md").read_text()
+    assert "<!-- ant gap table -->\n" + official_gap_ant.gap_table(record) + "\n" in doc
+    imperfect = [e for name, e in record["runs"].items() if "imperfect" in name]
+    keys = ("this_simulator", "start=official,reset_noise=official", "start=package,reset_noise=official")
+    totals = {key: [sum(e[key]["outcomes"].get(k, 0) for e in imperfect) for k in ("avoid", "flipped")] for key in keys}
+    (sim_a, sim_f), (off_a, off_f), (pkg_a, pkg_f) = totals.values()
+    assert (f"({pkg_a} wall contacts and {pkg_f} flips over the three runs, against {off_a} and {off_f} with "
+            f"AntMaze's start; this simulator {sim_a} and {sim_f})") in " ".join(doc.split())
