@@ -152,10 +152,13 @@ def _pool_started(pgid: int) -> bool:
 
 
 def _sweep_proc(out: Path):
-    seeds = [str(s) for s in range(400)]  # far more cells than a loaded machine finishes before the interrupt
+    seeds = [str(s) for s in range(40)]  # enough cells that the sweep is still running when the test interrupts it
     cmd = [sys.executable, "-m", "specrefine.runs.sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", *seeds,
            "--rollouts", "8", "--episodes", "16", "--workers", "2", "--out", str(out)]
-    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    # Ctrl-C must reach the sweep even when the suite itself was started in the background of a non-interactive
+    # shell, which starts it with SIGINT ignored (inherited through exec: the sweep would then never see it)
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _wait_for(condition, seconds=120):

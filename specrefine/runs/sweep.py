@@ -53,7 +53,7 @@ import time
 import traceback
 import warnings
 from collections.abc import Iterable
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -374,17 +374,11 @@ def _run_local(cells, out_root, workers, _address):
 
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),),
                                mp_context=_mp_context())
-    finished, queue, running = False, iter(cells), {}
+    finished = False
     try:
-        while True:
-            # a few cells in flight at a time: a long sweep is never busy submitting when Ctrl-C comes
-            for cell in itertools.islice(queue, 2 * workers - len(running)):
-                running[pool.submit(run_cell, cell, out_root)] = cell
-            if not running:
-                break
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
-            for fut in done:
-                yield _row_of(fut, running.pop(fut))
+        futures = {pool.submit(run_cell, cell, out_root): cell for cell in cells}
+        for fut in as_completed(futures):
+            yield _row_of(fut, futures[fut])
         finished = True
     finally:
         if not finished:  # interrupted: no waiting for running cells
