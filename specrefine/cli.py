@@ -93,7 +93,10 @@ def official(args) -> int:
 
         return summary(data) + f"\n  -> {args.out or args.run_dir / 'official.json'}"
 
-    return _command(work, show, "nothing written")
+    from .runs.official import partial_path
+
+    kept = partial_path(args.out or args.run_dir / "official.json")
+    return _command(work, show, f"the finished episodes are in {kept} (no official.json written)")
 
 
 def main(argv=None) -> int:

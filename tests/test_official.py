@@ -125,3 +125,27 @@ def test_an_unknown_reset_rule_is_one_line_and_exit_2(point_run, capsys):
 
     with pytest.raises(SpecrefineError, match="reset_noise 'x'"):
         run_official(point_run, 1, reset_noise="x")
+
+
+def test_an_interrupted_official_run_keeps_its_finished_episodes_beside_the_record(point_run, tmp_path, monkeypatch,
+                                                                                    capsys):
+    import specrefine.runs.official as official
+
+    out = tmp_path / "official.json"
+    real, calls = official._episode, []
+
+    def stop_at_the_third(*args):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(official, "_episode", stop_at_the_third)
+    assert main(["official", str(point_run), "--episodes", "5", "--out", str(out)]) == 130
+    partial = json.loads((tmp_path / "official.partial.json").read_text())
+    assert partial["interrupted"] is True and partial["episodes"] == 2 and partial["episodes_asked"] == 5
+    assert sum(partial["outcomes"].values()) == 2 and not out.exists()
+    assert "official.partial.json" in capsys.readouterr().err
+    monkeypatch.setattr(official, "_episode", real)
+    assert main(["official", str(point_run), "--episodes", "2", "--out", str(out)]) == 0
+    assert out.exists() and not (tmp_path / "official.partial.json").exists()  # a complete run supersedes it

@@ -24,6 +24,9 @@ region, clear of walls by the spawn radius), and ``reset_noise="package"`` adds 
 (``Agent.reset_noise``: the Ant's qpos[2:] +-0.1 uniform, qvel 0.1 N(0, 1); none for the point mass).  Their
 draws come from a stream of their own, so the episodes' start cells and goal points stay those of the plain run.
 
+An interrupted run (Ctrl-C) keeps its finished episodes in ``official.partial.json`` (``interrupted: true``,
+``episodes_asked``) and writes no ``official.json``; a later complete run removes that file.
+
 ``RUN_DIR/official.json`` (written atomically; ``out`` elsewhere): ``env_id``, ``episodes``, ``success_rate``,
 ``success_ci`` (95 % Wilson), ``sim_success_rate`` / ``sim_success_ci`` / ``sim_episodes`` (the run's
 own measurement in this package's simulator), ``outcomes``, ``seed`` and the settings used.
@@ -117,17 +120,21 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     reset_rng = np.random.default_rng([seed, 1])  # the package's reset rules draw apart from the episodes
     start_region = original.region(original.initial)
     success, outcomes = [], {}
+    interrupted = False
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
-        for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
-            options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
-            obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
-            if start == "package" or reset_noise == "package":
-                obs = _reset_as_package(env, policy, start_region if start == "package" else None,
-                                        reset_noise == "package", reset_rng)
-            traj, outcome = _episode(env, policy, obs, rng)
-            ok = outcome != "flipped" and bool(satisfies(original, traj[None], clearance=policy.clearance)[0])
-            success.append(ok)
-            outcomes[outcome] = outcomes.get(outcome, 0) + 1
+        try:
+            for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
+                options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
+                obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
+                if start == "package" or reset_noise == "package":
+                    obs = _reset_as_package(env, policy, start_region if start == "package" else None,
+                                            reset_noise == "package", reset_rng)
+                traj, outcome = _episode(env, policy, obs, rng)
+                ok = outcome != "flipped" and bool(satisfies(original, traj[None], clearance=policy.clearance)[0])
+                success.append(ok)
+                outcomes[outcome] = outcomes.get(outcome, 0) + 1
+        except KeyboardInterrupt:
+            interrupted = True
     env.close()
     k, n = int(np.sum(success)), len(success)
     data = {"env_id": env_id(maze, agent), "episodes": n, "success_rate": k / n if n else 0.0,
@@ -139,8 +146,20 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
                          "continuing_task": True, "reset_target": False, "clearance": policy.clearance,
                          "start": start, "reset_noise": reset_noise},
             "wall_seconds": time.time() - t0}
+    target = run_dir / OFFICIAL_JSON if out is None else Path(out)
+    partial = partial_path(target)
+    if interrupted:  # keep the finished episodes beside, never as, the complete record
+        write_atomic(partial, json.dumps({**data, "interrupted": True, "episodes_asked": episodes}, indent=2))
+        raise KeyboardInterrupt
+    partial.unlink(missing_ok=True)
     write_atomic(run_dir / OFFICIAL_JSON if out is None else out, json.dumps(data, indent=2))
     return data
+
+
+def partial_path(target) -> Path:
+    """Where an interrupted run keeps its finished episodes: ``official.partial.json`` beside ``official.json``."""
+    target = Path(target)
+    return target.with_name(f"{target.stem}.partial{target.suffix}")
 
 
 def _reset_as_package(env, policy: CompositionalPolicy, start_region, noise: bool, rng) -> dict:
