@@ -152,7 +152,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
         write_atomic(partial, json.dumps({**data, "interrupted": True, "episodes_asked": episodes}, indent=2))
         raise KeyboardInterrupt
     partial.unlink(missing_ok=True)
-    write_atomic(run_dir / OFFICIAL_JSON if out is None else out, json.dumps(data, indent=2))
+    write_atomic(target, json.dumps(data, indent=2))
     return data
 
 
