@@ -36,16 +36,15 @@ def sim_side(run: Path, episodes: int) -> dict:
 
 def gap_table(record: dict) -> str:
     """The record as docs/official_env.md shows it: both simulators per maze, and official - this simulator."""
-    from specrefine.core.results import newcombe_ci, rate_text
+    from specrefine.core.results import difference_text, rate_text
 
     lines = ["| maze | official environment | legs | this simulator [95 % CI] (episodes) | official [95 % CI] "
              "(episodes) | official - this simulator [95 % CI] |", "|---|---|---|---|---|---|"]
     for row in record["rows"]:
         here, there = row["this_simulator"], row["official"]
         (ks, ns), (ko, no) = [(round(s["success_rate"] * s["episodes"]), s["episodes"]) for s in (here, there)]
-        lo, hi = newcombe_ci(ko, no, ks, ns)
         lines.append(f"| `{row['maze']}` | `{row['env_id']}` | {len(row['path']) - 1} | {rate_text(ks, ns)} | "
-                     f"{rate_text(ko, no)} | {ko / no - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}] |")
+                     f"{rate_text(ko, no)} | {difference_text(ko, no, ks, ns)} |")
     return "\n".join(lines)
 
 

@@ -37,7 +37,7 @@ LABELS = {"this_simulator": "this simulator", variant_name("official", "official
 def gap_table(record: dict) -> str:
     """Per proposer and variant, pooled over the runs that have it: success, and its difference from this
     simulator on the same runs (Newcombe 95 %)."""
-    from specrefine.core.results import newcombe_ci, rate_text
+    from specrefine.core.results import difference_text, rate_text
 
     def counts(entry, key):
         side = entry[key]
@@ -54,10 +54,7 @@ def gap_table(record: dict) -> str:
                 continue
             k, n = map(sum, zip(*(counts(e, key) for e in have.values())))
             ks, ns = map(sum, zip(*(counts(e, "this_simulator") for e in have.values())))
-            diff = "—"
-            if key != "this_simulator":
-                lo, hi = newcombe_ci(k, n, ks, ns)
-                diff = f"{k / n - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+            diff = "—" if key == "this_simulator" else difference_text(k, n, ks, ns)
             lines.append(f"| {proposer.replace('-', ':')} | {label} | {','.join(have)} | {rate_text(k, n)} | {diff} |")
     return "\n".join(lines)
 

@@ -109,6 +109,12 @@ def rate_text(k: int, n: int) -> str:
     return f"{k / n:.3f} [{lo:.3f}, {hi:.3f}] ({n})"
 
 
+def difference_text(k1: int, n1: int, k2: int, n2: int) -> str:
+    """'k1/n1 - k2/n2 [Newcombe 95 % interval]' with signs, as the result tables write a difference of two rates."""
+    lo, hi = newcombe_ci(k1, n1, k2, n2)
+    return f"{k1 / n1 - k2 / n2:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+
+
 def newcombe_ci(k1, n1, k2, n2, z: float = 1.96) -> tuple[float, float]:
     """Newcombe's hybrid score interval (his method 10) for p1 - p2 of two independent proportions, from their
     Wilson intervals."""

@@ -23,7 +23,7 @@ import numpy as np
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
-from ..core.results import newcombe_ci, rate_text, wilson_ci
+from ..core.results import difference_text, rate_text, wilson_ci
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
 from ..core.tables import goal_points_of
 from ..pictures.render import subplots
@@ -109,9 +109,7 @@ def _difference(runs) -> str:
     both = [r for r in runs if r["official_episodes"] != ""]
     if not both:
         return "—"
-    (ks, ns), (ko, no) = _pooled(both, "sim"), _pooled(both, "official")
-    lo, hi = newcombe_ci(ko, no, ks, ns)
-    return f"{ko / no - ks / ns:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+    return difference_text(*_pooled(both, "official"), *_pooled(both, "sim"))
 
 
 def figure(rows):
