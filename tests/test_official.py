@@ -149,3 +149,9 @@ def test_an_interrupted_official_run_keeps_its_finished_episodes_beside_the_reco
     monkeypatch.setattr(official, "_episode", real)
     assert main(["official", str(point_run), "--episodes", "2", "--out", str(out)]) == 0
     assert out.exists() and not (tmp_path / "official.partial.json").exists()  # a complete run supersedes it
+
+
+def test_an_out_file_in_a_missing_folder_is_refused_before_any_episode(point_run, tmp_path, capsys):
+    assert main(["official", str(point_run), "--out", str(tmp_path / "nowhere" / "x.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "does not exist" in err

@@ -101,6 +101,8 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
         if rule not in RESET_RULES:
             raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
     run_dir = Path(run_dir)
+    if out is not None and not Path(out).parent.is_dir():
+        raise SpecrefineError(f"--out {out}: its folder {Path(out).parent} does not exist")
     result = _read_result(run_dir)
     policy = CompositionalPolicy.load(run_dir)
     agent, maze = policy.agent, policy.maze
