@@ -148,7 +148,9 @@ class RefinementSearch:
         if path and self.cfg.polish_rollouts:
             self._polish(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
-        self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0)
+        self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
+                  probabilities=probs, splits_generated=self.splits_generated,
+                  max_edge_splits=self.cfg.max_edge_splits)
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
                             self.vertex_generated)
 
