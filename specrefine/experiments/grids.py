@@ -320,6 +320,12 @@ GRIDS = {g.name: g for g in (
         mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
         policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre",
         table="data/results/ant/antmaze_centre.csv", out="runs/antmaze_centre", code="d3488cc"),
+    ExperimentGrid(
+        "taxonomy", "docs/corrector.md, 'The failure taxonomy' (issue 39; fixed 2026-11-27 before it ran)", "point",
+        parts=(Part(("ours",), ("geometric",), table="data/results/corrector/taxonomy_oracle.csv", out="oracle"),
+               Part(("ours", "ours-repair"), IMPERFECT[:3], split="proposers")),
+        seeds=(0, 1, 2, 3), workers=1, code="ceaa05f", table="data/results/corrector/taxonomy.csv",
+        out="runs/taxonomy"),
 )}
 
 
