@@ -24,7 +24,8 @@ def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2"):
 
 def test_every_method_is_listed_once_with_what_it_is():
     asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
-              "ours-repair", "ours-repair-tuned", "ours-corrector", "ours-polish", "ours-shortcut", "vlm-oneshot", "vlm-oneshot-matched"}
+              "ours-repair", "ours-repair-tuned", "ours-corrector", "ours-polish", "ours-shortcut", "vlm-oneshot",
+              "vlm-oneshot-matched"}
     assert set(METHODS) == asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) == asking
 
 
