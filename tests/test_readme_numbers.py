@@ -768,3 +768,25 @@ def test_the_ant_gap_table_is_its_record():
     (sim_a, sim_f), (off_a, off_f), (pkg_a, pkg_f) = totals.values()
     assert (f"({pkg_a} wall contacts and {pkg_f} flips over the three runs, against {off_a} and {off_f} with "
             f"AntMaze's start; this simulator {sim_a} and {sim_f})") in " ".join(doc.split())
+
+
+def test_the_ant_gap_records_outcomes_agree_with_their_success_rates():
+    """One truth per entry: its outcomes add up to its episodes, and its successes are the episodes labelled
+    success plus those counted apart (a trajectory that met the task while the policy's run ended otherwise)."""
+    import json
+
+    spec = importlib.util.spec_from_file_location("official_gap_ant", ROOT / "scripts" / "official_gap_ant.py")
+    official_gap_ant = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(official_gap_ant)
+    record = json.loads((ROOT / "data/official/ant_gap.json").read_text())
+    assert official_gap_ant.UNLABELLED in record["note"]
+    apart = []
+    for name, entry in record["runs"].items():
+        for key, side in entry.items():
+            assert sum(side["outcomes"].values()) == side["episodes"], (name, key)
+            assert side == official_gap_ant.side(side), (name, key)  # what the script writes today
+            successes = round(side["success_rate"] * side["episodes"])
+            assert successes == side["outcomes"].get("success", 0) + side.get(official_gap_ant.UNLABELLED, 0)
+            apart += [side[official_gap_ant.UNLABELLED]] if official_gap_ant.UNLABELLED in side else []
+    assert apart == [1, 1] and "1 in each of 2 of the 24 entries" in record["note"]
+    assert sum(len(entry) for entry in record["runs"].values()) == 24
