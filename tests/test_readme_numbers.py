@@ -790,3 +790,33 @@ def test_the_ant_gap_records_outcomes_agree_with_their_success_rates():
             apart += [side[official_gap_ant.UNLABELLED]] if official_gap_ant.UNLABELLED in side else []
     assert apart == [1, 1] and "1 in each of 2 of the 24 entries" in record["note"]
     assert sum(len(entry) for entry in record["runs"].values()) == 24
+
+
+def test_the_choices_numbers_are_their_tables():
+    """docs/choices.md's numbers for the goal-point rule, adaptive evaluation and the oracle's cap."""
+    import csv
+
+    def rows(table, **match):
+        with (ROOT / table).open(newline="") as fh:
+            return [r for r in csv.DictReader(fh) if all(r[k] == v for k, v in match.items())]
+
+    def pooled(runs, episodes=None):
+        return (sum(round(float(r["success_rate"]) * (episodes or int(r["episodes"]))) for r in runs),
+                sum(episodes or int(r["episodes"]) for r in runs))
+
+    doc = " ".join((ROOT / "docs/choices.md").read_text().split())
+    check = (ROOT / "data/results/ant/centre_check.md").read_text()
+    lever, base, diff = re.search(r"Pooled ([0-9.]+) .*? against ([0-9.]+) .*?: difference (\S+ \[\S+ \S+\])",
+                                  check).groups()
+    assert f"{base} sampled against {lever} centre, difference {diff}" in doc
+    cap48 = pooled(rows("data/results/ant/uchain5_cap48.csv"))
+    cap32 = pooled(rows("data/results/ant/comparison.csv", maze="u_chain_5", method="ours", proposer="geometric"))
+    assert f"{cap48[0]}/{cap48[1]} = {cap48[0] / cap48[1]:.3f} against {cap32[0]}/{cap32[1]} = " \
+           f"{cap32[0] / cap32[1]:.3f} with 32" in doc
+    held = {ev: rows("data/results/ant/adaptive_bench.csv", evaluation=ev) for ev in ("fixed", "adaptive")}
+    held = {ev: [r for r in runs if r["seed"] in ("1", "2")] for ev, runs in held.items()}  # seed 0 informed it
+    ratio = {k: sum(float(r[k]) for r in held["fixed"]) / sum(float(r[k]) for r in held["adaptive"])
+             for k in ("sim_steps", "wall_seconds")}
+    (ka, na), (kf, nf) = (pooled(held[ev], episodes=200) for ev in ("adaptive", "fixed"))
+    assert (f"{ratio['sim_steps']:.2f}x fewer simulator steps and {ratio['wall_seconds']:.2f}x less wall time on the "
+            f"held-out Ant runs at equal success ({ka}/{na} adaptive against {kf}/{nf} fixed") in doc
