@@ -328,6 +328,7 @@ CENTRE = ["data/results/ant/centre.csv", "data/results/ant/scaling/ours_centre.c
           "data/results/ant/scaling/repair_geometric_centre.csv"]
 SAMPLED = ["data/results/ant/scaling/ours_geometric.csv", "data/results/ant/scaling/oneshot.csv"]
 PLAIN = [f"u_chain_{n}" for n in range(1, 6)]
+SCALING = [m for n in range(1, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals") if m != "u_chain_1_subgoals"]
 SUBGOALS = [f"u_chain_{n}_subgoals" for n in range(2, 6)]
 MULTI_ROOM = [m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")]
 
@@ -820,3 +821,55 @@ def test_the_choices_numbers_are_their_tables():
     (ka, na), (kf, nf) = (pooled(held[ev], episodes=200) for ev in ("adaptive", "fixed"))
     assert (f"{ratio['sim_steps']:.2f}x fewer simulator steps and {ratio['wall_seconds']:.2f}x less wall time on the "
             f"held-out Ant runs at equal success ({ka}/{na} adaptive against {kf}/{nf} fixed") in doc
+
+
+def test_the_stage5_section_is_its_csvs():
+    """docs/results.md's stage-5 table and the numbers under it, from the CSVs as the front page's."""
+    centre, sampled = _csv_runs(CENTRE), _csv_runs(SAMPLED)
+    columns = [(sampled, "ours"), (sampled, "vlm-oneshot"), (centre, "ours"), (centre, "vlm-oneshot")]
+    rates = [_rates(runs, method, ORACLE, SCALING) for runs, method in columns]
+    lines = ["| maze | ours, sampled | vlm-oneshot, sampled | ours, centre | vlm-oneshot, centre |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {maze} | " + " | ".join(f"{r[i]:.3f}" for r in rates) + " |" for i, maze in enumerate(SCALING)]
+    lines.append("| change 1→5 rooms | " + " | ".join(f"{_change(_room_values(runs, method, ORACLE)):+.3f}"
+                                                    for runs, method in columns) + " |")
+    assert "<!-- stage 5 table -->\n" + "\n".join(lines) + "\n" in README
+    text = " ".join(README.split())
+    assert [m for m, r in zip(SCALING, rates[0]) if r >= 0.90] == ["u_chain_1", "u_chain_2"]
+    assert "With sampled goal points `ours` reaches 0.90 only on U-chain 1 and 2" in text
+    for marker in ("front sampled grid", "front centre grid"):  # the same intervals as the front page's
+        change = re.search(r"change from 1 to 5 rooms (\S+ \[\S+ \S+\])", _between(FRONT, marker)).group(1)
+        assert change in text, marker
+    assert _between(FRONT, "front centre oneshot").endswith("the same success as `ours` in 23 of the 27 runs")
+    assert "the same success in 23 of the 27 runs" in text
+    erring, alone = _between(FRONT, "front erring"), _between(FRONT, "front erring ours")
+    best = re.match(r"(\S+)x the one-shot (\[\S+ \S+\])", erring).groups()
+    assert f"reaches {best[0]}x the one-shot's mean success on the multi-room mazes {best[1]}; `ours` alone {alone}" \
+           in text
+    zeros, lifted = re.search(r"at 0 in (\d+) of 27 runs and `ours-repair` lifts (\d+)", erring).groups()
+    assert f"`ours` ends at 0 in {zeros} of its 27 runs, {lifted} of which `ours-repair` lifts above 0" in text
+    rotated = _between(FRONT, "front rotated").replace(", difference", " on the original, difference")
+    assert rotated in text
+    centre_check = _between(FRONT, "front centre").split(", difference")[0]
+    assert f"helps, {centre_check})" in text
+
+
+def test_the_offline_comparison_counts_its_rows_by_code():
+    import csv
+    from collections import Counter
+
+    with (ROOT / "data/results/imperfect/results.csv").open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    first = Counter(r["method"] for r in rows[:1360])
+    later = Counter(r["method"] for r in rows[1360:])
+    assert set(first) == {"ours", "ours-nosearchvertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"}
+    assert set(later) == {"ours-novertex", "ours-notune", "ours-nofeedback"} and set(first.values()) == {272}
+    assert len(first) == 5
+    assert all(r["status"] == "ok" for r in rows)
+    assert " ".join(_between(README, "imperfect rows").split()) == (
+        f"{len(rows)} runs in `results.csv`, none failed: {sum(first.values())} of five methods run with "
+        f"commit 1461726 and {sum(later.values())} of the three redefined controls run with commit 309875a")
+    readme = " ".join((ROOT / "data/results/README.md").read_text().split())
+    assert (f"**rows 1-{sum(first.values())}** (272 each of `ours`, `ours-nosearchvertex`, `ours-d1`, `vlm-oneshot`, "
+            f"`vlm-oneshot-matched`) ran with commit **1461726**") in readme
+    assert f"**rows {sum(first.values()) + 1}-{len(rows)}** (272 each of the redefined" in readme
