@@ -190,6 +190,17 @@ CONTROLS = ("ours-novertex", "ours-notune", "ours-nofeedback")
 U_CHAINS = tuple(f"u_chain_{n}" for n in range(1, 6))
 SUBGOALS = tuple(f"u_chain_{n}_subgoals" for n in range(2, 6))
 GEOMETRIC_48 = "geometric:max_waypoints=48"
+OTHER_POINT_MAZES = ("hazard_pool", "or_maze", "split_doorway", "two_doors", "u_maze", "x_maze", "xx_maze_h",
+                     "xx_maze_v")  # the point suite beside the U-chains
+HELD_OUT_MAZES = ("data/mazes/unseen/spiral.maze", "data/mazes/unseen/zigzag.maze",
+                  "data/mazes/unseen/detour_subgoal.maze", "data/mazes/unseen/pillars.maze", "random:3x4:7",
+                  "random:4x4:11")
+#: error mixes no method was developed on: (A) small regions pulled to corners and false openings, (B) dropped
+#: turns growing with the span of a query, mirrored replies and wrong branches
+HELD_OUT_MIXES = ("imperfect:position_sigma=0.35,radius=0.3,radius_log_sigma=0.6,corner_pull=0.5,"
+                  "p_false_opening=0.3,p_wrong_branch=0.1,p_drop_turn=0.1,p_uncapped=0.3,p_unparseable=0.05,rho=0.5",
+                  "imperfect:position_sigma=0.2,radius_log_sigma=0.3,p_drop_turn=0.35,p_uncapped=0.7,alpha=0.2,"
+                  "p_mirror_y=0.1,p_wrong_branch=0.3,rho=0.3")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -320,6 +331,32 @@ GRIDS = {g.name: g for g in (
         mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
         policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre",
         table="data/results/ant/antmaze_centre.csv", out="runs/antmaze_centre", code="d3488cc"),
+    ExperimentGrid(
+        "taxonomy", "docs/corrector.md, 'The failure taxonomy' (issue 39; fixed 2026-11-27 before it ran)", "point",
+        parts=(Part(("ours",), ("geometric",), table="data/results/corrector/taxonomy_oracle.csv", out="oracle"),
+               Part(("ours", "ours-repair"), IMPERFECT[:3], split="proposers")),
+        seeds=(0, 1, 2, 3), workers=1, code="ceaa05f", table="data/results/corrector/taxonomy.csv",
+        out="runs/taxonomy"),
+    ExperimentGrid(
+        "corrector", "docs/corrector.md, 'The grids' (issue 39; fixed 2026-11-27 before its first cell ran)", "point",
+        parts=(Part(("ours-corrector", "vlm-oneshot"), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                    split="proposers"),
+               Part(("ours-corrector",), ("imperfect:severe",), mazes=SCALING_MAZES),
+               Part(("ours-corrector",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES)),
+        seeds=(0, 1, 2, 3), workers=1, code="5356175", table="data/results/corrector/point.csv",
+        out="runs/corrector"),
+    ExperimentGrid(
+        "corrector-held-out", "docs/corrector.md, 'Held out' (issue 39; fixed 2026-11-27 before its first cell ran)",
+        "point",
+        parts=(Part(("ours",), ("geometric",), table="data/results/corrector/held_out_oracle.csv", out="oracle"),
+               Part(("ours", "ours-corrector"), HELD_OUT_MIXES)),
+        seeds=(0, 1), mazes=HELD_OUT_MAZES, workers=1, code="5356175",
+        table="data/results/corrector/held_out.csv", out="runs/corrector_held_out"),
+    ExperimentGrid(
+        "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
+        parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
+        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
+        workers=1, code="5356175", table="data/results/corrector/ant.csv", out="runs/ant_corrector"),
 )}
 
 

@@ -129,8 +129,9 @@ def ours_variant(**changes) -> Callable[[SearchJob], object]:
         from ..refine import RefinementSearch, SearchConfig
 
         c, variant = job.config, dict(changes)
-        if variant.get("shortcut_reach") == "policy":  # as far as the policy was trained to reach a goal
-            variant["shortcut_reach"] = get_agent(c.agent).reach_task.goal_max
+        for reach in ("shortcut_reach", "correct_reach"):
+            if variant.get(reach) == "policy":  # as far as the policy was trained to reach a goal
+                variant[reach] = get_agent(c.agent).reach_task.goal_max
         cfg = SearchConfig.from_run(c, **variant)
         images = getattr(job.proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(job.maze, c.agent, job.evaluator.facts(), images=images)
@@ -194,6 +195,12 @@ register_method("ours-polish", ours_variant(polish_rollouts=128),
 register_method("ours-shortcut", ours_variant(shortcut_reach="policy"),
                 "beyond the paper: ours, then shortcut edges over the found path's waypoints (one long leg where it "
                 "beats several short ones; refine/shortcut.py)", colour="#283593")
+register_method("ours-corrector", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
+                                               correct_rollouts=4, correct_reach="policy"),
+                "beyond the paper: ours with repair to three levels and any feasible chain preferred to a dead "
+                "edge, then the found path's legs estimated again on 4x fresh rollouts and its weak legs split, "
+                "split over or bypassed while the path gains (refine/correct.py)",
+                colour="#c62828")
 register_method("vlm-oneshot", vlm_oneshot,
                 "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w",
                 colour="#ef6c00", knobs=("w", "d"))

@@ -18,7 +18,9 @@ The search settings ``w``, ``d`` and ``k`` (``-w 3 5 -k 5 10``; defaults and bou
 settings it reads (``methods.Method.knobs``).  A cell with the paper's values keeps the id it always had; any
 other value is named in the id (``...__s0__w5``) and recorded in the ``w``, ``d``, ``k`` columns (a table from
 before them reads as the paper's values; cells with other values are refused into it).  ``--goal-points centre``
-(``RunConfig.goal_points``) likewise ends the id in ``__centre``.
+(``RunConfig.goal_points``) likewise ends the id in ``__centre``.  Every row records what it ran with:
+``policy_fingerprint`` (the goal policy's weights) and ``commit`` (the code's commit, ``-dirty`` if ``specrefine/``
+had uncommitted edits, ``unknown`` outside a git checkout: ``core.paths.code_commit``).
 
 A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
 ``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
@@ -63,6 +65,7 @@ from tqdm.auto import tqdm
 from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
+from ..core.paths import code_commit
 from ..core.plugins import loaded
 from ..core.runfolder import replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
@@ -76,10 +79,14 @@ COLUMNS = [
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
     "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
     "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k", "goal_points",
+    "commit",
 ]
 #: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
 #: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
-#: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header.
+#: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header, except
+#: for PROVENANCE: a row always records the policy and the code it ran with, so a table without those columns gets
+#: them (rewritten whole, its older rows empty there: unknown) before the row is appended.
+PROVENANCE = ("policy_fingerprint", "commit")
 
 
 @dataclass(frozen=True)
@@ -201,7 +208,7 @@ def run_cell(cell: Cell, out_root: str, plugins: tuple[str, ...] = ()) -> dict:
     from ..core.plugins import load_plugins
     from .pipeline import refine_maze
 
-    row = {**asdict(cell), "cell": cell.id}
+    row = {**asdict(cell), "cell": cell.id, "commit": code_commit()}  # a failed cell's row names its code too
     out = Path(out_root) / "cells" / cell.id
     try:
         load_plugins(plugins)
@@ -285,6 +292,8 @@ def _append(path: Path, row: dict) -> None:
             raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
     if not new:
         _drop_cut_row(path)
+        if missing := [c for c in PROVENANCE if c not in columns]:
+            columns = _add_columns(path, columns, missing)
     with path.open("a", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
@@ -293,6 +302,18 @@ def _append(path: Path, row: dict) -> None:
                          for k in columns})  # one line per row: a cut row is then always the last line
         fh.flush()
         os.fsync(fh.fileno())
+
+
+def _add_columns(path: Path, columns: list[str], missing: list[str]) -> list[str]:
+    """The table rewritten whole with ``missing`` columns after its own, empty in its rows; the new header."""
+    with path.open(newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))[1:]
+    columns = [*columns, *missing]
+    with replacing(path, newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(columns)
+        writer.writerows(row + [""] * (len(columns) - len(row)) for row in rows if row)
+    return columns
 
 
 def pending(cells: list[Cell], table: Path) -> list[Cell]:
