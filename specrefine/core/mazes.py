@@ -312,6 +312,8 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     path = Path(path)
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"
+    if not path.exists() and not path.is_symlink() and not path.suffix:
+        raise MazeError(_unknown_name(str(path)))
     try:
         text = regular_file(path, "maze file").read_text(encoding="utf-8")
     except SpecrefineError as exc:
@@ -321,6 +323,17 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     except UnicodeDecodeError:
         raise MazeError(f"{path}:1:1: not a text file") from None
     return parse_maze(text, str(path), cell_size)
+
+
+def _unknown_name(name: str) -> str:
+    """One line for a maze name that is neither a file nor a shipped maze: the nearest shipped names."""
+    import difflib
+
+    names = sorted(p.relative_to(MAZE_DIR).with_suffix("").as_posix() for p in MAZE_DIR.rglob("*.maze"))
+    near = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+    hint = f"nearest: {', '.join(near)}" if near else f"shipped: {', '.join(n for n in names if '/' not in n)}"
+    return (f"{name}: no such maze (not a file, not in data/mazes/; {hint}; or gr:NAME, random:RxC:SEED, "
+            f"a path to a .maze file)")
 
 
 def _random_from_text(text: str, cell_size: float) -> Maze:
