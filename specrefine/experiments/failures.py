@@ -66,7 +66,7 @@ def leg_table(run, n_legs: int) -> list[dict]:
     return rows
 
 
-def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal_points: str | None = None) -> dict:
+def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_points: str | None = None) -> dict:
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
 
     ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
@@ -108,6 +108,8 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     if goal_points is None:
         goal_points = goal_points_of(result.get("config") or {})
+    if policy is None:  # the run's own (a run from before the config was recorded: the shipped one)
+        policy = (result.get("config") or {}).get("policy") or "shipped"
     rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation")
                    or PAPER.rollouts)
     exp = setup(result["maze"], agent=result["agent"], seed=seed, policy=policy, goal_points=goal_points,
@@ -120,7 +122,7 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
     return exp, graph, path, legs
 
 
-def leg_estimates(result: dict, seeds, policy="shipped", goal_points: str | None = None) -> dict:
+def leg_estimates(result: dict, seeds, policy=None, goal_points: str | None = None) -> dict:
     """Every leg of ``result``'s path estimated again along the chain, once per seed (see the module docstring)."""
     from ..refine.common import Leg, estimate_legs
     from ..refine.polish import Rollouts
@@ -172,7 +174,8 @@ def add_arguments(p) -> None:
     p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
-    p.add_argument("--policy", default="shipped", help="'shipped' (the run's agent's) or a policy checkpoint")
+    p.add_argument("--policy", default=None, help="'shipped' (data/policies/AGENT.pt), a shipped one's name or a "
+                                                  "policy checkpoint (default: the run's own)")
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
                         "centre: at the set's centre (beyond the paper) (default: as the run measured it)")

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
-from ..runs.config import DEFAULTS
+from ..core.paper import PAPER
 from ..runs.sweep import Cell, grid
 
 ROOT = Path(__file__).resolve().parents[2]  # the checkout: a grid's paths are relative to it
@@ -56,7 +56,7 @@ class ExperimentGrid:
     policy: str = "shipped"  # or a checkout-relative path to a checkpoint
     policy_in_checkout: bool = False  # the checkout's copy (an absolute path), not the pinned code tree's
     evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
-    goal_points: str | None = None  # None: the sweep's default, the paper's sampled points (not passed)
+    goal_points: str | None = None  # None: what the pinned code defaulted to, the paper's sampled points (not passed)
     rollouts: int | None = None  # None: the sweep's default (not passed)
     episodes: int | None = None
     workers: int = 2
@@ -169,7 +169,7 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      goal_points=g.goal_points or DEFAULTS.goal_points, **_budget(g))
+                      goal_points=g.goal_points or PAPER.goal_points, **_budget(g))
     return list(dict.fromkeys(cells))
 
 

@@ -150,6 +150,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
             "success_ci": list(wilson_ci(k, n)), "sim_success_rate": result.get("success_rate"),
             "sim_success_ci": result.get("success_ci"), "sim_episodes": result.get("episodes"),
             "outcomes": outcomes, "seed": seed, "agent": policy.agent, "maze": maze.name,
+            "preset": _run_preset(result),
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
@@ -236,10 +237,16 @@ def _read_result(run_dir: Path) -> dict:
     return data
 
 
+def _run_preset(result: dict) -> str:
+    """The run's preset, from its result.json ("none": a run from before presets, whose settings it records)."""
+    preset = result.get("preset")
+    return preset if preset in ("best", "paper") else "none"
+
+
 def summary(data: dict) -> str:
     lo, hi = data["success_ci"]
     line = (f"official {data['env_id']}: success on the original task {data['success_rate']:.3f} "
-            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes)")
+            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')})")
     if data.get("sim_success_rate") is not None:
         slo, shi = data["sim_success_ci"]
         line += (f"\nthis package's simulator: {data['sim_success_rate']:.3f} (95% CI {slo:.3f}-{shi:.3f}, "
