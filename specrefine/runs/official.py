@@ -45,6 +45,7 @@ from tqdm.auto import tqdm
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
+from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import write_atomic
 from ..core.standard_maps import to_gymnasium
@@ -106,12 +107,14 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     result = _read_result(run_dir)
     policy = CompositionalPolicy.load(run_dir)
     agent, maze = policy.agent, policy.maze
+    if (result["agent"], result["maze"]) != (agent, maze.name):
+        raise SpecrefineError(f"{run_dir}: result.json is of the {result['agent']} in {result['maze']!r:.40}, "
+                              f"policy.json of the {agent} in {maze.name!r:.40}: not one run's records")
     if agent not in ENVIRONMENTS:
         raise SpecrefineError(f"{run_dir}: no official Gymnasium-Robotics environment for the {agent}")
-    try:
-        original = TaskGraph.from_dict(result["input_graph"])
-    except (KeyError, TypeError, ValueError) as exc:
-        raise SpecrefineError(f"{run_dir / 'result.json'}: no usable input_graph ({type(exc).__name__})") from None
+    original = TaskGraph.from_dict(result["input_graph"])  # checked by read_result
+    sim = {f"sim_{key}": result.get(key) for key in ("success_rate", "success_ci", "episodes")}  # the run's own
+    sim = sim if None not in sim.values() else dict.fromkeys(sim)  # measurement, whole or not at all
     probe = make_env(maze, agent, 1)
     policy.match_env_dt(probe.unwrapped.model.opt.timestep * _inner(probe).frame_skip)
     probe.close()
@@ -140,9 +143,8 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     env.close()
     k, n = int(np.sum(success)), len(success)
     data = {"env_id": env_id(maze, agent), "episodes": n, "success_rate": k / n if n else 0.0,
-            "success_ci": list(wilson_ci(k, n)), "sim_success_rate": result.get("success_rate"),
-            "sim_success_ci": result.get("success_ci"), "sim_episodes": result.get("episodes"),
-            "outcomes": outcomes, "seed": seed, "agent": agent, "maze": maze.name,
+            "success_ci": list(wilson_ci(k, n)), **sim, "outcomes": outcomes, "seed": seed, "agent": agent,
+            "maze": maze.name,
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs), "max_episode_steps": max_steps,
                          "continuing_task": True, "reset_target": False, "clearance": policy.clearance,
@@ -205,16 +207,14 @@ def _inner(env):
 
 
 def _read_result(run_dir: Path) -> dict:
+    """The run's result.json, checked by the records' schema, with the task the episodes are judged on."""
     path = run_dir / "result.json"
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder") from None
-    except (OSError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
-    if not isinstance(data, dict):
-        raise SpecrefineError(f"{path}: not a run result")
-    return data
+    if not path.exists() and not path.is_symlink():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+    result = read_result(path)
+    if "input_graph" not in result:
+        raise SpecrefineError(f"{path}: no input_graph (the original task the episodes are judged on)")
+    return result
 
 
 def summary(data: dict) -> str:
