@@ -163,11 +163,11 @@ NEEDED = ("success_rate", "seed", "rollouts_per_evaluation", "episodes", "path",
 def checked_run(run, maze_dir=None):
     """(result file, its data with the graphs built, run.json's arguments, the maze) of a finished run, checked
     before any simulation: anything unusable is a one-line :class:`~specrefine.core.errors.SpecrefineError`."""
-    import json
 
     from ..core.errors import SpecrefineError
     from ..core.graph import TaskGraph
     from ..core.mazes import load_maze
+    from ..core.records import read_json
     from ..core.runfolder import read_result, recorded_maze
 
     path = result_file(run)
@@ -176,10 +176,7 @@ def checked_run(run, maze_dir=None):
     if missing:
         raise SpecrefineError(f"{path}: result.json lacks {', '.join(missing)}")
     run_json = path.with_name("run.json") if path.name == "result.json" else None
-    try:
-        args = json.loads(run_json.read_text()) if run_json and run_json.is_file() else {}
-    except (OSError, ValueError):
-        raise SpecrefineError(f"{run_json}: unreadable run record") from None
+    args = read_json(run_json, "run record") if run_json and run_json.is_file() else {}
     if not isinstance(args, dict):
         raise SpecrefineError(f"{run_json}: unreadable run record")
     if args.get("policy", "shipped") != "shipped":
