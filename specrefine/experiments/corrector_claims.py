@@ -1,6 +1,6 @@
 """The corrector grids' claims (docs/corrector.md, "The rules"), decided as fixed there.
 
-    python -m specrefine.experiments.corrector_claims --out data/results/corrector
+    specrefine corrector-claims --out data/results/corrector
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
 and the one-shot) and, where present, ``ant-corrector`` with the Ant scaling grid's one-shot and oracle; writes
@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -257,22 +258,32 @@ def markdown(point: dict, ant: dict | None) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, out_path
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
 
-    p = OneLineParser(prog="python -m specrefine.experiments.corrector_claims", description=__doc__.split("\n")[0])
-    p.add_argument("--out", type=out_path, default=Path("data/results/corrector"), help="folder for claims.md/json")
-    args = p.parse_args(argv)
+    p.description = __doc__.split("\n\n")[0]
+    p.add_argument("--out", type=out_path, default=Path("data/results/corrector"),
+                   help="folder for claims.md and claims.json (default: data/results/corrector)")
+
+
+def run(args, p) -> int:
     try:
         point, ant = point_study(), ant_study()
         args.out.mkdir(parents=True, exist_ok=True)
         write_atomic(args.out / "claims.md", markdown(point, ant))
         write_atomic(args.out / "claims.json", json.dumps({"point": point, "ant": ant, "rules": verdicts(point, ant)},
                                                           indent=1, default=float) + "\n")
-        print(f"-> {args.out}/claims.md")
-    except SpecrefineError as exc:
-        p.exit(2, f"{p.prog}: error: {exc}\n")
+    except (SpecrefineError, OSError) as exc:
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"-> {args.out}/claims.md")
     return 0
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("corrector-claims", argv, prog="python -m specrefine.experiments.corrector_claims")
 
 
 if __name__ == "__main__":
