@@ -146,6 +146,8 @@ class CompositionalPolicy:
     def load(cls, run_dir, env_dt: float | None = None) -> CompositionalPolicy:
         """The policy saved in ``run_dir`` (``policy.json`` + its goal policy); problems are one PolicyError line."""
         path = Path(run_dir) / POLICY_JSON
+        if path.exists() and not path.is_file():  # a FIFO would block the read forever
+            raise PolicyError(f"{path}: not a regular file (a folder, a FIFO or a device)")
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except FileNotFoundError:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import sys
 from collections import Counter
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -165,7 +166,7 @@ def summary(report: dict) -> str:
 
 def main(argv=None) -> int:
     from ..core.argtypes import OneLineParser, bounded_int, out_path
-    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic, writing_into
     from ..evaluation.evaluator import GOAL_POINTS
 
     p = OneLineParser(prog="python -m specrefine.experiments.failures", description=__doc__.split("\n\n")[0])
@@ -182,16 +183,17 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
     args = p.parse_args(argv)
     try:
-        if args.out is not None:
-            writable_parent(args.out)  # before the re-run, not after it
         result = read_result(args.result)
-        maze = recorded_maze(args.result, result["maze"])
-        if args.estimates:
-            report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
-        else:
-            report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
-        if args.out is not None:
-            write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+        # --out checked before the re-run, not after it; written into a run folder under that folder's lock
+        with nullcontext() if args.out is None else writing_into(writable_parent(args.out)):
+            maze = recorded_maze(args.result, result["maze"])
+            if args.estimates:
+                report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
+            else:
+                report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy,
+                                       args.goal_points)
+            if args.out is not None:
+                write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:
         print(f"{p.prog}: error: {e}", file=sys.stderr)
         return 2

@@ -41,14 +41,15 @@ import time
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
+from ..core.paths import regular_file
 from ..core.results import wilson_ci
-from ..core.runfolder import write_atomic
+from ..core.runfolder import output_file, write_atomic, writing_into
 from ..core.standard_maps import to_gymnasium
 from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
+from .progress import counted
 
 OFFICIAL_JSON = "official.json"
 RESET_RULES = ("official", "package")  # whose start / reset noise an episode begins with (module docstring)
@@ -92,18 +93,25 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``
     (or ``out``).  ``start`` / ``reset_noise``: "official" (the environment's own) or "package" (this package's
     rule, module docstring)."""
-    from ..core.graph import TaskGraph
-    from ..evaluation.evaluator import _torch_threads
-    from ..evaluation.monitor import satisfies
-
     t0 = time.time()
     for name, rule in (("start", start), ("reset_noise", reset_noise)):
         if rule not in RESET_RULES:
             raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
     run_dir = Path(run_dir)
-    if out is not None and not Path(out).parent.is_dir():
-        raise SpecrefineError(f"--out {out}: its folder {Path(out).parent} does not exist")
     result = _read_result(run_dir)
+    target = run_dir / OFFICIAL_JSON if out is None else Path(out)
+    what = "--out" if out is not None else "the record"
+    with writing_into(target, what):  # checked before any episode; the run folder's lock held while writing into it
+        output_file(partial_path(target), what)
+        return _run(run_dir, result, episodes, seed, start, reset_noise, target, t0)
+
+
+def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, reset_noise: str, target: Path,
+         t0: float) -> dict:
+    from ..core.graph import TaskGraph
+    from ..evaluation.evaluator import _torch_threads
+    from ..evaluation.monitor import satisfies
+
     policy = CompositionalPolicy.load(run_dir)
     agent, maze = policy.agent, policy.maze
     if agent not in ENVIRONMENTS:
@@ -125,7 +133,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     interrupted = False
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
         try:
-            for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
+            for episode in counted(range(episodes), episodes, f"official {maze.name}", "episode", leave=False):
                 options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
                 obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
                 if start == "package" or reset_noise == "package":
@@ -148,7 +156,6 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
                          "continuing_task": True, "reset_target": False, "clearance": policy.clearance,
                          "start": start, "reset_noise": reset_noise},
             "wall_seconds": time.time() - t0}
-    target = run_dir / OFFICIAL_JSON if out is None else Path(out)
     partial = partial_path(target)
     if interrupted:  # keep the finished episodes beside, never as, the complete record
         write_atomic(partial, json.dumps({**data, "interrupted": True, "episodes_asked": episodes}, indent=2))
@@ -206,10 +213,10 @@ def _inner(env):
 
 def _read_result(run_dir: Path) -> dict:
     path = run_dir / "result.json"
+    if not path.exists():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder") from None
+        data = json.loads(regular_file(path, "result file").read_text(encoding="utf-8"))  # a FIFO: never opened
     except (OSError, ValueError) as exc:
         raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
     if not isinstance(data, dict):
