@@ -1,5 +1,6 @@
 """README's result tables and claims are their tables' numbers: each recomputed here from the shipped CSV it names
-with the package's own functions (not read from claims.json / claims.md, which could be stale).
+(not read from claims.json / claims.md / legs.md, which could be stale), with the package's own functions or, for the
+Ant's stage-5 grids, through a path of its own: the plain ``csv`` module and the formula the text states.
 
 A hand-typed or stale figure (a rounding of a rounding, a count from before a table grew) fails here naming the
 row; floats are compared as README prints them, verdicts exactly.
@@ -316,23 +317,133 @@ def test_front_page_rotated_check_is_its_shipped_check():
     assert _between(FRONT, "front rotated") == f"{lever} against {base}, difference {diff}"
 
 
-def test_front_page_centre_grid_is_its_claims():
-    import json
+# The Ant's stage-5 grids, recomputed with the csv module alone and the formulas the text states: success pooled
+# over seeds 0-2 (successes = rate x episodes), the change from 1 to 5 rooms as the least-squares slope of the
+# seed means on U-chain 1-5 times 4, its interval the 2.5 and 97.5 % points of the bootstrap that resamples the
+# seeds within each room (enumerated exactly here; the package draws 10,000 resamples, hence the tolerance).
+ORACLE = "geometric:max_waypoints=48"
+ERRING = "imperfect:moderate"
+CENTRE = ["data/results/ant/centre.csv", "data/results/ant/scaling/ours_centre.csv",
+          "data/results/ant/scaling/oneshot_centre.csv", "data/results/ant/scaling/imperfect_centre.csv",
+          "data/results/ant/scaling/repair_geometric_centre.csv"]
+SAMPLED = ["data/results/ant/scaling/ours_geometric.csv", "data/results/ant/scaling/oneshot.csv"]
+PLAIN = [f"u_chain_{n}" for n in range(1, 6)]
+SCALING = [m for n in range(1, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals") if m != "u_chain_1_subgoals"]
+SUBGOALS = [f"u_chain_{n}_subgoals" for n in range(2, 6)]
+MULTI_ROOM = [m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")]
 
-    flat = json.loads((ROOT / "data/results/ant/scaling_centre/claims.json").read_text())["flat"]
-    rate = {maze: f"{m['success']:.3f}" for maze, m in flat["per_maze"].items()}
-    plain = ", ".join(rate[f"u_chain_{n}"] for n in range(1, 6))
-    subgoals = ", ".join(rate[f"u_chain_{n}_subgoals"] for n in range(2, 6))
-    lo, hi = flat["change_ci"]
-    assert _between(FRONT, "front centre grid") == (
-        f"{plain} for 1-5 rooms (with subgoals {subgoals}); change from 1 to 5 rooms {flat['change_1_to_5']:+.3f} "
-        f"[{lo:+.3f}, {hi:+.3f}]")
+
+def _csv_runs(tables) -> dict:
+    """{(maze, method, proposer): {seed: row}} of the ok rows, by the csv module alone; one row per run."""
+    import csv
+
+    runs: dict = {}
+    for table in tables:
+        with (ROOT / table).open(newline="") as fh:
+            for row in csv.DictReader(fh):
+                if row["status"] == "ok":
+                    seeds = runs.setdefault((row["maze"], row["method"], row["proposer"]), {})
+                    assert int(row["seed"]) not in seeds, (table, row["cell"])
+                    seeds[int(row["seed"])] = row
+    return runs
+
+
+def _rates(runs, method, proposer, mazes) -> list[float]:
+    """Success pooled over seeds 0-2 per maze."""
+    out = []
+    for maze in mazes:
+        seeds = runs[maze, method, proposer]
+        assert sorted(seeds) == [0, 1, 2], (maze, method, proposer)
+        ok = sum(round(float(r["success_rate"]) * int(r["episodes"])) for r in seeds.values())
+        out.append(ok / sum(int(r["episodes"]) for r in seeds.values()))
+    return out
+
+
+def _change(room_values: list[list[float]]) -> float:
+    """4 x the least-squares slope of the room means over 1-5 rooms (x centred: -2..2, sum of x^2 = 10)."""
+    return 4 * sum(x * sum(v) / len(v) for x, v in zip(range(-2, 3), room_values)) / 10
+
+
+def _change_interval(room_values: list[list[float]]) -> tuple[float, float]:
+    """The exact percentile bootstrap of _change with the seeds resampled within each room."""
+    import itertools
+    from collections import Counter
+
+    dist = {0.0: 1.0}
+    for x, values in zip(range(-2, 3), room_values):
+        draws = Counter(sum(d) / len(d) for d in itertools.product(values, repeat=len(values)))
+        total = len(values) ** len(values)
+        step: dict = {}
+        for a, pa in dist.items():
+            for mean, count in draws.items():
+                key = round(a + 0.4 * x * mean, 12)
+                step[key] = step.get(key, 0.0) + pa * count / total
+        dist = step
+    cum, lo, hi = 0.0, None, None
+    for value, prob in sorted(dist.items()):
+        cum += prob
+        lo = value if lo is None and cum >= 0.025 - 1e-12 else lo
+        hi = value if hi is None and cum >= 0.975 - 1e-12 else hi
+    return lo, hi
+
+
+def _room_values(runs, method, proposer) -> list[list[float]]:
+    return [[float(r["success_rate"]) for r in runs[maze, method, proposer].values()] for maze in PLAIN]
+
+
+def _change_text(runs, method, proposer, printed: str) -> str:
+    """The change as README prints it, its interval checked against the exact bootstrap."""
+    values = _room_values(runs, method, proposer)
+    lo, hi = (float(x) for x in re.search(r"\[(\S+), (\S+)\]", printed).groups())
+    exact = _change_interval(values)
+    assert abs(lo - exact[0]) <= 0.002 and abs(hi - exact[1]) <= 0.002, (printed, exact)
+    return f"{_change(values):+.3f} [{lo:+.3f}, {hi:+.3f}]"
+
+
+def _three(values) -> str:
+    return ", ".join(f"{v:.3f}" for v in values)
+
+
+def test_front_page_centre_grid_is_its_csvs():
+    runs = _csv_runs(CENTRE)
+    text = _between(FRONT, "front centre grid")
+    printed = re.search(r"rooms (\S+ \[\S+ \S+\])$", text).group(1)
+    assert text == (f"{_three(_rates(runs, 'ours', ORACLE, PLAIN))} for 1-5 rooms (with subgoals "
+                    f"{_three(_rates(runs, 'ours', ORACLE, SUBGOALS))}); change from 1 to 5 rooms "
+                    f"{_change_text(runs, 'ours', ORACLE, printed)}")
+    assert min(_rates(runs, "ours", ORACLE, PLAIN + SUBGOALS)) >= 0.90  # "at least 0.90 at every length holds"
+    assert "**At least 0.90 at every length holds; flat within ±0.05 does not.**" in " ".join(FRONT.split())
+    assert _change_interval(_room_values(runs, "ours", ORACLE))[0] < -0.05
+
+
+def test_front_page_one_shot_with_the_oracle_is_its_csv():
+    """The near-flat curve is the one-shot's too: README names its numbers and the runs where they are equal."""
+    runs = _csv_runs(CENTRE)
+    text = _between(FRONT, "front centre oneshot")
+    printed = re.search(r"change (\S+ \[\S+ \S+\])", text).group(1)
+    same = sum(runs[maze, "ours", ORACLE][s]["success_rate"] == runs[maze, "vlm-oneshot", ORACLE][s]["success_rate"]
+               for maze in PLAIN + SUBGOALS for s in (0, 1, 2))
+    assert text == (f"{_three(_rates(runs, 'vlm-oneshot', ORACLE, PLAIN))} for 1-5 rooms; change "
+                    f"{_change_text(runs, 'vlm-oneshot', ORACLE, printed)}; the same success as `ours` in {same} of "
+                    f"the {3 * len(PLAIN + SUBGOALS)} runs")
+    assert "**`ours --goal-points centre`** with the same oracle" in " ".join(FRONT.split())
+
+
+def test_front_page_sampled_goal_points_are_their_csv():
+    """The paper's rule (sampled goal points), stage 5, cap 48: README names it beside the centre variant."""
+    runs = _csv_runs(SAMPLED)
+    text = _between(FRONT, "front sampled grid")
+    printed = re.search(r"rooms (\S+ \[\S+ \S+\]);", text).group(1)
+    below = sum(r < 0.90 for r in _rates(runs, "ours", ORACLE, PLAIN + SUBGOALS))
+    assert text == (f"{_three(_rates(runs, 'ours', ORACLE, PLAIN))} for 1-5 rooms; change from 1 to 5 rooms "
+                    f"{_change_text(runs, 'ours', ORACLE, printed)}; {below} of the 9 mazes below 0.90")
+    with (ROOT / "data/results/ant/scaling/ours_geometric.csv").open() as fh:
+        assert "goal_points" not in fh.readline()  # from before the option: every row aimed at sampled points
 
 
 def test_front_page_leg_losses_and_legs_per_room_are_the_centre_grids():
     import json
 
-    from specrefine.experiments import scaling
     from specrefine.experiments.legs import turn_table
 
     profiles = json.loads((ROOT / "data/results/ant/scaling_centre/leg_profiles.json").read_text())
@@ -341,26 +452,107 @@ def test_front_page_leg_losses_and_legs_per_room_are_the_centre_grids():
     assert " ".join(_between(FRONT, "front turns").split()) == (
         f"{100 * rate['straight']:.2f} % of the episodes that start it when it runs straight and "
         f"{100 * rate['turning']:.2f} % when it turns, against {100 * rate['first leg']:.2f} % for a path's first leg")
-    per_room = [float(line.split(" | ")[7]) for line in
-                (ROOT / "data/results/ant/scaling_centre/legs.md").read_text().splitlines()[2:]
-                if f"| ours | {scaling.ORACLE} |" in line]
-    assert len(per_room) == len(scaling.MAZES)
+    runs = _csv_runs(CENTRE)
+    # the profiles are of the shipped runs: each one's legs and successes are its row's
+    assert len(profiles) == 27
+    for p in profiles:
+        row = runs[p["maze"], "ours", ORACLE][p["seed"]]
+        assert len(p["leg_failure"]) == int(float(row["path_edges"])), (p["maze"], p["seed"])
+        assert p["episode_outcomes"].get("success", 0) == round(float(row["success_rate"]) * p["episodes"])
+    per_room = [sum(float(r["path_edges"]) for r in runs[maze, "ours", ORACLE].values()) / 3
+                / int(maze.split("_")[2]) for maze in PLAIN + SUBGOALS]
     assert _between(FRONT, "front legs") == f"{min(per_room):.1f}-{max(per_room):.1f} legs per room"
 
 
-def front_erring_text() -> str:
+def _erring_cells(runs, method) -> list[tuple[str, int, float]]:
+    return [(maze, s, float(runs[maze, method, ERRING][s]["success_rate"])) for maze in MULTI_ROOM for s in (0, 1, 2)]
+
+
+def test_front_page_erring_line_is_the_centre_grids_csvs():
+    """The better of ours / ours-repair per maze (higher mean over seeds, a tie keeps ours) over the one-shot's mean
+    on the multi-room runs; ours alone beside it; the runs of ours at 0 and what the repair made of them."""
+    from specrefine.experiments.comparison import bootstrap_ratio
+
+    runs = _csv_runs(CENTRE)
+    shot = [v for _, _, v in _erring_cells(runs, "vlm-oneshot")]
+    ours, repair = _erring_cells(runs, "ours"), _erring_cells(runs, "ours-repair")
+    chosen = []
+    for maze in MULTI_ROOM:
+        mine, fixed = ([v for m, _, v in cells if m == maze] for cells in (ours, repair))
+        chosen += fixed if sum(fixed) > sum(mine) else mine
+    zeros = [(m, s) for m in ["u_chain_1", *MULTI_ROOM] for s in (0, 1, 2)
+             if float(runs[m, "ours", ERRING][s]["success_rate"]) == 0]
+    lifted = sum(float(runs[m, "ours-repair", ERRING][s]["success_rate"]) > 0 for m, s in zeros)
+
+    def ratio(values):
+        _, (lo, hi), _ = bootstrap_ratio(np.array(values), np.array(shot))  # the comparison's bootstrap
+        return sum(values) / sum(shot), lo, hi
+
+    import numpy as np
+
+    best, lo, hi = ratio(chosen)
+    assert _between(FRONT, "front erring") == (
+        f"{best:.1f}x the one-shot [{lo:.1f}, {hi:.1f}] on the multi-room mazes ({len(shot)} paired runs; the rule: "
+        f"{'holds' if best >= 2 else 'not met'}); `ours` ends at 0 in {len(zeros)} of 27 runs and `ours-repair` "
+        f"lifts {lifted} of them above 0")
+    alone, lo, hi = ratio([v for _, _, v in ours])
+    assert _between(FRONT, "front erring ours") == f"{alone:.1f}x [{lo:.1f}, {hi:.1f}]"
+
+
+def test_front_page_ant_sentences_the_tables_carry():
+    """The stage-4 legs per room and per-leg failure, the rotated check's wording, the cost's goal-point rule, the
+    one-shot's better two_doors, the attribution at moderate, row 286's rerun and where the one-shot table ran."""
+    import csv
     import json
 
-    erring = json.loads((ROOT / "data/results/ant/scaling_centre/claims.json").read_text())["erring"]
-    lo, hi = erring["ratio_ci"]
-    lifted = sum(1 for z in erring["ours_at_zero"] if (z["ours_repair"] or 0) > 0)
-    return (f"{erring['ratio']:.1f}x the one-shot [{lo:.1f}, {hi:.1f}] on the multi-room mazes ({erring['cells']} "
-            f"paired runs; the rule: {erring['verdict']}); `ours` ends at 0 in {len(erring['ours_at_zero'])} of "
-            f"{erring['ours_runs']} runs and `ours-repair` lifts {lifted} of them above 0")
-
-
-def test_front_page_erring_line_is_the_centre_grids_claims():
-    assert _between(FRONT, "front erring") == front_erring_text()
+    with (ROOT / "data/results/ant/comparison.csv").open(newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if (r["method"], r["proposer"]) == ("ours", "geometric")]
+    legs, fail = {}, {}
+    for maze in PLAIN + SUBGOALS:
+        runs = [r for r in rows if r["maze"] == maze]
+        n_legs = sum(float(r["path_edges"]) for r in runs) / len(runs)
+        ok = sum(round(float(r["success_rate"]) * int(r["episodes"])) for r in runs)
+        legs[maze] = n_legs / int(maze.split("_")[2])
+        fail[maze] = 1 - (ok / sum(int(r["episodes"]) for r in runs)) ** (1 / n_legs)
+    rest = [m for m in PLAIN[1:] + SUBGOALS if m != "u_chain_5"]  # from two rooms on; U-chain 5 has doubled legs
+    assert " ".join(_between(FRONT, "front stage4 legs").split()) == (
+        f"{min(legs[m] for m in rest):.1f}-{max(legs[m] for m in rest):.1f} legs per room from two rooms on, each "
+        f"losing {100 * min(fail[m] for m in rest):.1f}-{100 * max(fail[m] for m in rest):.1f} % of the episodes "
+        f"(1 - success^(1/legs)); U-chain 5 without subgoals {legs['u_chain_5']:.1f} legs per room losing "
+        f"{100 * fail['u_chain_5']:.1f} % each")
+    text = " ".join(FRONT.split())
+    assert "no dependence on the direction of travel shown" in text
+    lo, hi = (float(x) for x in re.search(r"difference \S+ \[(\S+), (\S+)\]",
+                                          (ROOT / "data/results/ant/rotated_centre_check.md").read_text()).groups())
+    assert lo < 0 < hi  # a null result: no dependence shown, not none found
+    cost = json.loads((ROOT / "data/results/ant/scaling/cost_u_chain_5.json").read_text())
+    assert "--goal-points" not in cost["command"] and "d6a96ee" in cost["code"]
+    assert "A U-chain 5 run with the paper's sampled goal points (code d6a96ee" in text
+    point = {(s["maze"], s["method"]): s["success_mean"]
+             for s in summarise(read_table(ROOT / "data/results/results.csv")) if s["proposer"] == "geometric"}
+    assert (f"better on two_doors ({point['two_doors', 'vlm-oneshot']:.3f} against {point['two_doors', 'ours']:.3f})"
+            in text)
+    _, contrasts, _ = _offline()
+    mild, moderate = (contrasts[f"imperfect:{p}", "ours - ours-notune"] for p in ("mild", "moderate"))
+    assert (mild["verdict"], moderate["verdict"]) == ("higher", "undecided")
+    fmt = lambda c: f"{c['estimate']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"  # noqa: E731
+    assert _between(FRONT, "front notune") == (f"{fmt(mild)} at mild; at moderate, the one preset where the 2x claim "
+                                               f"holds, {fmt(moderate)}, undecided")
+    with (ROOT / "data/results/ant/comparison/row286_rerun.csv").open(newline="") as fh:
+        (rerun,) = csv.DictReader(fh)
+    with (ROOT / "data/results/ant/comparison.csv").open(newline="") as fh:
+        shipped = list(csv.DictReader(fh))[285]
+    assert rerun["cell"] == shipped["cell"] == "u_maze__ant__ours__geometric__s2__adaptive"
+    assert shipped["policy_fingerprint"] == ""
+    assert _between(FRONT, "front row286") == (
+        f"{float(rerun['success_rate']):.3f} with {rerun['evaluations']} evaluations and {rerun['refinements']} "
+        f"refinements, against the shipped {float(shipped['success_rate']):.3f} with {shipped['evaluations']} and "
+        f"{shipped['refinements']}")
+    with (ROOT / "data/results/ant/scaling/oneshot.csv").open(newline="") as fh:
+        assert len(list(csv.DictReader(fh))) == 54
+    doc = " ".join((ROOT / "docs/ant_experiments.md").read_text().split())
+    assert "53 of part 2's 54 cells" in doc and "16 x86-64 cores" in doc
+    assert "except 53 of the 54 runs of `data/results/ant/scaling/oneshot.csv`" in text
 
 
 def test_front_page_evaluator_ratio_is_the_shipped_benchmark():
@@ -577,3 +769,107 @@ def test_the_ant_gap_table_is_its_record():
     (sim_a, sim_f), (off_a, off_f), (pkg_a, pkg_f) = totals.values()
     assert (f"({pkg_a} wall contacts and {pkg_f} flips over the three runs, against {off_a} and {off_f} with "
             f"AntMaze's start; this simulator {sim_a} and {sim_f})") in " ".join(doc.split())
+
+
+def test_the_ant_gap_records_outcomes_agree_with_their_success_rates():
+    """One truth per entry: its outcomes add up to its episodes, and its successes are the episodes labelled
+    success plus those counted apart (a trajectory that met the task while the policy's run ended otherwise)."""
+    import json
+
+    spec = importlib.util.spec_from_file_location("official_gap_ant", ROOT / "scripts" / "official_gap_ant.py")
+    official_gap_ant = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(official_gap_ant)
+    record = json.loads((ROOT / "data/official/ant_gap.json").read_text())
+    assert official_gap_ant.UNLABELLED in record["note"]
+    apart = []
+    for name, entry in record["runs"].items():
+        for key, side in entry.items():
+            assert sum(side["outcomes"].values()) == side["episodes"], (name, key)
+            assert side == official_gap_ant.side(side), (name, key)  # what the script writes today
+            successes = round(side["success_rate"] * side["episodes"])
+            assert successes == side["outcomes"].get("success", 0) + side.get(official_gap_ant.UNLABELLED, 0)
+            apart += [side[official_gap_ant.UNLABELLED]] if official_gap_ant.UNLABELLED in side else []
+    assert apart == [1, 1] and "1 in each of 2 of the 24 entries" in record["note"]
+    assert sum(len(entry) for entry in record["runs"].values()) == 24
+
+
+def test_the_choices_numbers_are_their_tables():
+    """docs/choices.md's numbers for the goal-point rule, adaptive evaluation and the oracle's cap."""
+    import csv
+
+    def rows(table, **match):
+        with (ROOT / table).open(newline="") as fh:
+            return [r for r in csv.DictReader(fh) if all(r[k] == v for k, v in match.items())]
+
+    def pooled(runs, episodes=None):
+        return (sum(round(float(r["success_rate"]) * (episodes or int(r["episodes"]))) for r in runs),
+                sum(episodes or int(r["episodes"]) for r in runs))
+
+    doc = " ".join((ROOT / "docs/choices.md").read_text().split())
+    check = (ROOT / "data/results/ant/centre_check.md").read_text()
+    lever, base, diff = re.search(r"Pooled ([0-9.]+) .*? against ([0-9.]+) .*?: difference (\S+ \[\S+ \S+\])",
+                                  check).groups()
+    assert f"{base} sampled against {lever} centre, difference {diff}" in doc
+    cap48 = pooled(rows("data/results/ant/uchain5_cap48.csv"))
+    cap32 = pooled(rows("data/results/ant/comparison.csv", maze="u_chain_5", method="ours", proposer="geometric"))
+    assert f"{cap48[0]}/{cap48[1]} = {cap48[0] / cap48[1]:.3f} against {cap32[0]}/{cap32[1]} = " \
+           f"{cap32[0] / cap32[1]:.3f} with 32" in doc
+    held = {ev: rows("data/results/ant/adaptive_bench.csv", evaluation=ev) for ev in ("fixed", "adaptive")}
+    held = {ev: [r for r in runs if r["seed"] in ("1", "2")] for ev, runs in held.items()}  # seed 0 informed it
+    ratio = {k: sum(float(r[k]) for r in held["fixed"]) / sum(float(r[k]) for r in held["adaptive"])
+             for k in ("sim_steps", "wall_seconds")}
+    (ka, na), (kf, nf) = (pooled(held[ev], episodes=200) for ev in ("adaptive", "fixed"))
+    assert (f"{ratio['sim_steps']:.2f}x fewer simulator steps and {ratio['wall_seconds']:.2f}x less wall time on the "
+            f"held-out Ant runs at equal success ({ka}/{na} adaptive against {kf}/{nf} fixed") in doc
+
+
+def test_the_stage5_section_is_its_csvs():
+    """docs/results.md's stage-5 table and the numbers under it, from the CSVs as the front page's."""
+    centre, sampled = _csv_runs(CENTRE), _csv_runs(SAMPLED)
+    columns = [(sampled, "ours"), (sampled, "vlm-oneshot"), (centre, "ours"), (centre, "vlm-oneshot")]
+    rates = [_rates(runs, method, ORACLE, SCALING) for runs, method in columns]
+    lines = ["| maze | ours, sampled | vlm-oneshot, sampled | ours, centre | vlm-oneshot, centre |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {maze} | " + " | ".join(f"{r[i]:.3f}" for r in rates) + " |" for i, maze in enumerate(SCALING)]
+    lines.append("| change 1→5 rooms | " + " | ".join(f"{_change(_room_values(runs, method, ORACLE)):+.3f}"
+                                                    for runs, method in columns) + " |")
+    assert "<!-- stage 5 table -->\n" + "\n".join(lines) + "\n" in README
+    text = " ".join(README.split())
+    assert [m for m, r in zip(SCALING, rates[0]) if r >= 0.90] == ["u_chain_1", "u_chain_2"]
+    assert "With sampled goal points `ours` reaches 0.90 only on U-chain 1 and 2" in text
+    for marker in ("front sampled grid", "front centre grid"):  # the same intervals as the front page's
+        change = re.search(r"change from 1 to 5 rooms (\S+ \[\S+ \S+\])", _between(FRONT, marker)).group(1)
+        assert change in text, marker
+    assert _between(FRONT, "front centre oneshot").endswith("the same success as `ours` in 23 of the 27 runs")
+    assert "the same success in 23 of the 27 runs" in text
+    erring, alone = _between(FRONT, "front erring"), _between(FRONT, "front erring ours")
+    best = re.match(r"(\S+)x the one-shot (\[\S+ \S+\])", erring).groups()
+    assert f"reaches {best[0]}x the one-shot's mean success on the multi-room mazes {best[1]}; `ours` alone {alone}" \
+           in text
+    zeros, lifted = re.search(r"at 0 in (\d+) of 27 runs and `ours-repair` lifts (\d+)", erring).groups()
+    assert f"`ours` ends at 0 in {zeros} of its 27 runs, {lifted} of which `ours-repair` lifts above 0" in text
+    rotated = _between(FRONT, "front rotated").replace(", difference", " on the original, difference")
+    assert rotated in text
+    centre_check = _between(FRONT, "front centre").split(", difference")[0]
+    assert f"helps, {centre_check})" in text
+
+
+def test_the_offline_comparison_counts_its_rows_by_code():
+    import csv
+    from collections import Counter
+
+    with (ROOT / "data/results/imperfect/results.csv").open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    first = Counter(r["method"] for r in rows[:1360])
+    later = Counter(r["method"] for r in rows[1360:])
+    assert set(first) == {"ours", "ours-nosearchvertex", "ours-d1", "vlm-oneshot", "vlm-oneshot-matched"}
+    assert set(later) == {"ours-novertex", "ours-notune", "ours-nofeedback"} and set(first.values()) == {272}
+    assert len(first) == 5
+    assert all(r["status"] == "ok" for r in rows)
+    assert " ".join(_between(README, "imperfect rows").split()) == (
+        f"{len(rows)} runs in `results.csv`, none failed: {sum(first.values())} of five methods run with "
+        f"commit 1461726 and {sum(later.values())} of the three redefined controls run with commit 309875a")
+    readme = " ".join((ROOT / "data/results/README.md").read_text().split())
+    assert (f"**rows 1-{sum(first.values())}** (272 each of `ours`, `ours-nosearchvertex`, `ours-d1`, `vlm-oneshot`, "
+            f"`vlm-oneshot-matched`) ran with commit **1461726**") in readme
+    assert f"**rows {sum(first.values()) + 1}-{len(rows)}** (272 each of the redefined" in readme

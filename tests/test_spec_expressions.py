@@ -12,7 +12,7 @@ from specrefine.core.errors import MazeError, SpecError, SpecrefineError
 from specrefine.core.graph import TaskGraph
 from specrefine.core.mazes import load_maze, parse_maze
 from specrefine.core.spec import SpecSyntaxError, chain_text, maze_spec_text, maze_task, parse_spec
-from specrefine.runs.sweep import COLUMNS, Cell, _append, grid, read_table, run_sweep, summarise
+from specrefine.runs.sweep import COLUMNS, PROVENANCE, Cell, _append, grid, read_table, run_sweep, summarise
 
 # a b c subgoals, one goal; every region reachable
 TEXT = """\
@@ -224,7 +224,8 @@ def test_rows_go_into_an_older_table_in_its_own_columns(tmp_path):
     _append(old, {"cell": "x", "maze": "u_maze", "status": "ok", "spec": ""})
     with old.open() as fh:
         header, row = list(csv.reader(fh))
-    assert header == COLUMNS[:COLUMNS.index("spec")] and row[0] == "x" and len(row) == len(header)
+    # its own columns, and the provenance columns every row records (policy_fingerprint, commit)
+    assert header == COLUMNS[:COLUMNS.index("spec")] + list(PROVENANCE) and row[0] == "x" and len(row) == len(header)
     with pytest.raises(ValueError, match="no 'spec' column"):
         _append(old, {"cell": "y", "maze": "u_maze", "status": "ok", "spec": "G"})
 

@@ -2,11 +2,14 @@
 
 In a checkout (editable install, ``PYTHONPATH``) they are the top-level ``prompts/`` and ``data/``
 beside ``specrefine/``; a built wheel carries the same files as ``specrefine/_shipped/{prompts,data}``
-(see ``setup.py``).  The checkout wins when both exist.
+(see ``setup.py``).  The checkout wins when both exist.  :func:`code_commit` names the checkout's commit, so
+that a result can say which code made it.
 """
 
 from __future__ import annotations
 
+import functools
+import subprocess
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parents[1]  # specrefine/, above core/
@@ -25,6 +28,25 @@ def prompt_dir() -> Path:
 
 def data_dir() -> Path:
     return _find("data")
+
+
+@functools.lru_cache(maxsize=1)
+def code_commit() -> str:
+    """The commit this package's code runs from (``git rev-parse --short=7 HEAD`` of its checkout or worktree), with
+    ``-dirty`` when tracked files under ``specrefine/`` differ from it; ``unknown`` where the package is not the
+    top of a git checkout (an installed wheel) or git is missing.  Asked once per process."""
+    def git(*args) -> str:
+        return subprocess.run(["git", "-C", str(_CHECKOUT), *args], capture_output=True, text=True, check=True,
+                              timeout=30).stdout.strip()
+
+    try:
+        if Path(git("rev-parse", "--show-toplevel")).resolve() != _CHECKOUT:  # a wheel inside someone's repo
+            return "unknown"
+        commit = git("rev-parse", "--short=7", "HEAD")
+        dirty = git("status", "--porcelain", "--untracked-files=no", "--", str(_PACKAGE))
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return f"{commit}-dirty" if dirty else commit
 
 
 def regular_file(path, what: str = "file") -> Path:

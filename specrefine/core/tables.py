@@ -94,7 +94,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-_TEXT = ("policy_fingerprint",)  # hex digests: "123e45678901" must not become a float
+_TEXT = ("policy_fingerprint", "commit")  # hex digests: "123e45678901" or "1461726" must not become a number
 
 
 def _typed(row: dict) -> dict:

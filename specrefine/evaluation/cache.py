@@ -22,18 +22,16 @@ log = logging.getLogger(__name__)
 
 
 class ResultCache:
-    """Counters: ``hits`` (answered from memory or disk), ``disk_hits`` (read from the folder), ``cached_steps``
-    (environment steps of disk entries this process never simulated, each counted once)."""
+    """Counters: ``hits`` (answered from memory or disk), ``disk_hits`` (read from the folder)."""
 
     def __init__(self, folder=None, memo_size: int = 512):
         self.folder = Path(folder) if folder is not None else None
         self.memo_size = memo_size
         self.hits = 0
         self.disk_hits = 0
-        self.cached_steps = 0
         self._memo: OrderedDict[str, EdgeResult] = OrderedDict()
         self._simulated: set[str] = set()
-        self._steps_counted: set[str] = set()
+        self._read_back: set[str] = set()
 
     def lookup(self, key: str, text: str, disk: bool) -> EdgeResult | None:
         """The stored result of ``key`` (marked cached), from memory, else from disk when ``disk``; None if absent."""
@@ -42,14 +40,19 @@ class ResultCache:
             self._memo.move_to_end(key)
         elif disk and (hit := self._load(key, text)) is not None:
             self.disk_hits += 1
-            if key not in self._simulated and key not in self._steps_counted:
-                self._steps_counted.add(key)
-                self.cached_steps += hit.steps
             self._remember(key, replace(hit, cached=False))
         if hit is None:
             return None
         self.hits += 1
         return replace(hit, cached=True)
+
+    def first_read(self, key: str) -> bool:
+        """True the first time ``key``, found by :meth:`lookup`, is work this process never simulated (an earlier run
+        of the same folder did), else False: each such result is counted once, where a run in one go simulated it."""
+        if key in self._simulated or key in self._read_back:
+            return False
+        self._read_back.add(key)
+        return True
 
     def add(self, key: str, text: str, res: EdgeResult, disk: bool) -> None:
         """A result just simulated: kept in memory, and on disk when ``disk``."""

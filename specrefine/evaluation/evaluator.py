@@ -59,7 +59,7 @@ from ..core.results import (
     wilson_ci,
 )
 from .cache import ResultCache
-from .rollouts import Controls, Plan, RolloutLoop
+from .rollouts import Controls, Plan, RolloutLoop, rows_stepped
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
@@ -143,6 +143,7 @@ class Evaluator:
         self.cache = ResultCache(cache_dir, self.MEMO_SIZE)
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
+        self.run_steps = 0  # the same, as a run in one go would have simulated them (cache_dir's earlier work too)
         self._act = policy.act if hasattr(policy, "act") else policy
         self.observation_frame = getattr(policy, "observation_frame", "world")
         self._sims: dict[int, object] = {}
@@ -168,9 +169,9 @@ class Evaluator:
     @property
     def cached_steps(self) -> int:
         """Environment steps of the evaluations read from cache_dir that this process never simulated (an earlier run
-        of the same folder did): each counted once, so sim_steps + cached_steps is the same for a run done in one go
-        and one resumed after a kill."""
-        return self.cache.cached_steps
+        of the same folder did), each counted once and as the batch that simulated it stepped it: sim_steps +
+        cached_steps (``run_steps``) is the same for a run done in one go, one resumed after a kill and a rerun."""
+        return self.run_steps - self.sim_steps
 
     @property
     def control_period(self) -> float:
@@ -290,6 +291,7 @@ class Evaluator:
         fp = self.policy_fingerprint  # hashed once per call (it hashes the weights); None: no disk cache
         results: list[EdgeResult | None] = [None] * len(subtasks)
         todo: dict[str, tuple] = {}  # key -> (text, task, positions)
+        one_go: dict[str, int] = {}  # key -> position: what a run in one go simulates here, in its order
         for i, (start, goal, avoid, goal_point) in enumerate(subtasks):
             legs = [(goal, avoid, self.aim(goal, goal_point))]  # a centre is keyed as the fixed point it is
             key, text = self._key("edge", start, legs, n, seed, fp)
@@ -297,11 +299,14 @@ class Evaluator:
                 todo[key][2].append(i)
             elif (hit := self.cache.lookup(key, text, disk=fp is not None)) is not None:
                 results[i] = hit
+                if self.cache.first_read(key):
+                    one_go[key] = i
             elif isinstance(start, StartStates) and len(start) == 0:
                 # nothing reached the start: p = 0, nothing run
                 results[i] = unreached(start.states.shape[1] if start.states.ndim == 2 else 0)
             else:
                 todo[key] = (text, (start, legs, n, seed), [i])
+                one_go[key] = i
         batch = max(1, self.MAX_EPISODES // n)
         pending = list(todo.items())
         for lo in range(0, len(pending), batch):
@@ -314,6 +319,10 @@ class Evaluator:
                 for i in positions[1:]:
                     self.cache.hits += 1
                     results[i] = replace(res, cached=True)
+        firsts = list(one_go.values())
+        for lo in range(0, len(firsts), batch):
+            self.run_steps += rows_stepped(np.concatenate([results[i].lengths for i in firsts[lo:lo + batch]]),
+                                           self.MIN_BATCH)
         return results
 
     def evaluate_edge(self, graph, u: str, v: str, start: Region | StartStates | None = None, seed=None,
@@ -336,6 +345,7 @@ class Evaluator:
         if not legs:
             raise SpecrefineError("run_compositional needs at least one leg")
         out = self._rollout(start, legs, n, seed)
+        self.run_steps += rows_stepped(out["lengths"], self.MIN_BATCH)
         success = out["legs_done"] == len(legs)
         k = int(success.sum())
         return CompositionalResult(p=k / n, ci=wilson_ci(k, n), n=n, successes=k, success=success,

@@ -155,8 +155,8 @@ class RolloutLoop:
 
     def _compact(self, running: int) -> None:
         """Move the running episodes into a smaller batch once they fill at most half of the sim."""
-        size = max(self.c.min_batch, 1 << (running - 1).bit_length())
-        if size > self.sim.n // 2:
+        size = compacted(self.sim.n, running, self.c.min_batch)
+        if size == self.sim.n:
             return
         ids = np.flatnonzero(self.active)
         states = self.sim.get_state()[self.row[ids]]
@@ -191,3 +191,26 @@ class RolloutLoop:
         return {"legs_done": self.leg[rows], "trajectories": self.traj[rows][np.arange(n)[:, None], pad],
                 "lengths": lengths, "outcome": self.outcome[rows], "end_states": self.end_states[rows],
                 "end_xy": self.end_xy[rows], "steps": steps}
+
+
+def compacted(rows: int, running: int, min_batch: int) -> int:
+    """The rows of the sim that ``running`` episodes continue in from a sim of ``rows``: a power of two (at least
+    ``min_batch``) once they fill at most half of it, else the same sim."""
+    size = max(min_batch, 1 << (running - 1).bit_length())
+    return size if size <= rows // 2 else rows
+
+
+def rows_stepped(lengths, min_batch: int) -> int:
+    """The rows a :class:`RolloutLoop` steps (its ``sim_steps``: padding and finished rows included) for episodes of
+    these ``lengths`` run side by side from a sim of ``len(lengths)`` rounded up to ``min_batch``.  A batch's cost
+    follows from its episodes' lengths alone, so work read back from a cache is counted as the run that simulated it
+    counted it."""
+    lengths = np.asarray(lengths, dtype=np.int64)
+    running = len(lengths) - np.cumsum(np.bincount(lengths))  # running[t]: episodes still going before step t
+    rows, total = -(-len(lengths) // min_batch) * min_batch, 0
+    for still in running[1:]:
+        if not still:
+            break
+        rows = compacted(rows, int(still), min_batch)
+        total += rows
+    return total

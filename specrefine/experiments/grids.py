@@ -190,6 +190,17 @@ CONTROLS = ("ours-novertex", "ours-notune", "ours-nofeedback")
 U_CHAINS = tuple(f"u_chain_{n}" for n in range(1, 6))
 SUBGOALS = tuple(f"u_chain_{n}_subgoals" for n in range(2, 6))
 GEOMETRIC_48 = "geometric:max_waypoints=48"
+OTHER_POINT_MAZES = ("hazard_pool", "or_maze", "split_doorway", "two_doors", "u_maze", "x_maze", "xx_maze_h",
+                     "xx_maze_v")  # the point suite beside the U-chains
+HELD_OUT_MAZES = ("data/mazes/unseen/spiral.maze", "data/mazes/unseen/zigzag.maze",
+                  "data/mazes/unseen/detour_subgoal.maze", "data/mazes/unseen/pillars.maze", "random:3x4:7",
+                  "random:4x4:11")
+#: error mixes no method was developed on: (A) small regions pulled to corners and false openings, (B) dropped
+#: turns growing with the span of a query, mirrored replies and wrong branches
+HELD_OUT_MIXES = ("imperfect:position_sigma=0.35,radius=0.3,radius_log_sigma=0.6,corner_pull=0.5,"
+                  "p_false_opening=0.3,p_wrong_branch=0.1,p_drop_turn=0.1,p_uncapped=0.3,p_unparseable=0.05,rho=0.5",
+                  "imperfect:position_sigma=0.2,radius_log_sigma=0.3,p_drop_turn=0.35,p_uncapped=0.7,alpha=0.2,"
+                  "p_mirror_y=0.1,p_wrong_branch=0.3,rho=0.3")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -320,6 +331,32 @@ GRIDS = {g.name: g for g in (
         mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
         policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre",
         table="data/results/ant/antmaze_centre.csv", out="runs/antmaze_centre", code="d3488cc"),
+    ExperimentGrid(
+        "taxonomy", "docs/corrector.md, 'The failure taxonomy' (issue 39; fixed 2026-11-27 before it ran)", "point",
+        parts=(Part(("ours",), ("geometric",), table="data/results/corrector/taxonomy_oracle.csv", out="oracle"),
+               Part(("ours", "ours-repair"), IMPERFECT[:3], split="proposers")),
+        seeds=(0, 1, 2, 3), workers=1, code="ceaa05f", table="data/results/corrector/taxonomy.csv",
+        out="runs/taxonomy"),
+    ExperimentGrid(
+        "corrector", "docs/corrector.md, 'The grids' (issue 39; fixed 2026-11-27 before its first cell ran)", "point",
+        parts=(Part(("ours-corrector", "vlm-oneshot"), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                    split="proposers"),
+               Part(("ours-corrector",), ("imperfect:severe",), mazes=SCALING_MAZES),
+               Part(("ours-corrector",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES)),
+        seeds=(0, 1, 2, 3), workers=1, code="5356175", table="data/results/corrector/point.csv",
+        out="runs/corrector"),
+    ExperimentGrid(
+        "corrector-held-out", "docs/corrector.md, 'Held out' (issue 39; fixed 2026-11-27 before its first cell ran)",
+        "point",
+        parts=(Part(("ours",), ("geometric",), table="data/results/corrector/held_out_oracle.csv", out="oracle"),
+               Part(("ours", "ours-corrector"), HELD_OUT_MIXES)),
+        seeds=(0, 1), mazes=HELD_OUT_MAZES, workers=1, code="5356175",
+        table="data/results/corrector/held_out.csv", out="runs/corrector_held_out"),
+    ExperimentGrid(
+        "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
+        parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
+        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
+        workers=1, code="5356175", table="data/results/corrector/ant.csv", out="runs/ant_corrector"),
 )}
 
 
@@ -359,44 +396,55 @@ def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, li
     return out
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, bounded_int
+def add_arguments(p) -> None:
+    from ..core.argtypes import bounded_int
 
-    p = OneLineParser(prog="python -m specrefine.experiments.grids", description=__doc__.split("\n")[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    p.description = __doc__.split("\n")[0]
+    sub = p.add_subparsers(dest="grids_command", required=True, metavar="{list,show,args,plan,status}")
     sub.add_parser("list", help="every grid: name, agent, cells, where it was fixed")
     for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),
                        ("args", "one step's sweep arguments, shell-quoted on one line"),
                        ("plan", "the code and steps run_grid.sh runs"),
                        ("status", "cells done per part, from the shipped tables (--missing: which are not)")):
-        sp = sub.add_parser(name, help=what)
-        sp.add_argument("grid")
+        sp = sub.add_parser(name, help=what, description=what)
+        sp.add_argument("grid", help="a grid's name (specrefine grids list)")
         if name == "args":
-            sp.add_argument("--part", type=int, required=True)
-            sp.add_argument("--step", type=int, default=0)
-            sp.add_argument("--workers", type=bounded_int("workers"), default=None)
+            sp.add_argument("--part", type=int, required=True, help="the part, from 0 (required)")
+            sp.add_argument("--step", type=int, default=0, help="the step of the part, from 0")
+            sp.add_argument("--workers", type=bounded_int("workers"), default=None,
+                            help="local processes of the sweep (default: the grid's)")
         if name == "status":
             sp.add_argument("--missing", action="store_true", help="list the cells still to run")
         if name == "plan":
-            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it)")
-            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids)")
-    args = p.parse_args(argv)
+            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it) "
+                                                        "(default: the grid's)")
+            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids) "
+                                                            "(default: the grid's)")
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("grids", argv, prog="python -m specrefine.experiments.grids")
+
+
+def run(args, p) -> int:
     try:
-        if args.command == "list":
+        if args.grids_command == "list":
             for g in GRIDS.values():
                 print(f"{g.name}\t{g.agent}\t{len(cells(g))} cells\t{g.doc}")
             return 0
         g = get(args.grid)
-        if args.command == "show":
+        if args.grids_command == "show":
             print("\n".join(show(g)))
-        elif args.command == "status":
+        elif args.grids_command == "status":
             for i, done, total, missing in status(g):
                 part = g.parts[i]
                 print(f"part {i}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {done}/{total} done "
                       f"({g.part_table(i)})")
                 if args.missing:
                     print("".join(f"  {cell}\n" for cell in missing), end="")
-        elif args.command == "plan":
+        elif args.grids_command == "plan":
             print("\n".join(plan(g, args.out, args.shipped)))
         else:
             steps = sweep_args(g, args.part, workers=args.workers)

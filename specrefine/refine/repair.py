@@ -31,16 +31,23 @@ def cheapest(candidates: list[SplitCandidate], n: int) -> SplitCandidate:
 
 
 def repair(candidate: SplitCandidate, graph: TaskGraph, u: str, v: str, *, start, evaluator: SubtaskEvaluator,
-           split_leg: SplitLeg, may_split: Callable[[], bool]) -> SplitCandidate | None:
+           split_leg: SplitLeg, may_split: Callable[[], bool], depth: int = 1) -> SplitCandidate | None:
     """``candidate`` (a split of u -> v in ``graph``, started from ``start``) with its failing legs split once
-    more, first to last; None when no leg could be repaired. ``may_split()``: whether the budget allows a split."""
+    more, first to last; None when no leg could be repaired. ``may_split()``: whether the budget allows a split.
+    ``depth`` > 1: a leg's split that has a dead leg of its own is repaired in turn, to that many levels
+    (method ``ours-corrector``; ``ours-repair`` repairs one level)."""
     waypoints, results = list(candidate.waypoints), list(candidate.results)
     repaired, i = 0, _first_failing(results, 0)
     while i is not None and may_split():
         chain_graph = graph.copy()
         chain = [u, *chain_graph.split_edge(u, v, waypoints), v]
         leg_start = start_of(results[i - 1]) if i else start
-        fix = split_leg(chain_graph, chain[i], chain[i + 1], results[i], leg_start).best
+        outcome = split_leg(chain_graph, chain[i], chain[i + 1], results[i], leg_start)
+        fix = outcome.best
+        if fix is not None and fix.p <= 0.0 and depth > 1 and outcome.candidates:
+            fix = repair(cheapest(outcome.candidates, evaluator.n), chain_graph, chain[i], chain[i + 1],
+                         start=leg_start, evaluator=evaluator, split_leg=split_leg, may_split=may_split,
+                         depth=depth - 1)
         if fix is None or fix.p <= 0.0:
             break
         waypoints[i:i] = fix.waypoints

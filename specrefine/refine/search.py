@@ -31,6 +31,7 @@ import numpy as np
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
+from .correct import CHECK_SEED_OFFSET, correct
 from .edge_split import SplitCandidate, edge_split
 from .polish import polish
 from .racing import Racing
@@ -61,10 +62,39 @@ class SearchConfig:
     repair_tuning: bool = False  # beyond the paper: Algorithm 2 on a repaired chain before it is judged
     shortcut_reach: float | None = None  # beyond the paper: shortcut edges up to this long on the path (shortcut.py)
     polish_rollouts: int | None = None  # beyond the paper: the path's weak waypoints tuned on this many rollouts
+    repair_depth: int = 1  # beyond the paper: levels of repair (a repaired leg's split with a dead leg of its own)
+    correct_rollouts: int | None = None  # beyond the paper: the found path checked on this many x n fresh rollouts
+    #                                      per leg and its weak legs corrected (correct.py; method ours-corrector)
+    correct_splits_per_leg: float = 1.0  # the correction's proposer splits: this many per leg of the found path
+    dead_weight: float | None = None  # beyond the paper: the weight of a leg that never succeeded (None: -log(0.5/n))
+    correct_reach: float | None = None  # the correction drops a waypoint only where the leg it makes is this short
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
+
+    @classmethod
+    def from_run(cls, run, **changes) -> SearchConfig:
+        """The search a run's configuration asks for (``run``: a resolved ``runs.config.RunConfig``: its w, d, k,
+        seed and evaluation), with ``changes`` to any field; an unknown field is a one-line SpecrefineError."""
+        check_changes(changes)
+        taken = {name: getattr(run, name) for name in FROM_RUN}
+        return cls(**{**taken, **changes})
+
+
+FROM_RUN = ("w", "d", "k", "seed", "evaluation")  # what a run's configuration sets in its search
+
+
+def check_changes(changes: dict) -> None:
+    """A one-line SpecrefineError if ``changes`` names a field SearchConfig does not have."""
+    from dataclasses import fields
+
+    from ..core.errors import SpecrefineError
+
+    unknown = sorted(set(changes) - {f.name for f in fields(SearchConfig)})
+    if unknown:
+        raise SpecrefineError(f"SearchConfig has no field {', '.join(map(repr, unknown))}: use "
+                              f"{', '.join(f.name for f in fields(SearchConfig))}")
 
 
 @dataclass
@@ -147,8 +177,12 @@ class RefinementSearch:
             path = self._shortcut(path)
         if path and self.cfg.polish_rollouts:
             self._polish(path)
+        if path and self.cfg.correct_rollouts:
+            path = self._correct(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
-        self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0)
+        self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
+                  probabilities=probs, splits_generated=self.splits_generated,
+                  max_edge_splits=self.cfg.max_edge_splits)
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
                             self.vertex_generated)
 
@@ -161,10 +195,17 @@ class RefinementSearch:
             result = self._evaluate(f.arrivals[u], v, (u, v))
             self.results[(u, v)] = result
             self._log("evaluate", edge=[u, v], p=result.p, ci=list(result.ci))
-        c = f.cost[u] + weight(result.p, self.evaluator.n)
+        c = f.cost[u] + self._weight(result.p)
         if v not in f.open or c < f.cost[v]:
             f.cost[v], f.parent[v], f.arrivals[v] = c, u, start_of(result)
             f.open.add(v)
+
+    def _weight(self, p: float) -> float:
+        """An edge's weight: -log p, with p = 0 guarded by half a success in n rollouts (the paper's search) or,
+        given ``dead_weight``, weighing that much, so that any chain that succeeds at all beats one that never does."""
+        if p <= 0.0 and self.cfg.dead_weight is not None:
+            return self.cfg.dead_weight
+        return weight(p, self.evaluator.n)
 
     def _evaluate(self, start, v: str, edge):
         g = self.graph
@@ -236,19 +277,21 @@ class RefinementSearch:
             return None
         if self.cfg.repair and best.p == 0.0:
             best = self._repair(u, v, cheapest(outcome.candidates, self.evaluator.n)) or best
-        cost = f.cost[u] + sum(weight(p, self.evaluator.n) for p in best.probabilities)
+        cost = f.cost[u] + sum(self._weight(p) for p in best.probabilities)
         return Refinement("split", u, v, cost, best)
 
-    def _repair(self, u, v, candidate):
-        def split_leg(chain_graph, a, b, result, start):
-            self.splits_generated += 1
-            return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
-                              goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=self.cfg.d, k=self.cfg.k,
-                              rng=self.rng, picture=self.picture, racing=self.racing,
-                              feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
+    def _split_leg(self, chain_graph, a, b, result, start):
+        """Algorithm 1 on a -> b of ``chain_graph`` (a leg of a candidate or of the found path), from ``start``."""
+        self.splits_generated += 1
+        return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
+                          goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=self.cfg.d, k=self.cfg.k,
+                          rng=self.rng, picture=self.picture, racing=self.racing,
+                          feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
 
+    def _repair(self, u, v, candidate):
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,
-                          split_leg=split_leg, may_split=lambda: self.splits_generated < self.cfg.max_edge_splits)
+                          split_leg=self._split_leg, may_split=lambda: self.splits_generated < self.cfg.max_edge_splits,
+                          depth=self.cfg.repair_depth)
         after = dict(p_after=repaired.probabilities, legs_repaired=repaired.repaired,
                      waypoints=[x.to_dict() for x in repaired.waypoints]) if repaired else \
             dict(p_after=None, legs_repaired=0, waypoints=None)
@@ -277,8 +320,7 @@ class RefinementSearch:
         current = estimate_legs(self.evaluator, f.arrivals[u],
                                 [Leg(g.region(v), avoids[0], g.goal_point(v)), Leg(g.region(w), avoids[1],
                                                                                    g.goal_point(w))])
-        n = self.evaluator.n
-        gain = current.cost(n) - sum(weight(r.p, n) for r in choice.results)
+        gain = sum(self._weight(r.p) for r in current.results) - sum(self._weight(r.p) for r in choice.results)
         self._log("vertex-generated", vertex=v, p_current=current.p, p_best=choice.p,
                   region=choice.regions[0].to_dict())
         if choice.regions[0] == g.region(v) or gain <= 0:
@@ -325,9 +367,37 @@ class RefinementSearch:
         for edge, result in zip(zip(path, path[1:]), estimate_legs(self.evaluator, g.region(path[0]), legs).results):
             self.results[edge] = result
 
+    # --- beyond the paper: correcting the found path on fresh rollouts (correct.py) ------
+    def _correct(self, path: list[str]) -> list[str]:
+        n, budget = self.evaluator.n, self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg *
+                                                                         (len(path) - 1))
+
+        def split_leg(graph, a, b, result, start):
+            outcome = self._split_leg(graph, a, b, result, start)
+            best = outcome.best
+            if best is not None and best.p == 0.0 and self.cfg.repair:
+                best = repair(cheapest(outcome.candidates, n), graph, a, b, start=start, evaluator=self.evaluator,
+                              split_leg=self._split_leg, may_split=lambda: self.splits_generated < budget,
+                              depth=self.cfg.repair_depth) or best
+            return best
+
+        reach = self.cfg.correct_reach or 0.0
+        self.graph, path, _ = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
+                                      seed=self.cfg.seed + CHECK_SEED_OFFSET, split_leg=split_leg,
+                                      may_split=lambda: self.splits_generated < budget, reach=reach,
+                                      clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log)
+        assert_refines(self.graph, self.original)
+        # the corrected path's estimates on the search's own rollouts, so that its prediction is made as before
+        legs = [Leg(self.graph.region(b), self.graph.avoid(a, b), self.graph.goal_point(b))
+                for a, b in zip(path, path[1:])]
+        estimates = estimate_legs(self.evaluator, self.graph.region(path[0]), legs).results
+        for edge, result in zip(zip(path, path[1:]), estimates):
+            self.results[edge] = result
+        return path
+
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
     def _shortcut(self, path: list[str]) -> list[str]:
-        g, n = self.graph, self.evaluator.n
+        g = self.graph
         found = shortcuts(g, path, self.cfg.shortcut_reach, getattr(self.evaluator, "clearance", 0.0))
         if not found:
             return path
@@ -340,7 +410,7 @@ class RefinementSearch:
             for i in into[j]:
                 start = arrivals[i]
                 result = UNREACHED if start is None else self._evaluate(start, path[j], (path[i], path[j]))
-                options.append((cost[i] + weight(result.p, n), i, result))
+                options.append((cost[i] + self._weight(result.p), i, result))
             # a tie keeps the found path's leg (the larger i): 32 of 32 rollouts cannot tell a leg that loses 2 % from
             # one that loses none, and giving ties to the longer legs lost 0.207 of the Ant's episodes on U-chain 3
             # and 5 (docs/ant_experiments.md section 5, 'B with G, the tie fixed')

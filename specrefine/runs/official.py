@@ -40,15 +40,17 @@ import json
 import time
 from pathlib import Path
 
+import gymnasium
 import numpy as np
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
-from ..core.paths import regular_file
+from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import output_file, write_atomic, writing_into
 from ..core.standard_maps import to_gymnasium
-from ..evaluation.compositional import CompositionalPolicy, agent_xy, torso_flipped
+from ..evaluation.compositional import CompositionalPolicy
+from ..evaluation.gym_wrapper import TaskJudge
 from .progress import counted
 
 OFFICIAL_JSON = "official.json"
@@ -88,15 +90,47 @@ def make_env(maze, agent: str, max_episode_steps: int):
                     reset_target=False, max_episode_steps=max_episode_steps, **extra)
 
 
+def judged_env(run_dir, seed=None, *, start: str = "official", reset_noise: str = "official",
+               max_episode_steps: int | None = None) -> TaskJudge:
+    """The official environment of a finished run, judged as ``specrefine official`` judges it: a
+    :class:`~specrefine.evaluation.gym_wrapper.TaskJudge` (its ``policy`` the run's, matched to the environment's
+    step) on the run's ORIGINAL task.  ``seed``: the episodes' start cells and goal points; ``start`` /
+    ``reset_noise``: whose reset rule (module docstring); ``max_episode_steps``: default, never before the run's
+    own time limit."""
+    for name, rule in (("start", start), ("reset_noise", reset_noise)):
+        if rule not in RESET_RULES:
+            raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
+    run_dir = Path(run_dir)
+    result = _read_result(run_dir)
+    original = _original_task(run_dir, result)
+    policy = CompositionalPolicy.load(run_dir)
+    agent, maze = policy.agent, policy.maze
+    if (result["agent"], result["maze"]) != (agent, maze.name):
+        raise SpecrefineError(f"{run_dir}: result.json is of the {result['agent']} in {result['maze']!r:.40}, "
+                              f"policy.json of the {agent} in {maze.name!r:.40}: not one run's records")
+    if agent not in ENVIRONMENTS:
+        raise SpecrefineError(f"{run_dir}: no official Gymnasium-Robotics environment for the {agent}")
+    probe = make_env(maze, agent, 1)
+    policy.match_env_dt(probe.unwrapped.model.opt.timestep * _inner(probe).frame_skip)
+    probe.close()
+    env = make_env(maze, agent, max_episode_steps or episode_steps(policy))
+    if start == "package" or reset_noise == "package":
+        env = PackageReset(env, policy, original.region(original.initial) if start == "package" else None,
+                           reset_noise == "package", np.random.default_rng([seed or 0, 1]))
+    return TaskJudge(env, policy, original, seed=seed)
+
+
+def episode_steps(policy: CompositionalPolicy) -> int:
+    """Environment steps that never cut an episode before the run's own time limit (every leg's horizon)."""
+    return len(policy.legs) * policy.horizon * policy.hold + 1
+
+
 def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "official",
                  reset_noise: str = "official", out=None) -> dict:
     """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``
     (or ``out``).  ``start`` / ``reset_noise``: "official" (the environment's own) or "package" (this package's
     rule, module docstring)."""
     t0 = time.time()
-    for name, rule in (("start", start), ("reset_noise", reset_noise)):
-        if rule not in RESET_RULES:
-            raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
     run_dir = Path(run_dir)
     result = _read_result(run_dir)
     target = run_dir / OFFICIAL_JSON if out is None else Path(out)
@@ -108,53 +142,32 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
 
 def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, reset_noise: str, target: Path,
          t0: float) -> dict:
-    from ..core.graph import TaskGraph
+    """``run_official``'s episodes and record, once its outputs are checked (and its run folder's lock held)."""
     from ..evaluation.evaluator import _torch_threads
-    from ..evaluation.monitor import satisfies
 
-    policy = CompositionalPolicy.load(run_dir)
-    agent, maze = policy.agent, policy.maze
-    if agent not in ENVIRONMENTS:
-        raise SpecrefineError(f"{run_dir}: no official Gymnasium-Robotics environment for the {agent}")
-    try:
-        original = TaskGraph.from_dict(result["input_graph"])
-    except (KeyError, TypeError, ValueError) as exc:
-        raise SpecrefineError(f"{run_dir / 'result.json'}: no usable input_graph ({type(exc).__name__})") from None
-    probe = make_env(maze, agent, 1)
-    policy.match_env_dt(probe.unwrapped.model.opt.timestep * _inner(probe).frame_skip)
-    probe.close()
-    max_steps = len(policy.legs) * policy.horizon * policy.hold + 1
-    env = make_env(maze, agent, max_steps)
-    starts, goal = maze.cells("S"), maze.cells("G")[0]
-    rng = np.random.default_rng(seed)
-    reset_rng = np.random.default_rng([seed, 1])  # the package's reset rules draw apart from the episodes
-    start_region = original.region(original.initial)
+    sim = {f"sim_{key}": result.get(key) for key in ("success_rate", "success_ci", "episodes")}  # the run's own
+    sim = sim if None not in sim.values() else dict.fromkeys(sim)  # measurement, whole or not at all
+    env = judged_env(run_dir, seed, start=start, reset_noise=reset_noise)
+    policy, maze = env.policy, env.policy.maze
     success, outcomes = [], {}
     interrupted = False
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
         try:
             for episode in counted(range(episodes), episodes, f"official {maze.name}", "episode", leave=False):
-                options = {"reset_cell": np.array(starts[rng.integers(len(starts))]), "goal_cell": np.array(goal)}
-                obs, _ = env.reset(seed=seed if episode == 0 else None, options=options)
-                if start == "package" or reset_noise == "package":
-                    obs = _reset_as_package(env, policy, start_region if start == "package" else None,
-                                            reset_noise == "package", reset_rng)
-                traj, outcome = _episode(env, policy, obs, rng)
-                ok = outcome != "flipped" and bool(satisfies(original, traj[None], clearance=policy.clearance)[0])
+                ok, outcome = _episode(env, seed if episode == 0 else None)
                 success.append(ok)
                 outcomes[outcome] = outcomes.get(outcome, 0) + 1
         except KeyboardInterrupt:
             interrupted = True
     env.close()
     k, n = int(np.sum(success)), len(success)
-    data = {"env_id": env_id(maze, agent), "episodes": n, "success_rate": k / n if n else 0.0,
-            "success_ci": list(wilson_ci(k, n)), "sim_success_rate": result.get("success_rate"),
-            "sim_success_ci": result.get("success_ci"), "sim_episodes": result.get("episodes"),
-            "outcomes": outcomes, "seed": seed, "agent": agent, "maze": maze.name,
+    data = {"env_id": env_id(maze, policy.agent), "episodes": n, "success_rate": k / n if n else 0.0,
+            "success_ci": list(wilson_ci(k, n)), **sim, "outcomes": outcomes, "seed": seed, "agent": policy.agent,
+            "maze": maze.name,
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
-                         "horizon_per_leg": policy.horizon, "legs": len(policy.legs), "max_episode_steps": max_steps,
-                         "continuing_task": True, "reset_target": False, "clearance": policy.clearance,
-                         "start": start, "reset_noise": reset_noise},
+                         "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
+                         "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
+                         "clearance": policy.clearance, "start": start, "reset_noise": reset_noise},
             "wall_seconds": time.time() - t0}
     partial = partial_path(target)
     if interrupted:  # keep the finished episodes beside, never as, the complete record
@@ -163,6 +176,27 @@ def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, rese
     partial.unlink(missing_ok=True)
     write_atomic(target, json.dumps(data, indent=2))
     return data
+
+
+def _episode(env: TaskJudge, seed) -> tuple[bool, str]:
+    """One episode to its end, as docs/official_env.md's loop runs it: (success on the original task, outcome)."""
+    obs, info = env.reset(seed=seed)
+    terminated = truncated = False
+    while not (terminated or truncated):
+        obs, _, terminated, truncated, info = env.step(env.policy.act(obs))
+    return info["task_success"], info["outcome"]
+
+
+class PackageReset(gymnasium.Wrapper):
+    """The environment's reset, then this package's start and/or reset noise (module docstring)."""
+
+    def __init__(self, env, policy: CompositionalPolicy, start_region, noise: bool, rng):
+        super().__init__(env)
+        self.policy, self.start_region, self.noise, self.rng = policy, start_region, noise, rng
+
+    def reset(self, *, seed=None, options=None):
+        _, info = self.env.reset(seed=seed, options=options)
+        return _reset_as_package(self.env, self.policy, self.start_region, self.noise, self.rng), info
 
 
 def partial_path(target) -> Path:
@@ -187,41 +221,30 @@ def _reset_as_package(env, policy: CompositionalPolicy, start_region, noise: boo
     return env.unwrapped._get_obs(inner_obs[0] if isinstance(inner_obs, tuple) else inner_obs)
 
 
-def _episode(env, policy: CompositionalPolicy, obs, rng) -> tuple[np.ndarray, str]:
-    """One episode to its end (module docstring): the xy of every step and how it ended."""
-    policy.reset(obs, seed=rng)
-    xy = [agent_xy(obs)]
-    while True:
-        if policy.touching(xy[-1]):
-            return np.array(xy), "avoid"
-        if torso_flipped(policy.agent, obs):
-            return np.array(xy), "flipped"
-        policy.update(obs)
-        if policy.done:
-            return np.array(xy), "success"
-        if policy.timed_out:
-            return np.array(xy), "timeout"
-        obs, *_ = env.step(policy.act(obs).astype(np.float32))
-        xy.append(agent_xy(obs))
-
-
 def _inner(env):
     """The MuJoCo env inside a Gymnasium-Robotics maze env (its frame_skip)."""
     maze_env = env.unwrapped
     return getattr(maze_env, "point_env", None) or maze_env.ant_env
 
 
-def _read_result(run_dir: Path) -> dict:
-    path = run_dir / "result.json"
-    if not path.exists():
-        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+def _original_task(run_dir: Path, result: dict):
+    from ..core.graph import TaskGraph
+
     try:
-        data = json.loads(regular_file(path, "result file").read_text(encoding="utf-8"))  # a FIFO: never opened
-    except (OSError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
-    if not isinstance(data, dict):
-        raise SpecrefineError(f"{path}: not a run result")
-    return data
+        return TaskGraph.from_dict(result["input_graph"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SpecrefineError(f"{run_dir / 'result.json'}: no usable input_graph ({type(exc).__name__})") from None
+
+
+def _read_result(run_dir: Path) -> dict:
+    """The run's result.json, checked by the records' schema, with the task the episodes are judged on."""
+    path = run_dir / "result.json"
+    if not path.exists() and not path.is_symlink():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+    result = read_result(path)
+    if "input_graph" not in result:
+        raise SpecrefineError(f"{path}: no input_graph (the original task the episodes are judged on)")
+    return result
 
 
 def summary(data: dict) -> str:

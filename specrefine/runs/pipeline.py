@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.graph import check_refines
+from ..core.paths import code_commit
 from ..core.runfolder import replacing, write_atomic
 from ..core.spec import maze_spec_text
 from ..evaluation.compositional import save_run_policy
@@ -125,6 +126,7 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"], data["goal_points"] = config.evaluation, config.goal_points
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
+    data["commit"] = code_commit()  # which code: the checkout's commit, "-dirty" if specrefine/ was edited
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])
     data["config"] = config.to_dict()  # everything this run was asked to do (evaluation resolved)
     data.update(_durations(phases, time.time()))  # where the wall time went: search, measurement, calibration

@@ -18,7 +18,9 @@ The search settings ``w``, ``d`` and ``k`` (``-w 3 5 -k 5 10``; defaults and bou
 settings it reads (``methods.Method.knobs``).  A cell with the paper's values keeps the id it always had; any
 other value is named in the id (``...__s0__w5``) and recorded in the ``w``, ``d``, ``k`` columns (a table from
 before them reads as the paper's values; cells with other values are refused into it).  ``--goal-points centre``
-(``RunConfig.goal_points``) likewise ends the id in ``__centre``.
+(``RunConfig.goal_points``) likewise ends the id in ``__centre``.  Every row records what it ran with:
+``policy_fingerprint`` (the goal policy's weights) and ``commit`` (the code's commit, ``-dirty`` if ``specrefine/``
+had uncommitted edits, ``unknown`` outside a git checkout: ``core.paths.code_commit``).
 
 A maze given as a file outside ``data/mazes/`` is run from that file: its rows hold its absolute path in
 ``maze`` and its cell ids its stem plus a hash of the path (a shipped maze keeps its bare name, so older
@@ -61,7 +63,8 @@ from pathlib import Path
 from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
-from ..core.paths import regular_file
+from ..core.paths import code_commit, regular_file
+from ..core.plugins import loaded
 from ..core.runfolder import open_append, replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
 from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
@@ -75,10 +78,14 @@ COLUMNS = [
     "refines_input", "graph_vertices", "graph_edges", "path_edges", "rollouts_per_evaluation", "spec",
     "proposer_calls", "search_estimate", "predicted_ci_low", "predicted_ci_high", "evaluation", "policy",
     "policy_fingerprint", "search_seconds", "measure_seconds", "calibrate_seconds", "w", "d", "k", "goal_points",
+    "commit",
 ]
 #: Tables older than a column lack it (``spec``, ``evaluation``, ``policy``, ``policy_fingerprint``, the phases' wall
 #: times ``search_seconds``, ``measure_seconds``, ``calibrate_seconds``, ...): readers
-#: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header.
+#: take a row's missing field as unknown (``row.get``), and rows appended to such a table keep its header, except
+#: for PROVENANCE: a row always records the policy and the code it ran with, so a table without those columns gets
+#: them (rewritten whole, its older rows empty there: unknown) before the row is appended.
+PROVENANCE = ("policy_fingerprint", "commit")
 
 
 @dataclass(frozen=True)
@@ -206,13 +213,16 @@ def _knob_values(method: str, axes: dict[str, list[int]]) -> list[dict[str, int]
     return [dict(zip(KNOBS, combo)) for combo in dict.fromkeys(itertools.product(*values))]
 
 
-def run_cell(cell: Cell, out_root: str) -> dict:
-    """Run one cell; never raises: a failure becomes a row with status 'error'."""
+def run_cell(cell: Cell, out_root: str, plugins: tuple[str, ...] = ()) -> dict:
+    """Run one cell; never raises: a failure becomes a row with status 'error'. ``plugins``: the ``--plugin``
+    modules the sweep loaded (a Ray worker is a fresh process: it loads them, and the entry points, here)."""
+    from ..core.plugins import load_plugins
     from .pipeline import refine_maze
 
-    row = {**asdict(cell), "cell": cell.id}
+    row = {**asdict(cell), "cell": cell.id, "commit": code_commit()}  # a failed cell's row names its code too
     out = Path(out_root) / "cells" / cell.id
     try:
+        load_plugins(plugins)
         with cell_log(out / "log.txt"):
             result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
@@ -276,12 +286,14 @@ def _drop_cut_row(path: Path) -> None:
 
 
 def _append(path: Path, row: dict) -> None:
-    with open_append(path, "results table") as fh:  # a link or a FIFO is refused, never written through
-        new = os.fstat(fh.fileno()).st_size == 0
-        columns = COLUMNS if new else _header(path)  # an older table (without later columns) keeps its own header
+    new = not os.path.lexists(path) or os.lstat(path).st_size == 0
+    columns = COLUMNS if new else _header(path)  # an older table (without later columns) keeps its own header
+    if not new:
         _check_fits(path, columns, row)
-        if not new:
-            _drop_cut_row(path)
+        _drop_cut_row(path)
+        if missing := [c for c in PROVENANCE if c not in columns]:
+            columns = _add_columns(path, columns, missing)
+    with open_append(path, "results table") as fh:  # a link or a FIFO is refused, never written through
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
@@ -325,6 +337,18 @@ def check_table(table: Path, cells: list[Cell]) -> None:
             _check_fits(table, columns, asdict(cell))
         except ValueError as exc:
             raise SweepError(str(exc)) from None
+
+
+def _add_columns(path: Path, columns: list[str], missing: list[str]) -> list[str]:
+    """The table rewritten whole with ``missing`` columns after its own, empty in its rows; the new header."""
+    with path.open(newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))[1:]
+    columns = [*columns, *missing]
+    with replacing(path, newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(columns)
+        writer.writerows(row + [""] * (len(columns) - len(row)) for row in rows if row)
+    return columns
 
 
 def pending(cells: list[Cell], table: Path) -> list[Cell]:
@@ -407,7 +431,8 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
             if not todo:
                 break
             runner = _run_ray if backend == "ray" else _run_local
-            for row in counted(runner(todo, str(out_root), workers, address), len(todo),
+            where = (str(out_root), *([tuple(loaded())] if loaded() else []))  # run_cell's arguments after the cell
+            for row in counted(runner(todo, where, workers, address), len(todo),
                                f"sweep ({backend}, try {attempt + 1})", "cell", every=1):
                 _append(table, row)
     finally:
@@ -415,11 +440,12 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
     return table
 
 
-def _run_local(cells, out_root, workers, _address):
+def _run_local(cells, where, workers, _address):
+    """``where``: run_cell's arguments after the cell (the sweep folder, and its plugins if any)."""
     workers = workers or max(1, (os.cpu_count() or 1))
     if workers == 1:
         for cell in cells:
-            yield run_cell(cell, out_root)
+            yield run_cell(cell, *where)
         return
     # Imported once here, before the fork: importing mujoco starts a short-lived `python -c` (glfw's library
     # probe); in a worker, Ctrl-C could end the worker under it and the orphan printed a BrokenPipeError.
@@ -429,7 +455,7 @@ def _run_local(cells, out_root, workers, _address):
                                mp_context=_mp_context())
     finished = False
     try:
-        futures = {pool.submit(run_cell, cell, out_root): cell for cell in cells}
+        futures = {pool.submit(run_cell, cell, *where): cell for cell in cells}
         for fut in as_completed(futures):
             yield _row_of(fut, futures[fut])
         finished = True
@@ -478,13 +504,15 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     os._exit(1)  # orphaned: the sweep that started this worker was killed
 
 
-def _run_ray(cells, out_root, _workers, address):
-    import ray
+def _run_ray(cells, where, _workers, address):
+    from ..core.extras import require
+
+    ray = require("ray", "ray", "--backend ray")
 
     if not ray.is_initialized():
         ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
     remote = ray.remote(num_cpus=1)(run_cell)
-    refs = [remote.remote(cell, out_root) for cell in cells]
+    refs = [remote.remote(cell, *where) for cell in cells]
     try:
         while refs:
             ready, refs = ray.wait(refs, num_returns=1)
@@ -562,22 +590,36 @@ def _check_policy(policy: str, agent: str) -> str | None:
     return None
 
 
+PROG = "python -m specrefine.runs.sweep"  # its older path; `specrefine sweep` is the same command
+
+
 def parser() -> OneLineParser:
-    """The sweep's command line."""
-    from ..core.mazes import benchmark_mazes
+    """The sweep's command line (as its older path names it)."""
+    from ..core.commands import command_parser
+
+    return command_parser("sweep", PROG)
+
+
+def add_arguments(p) -> None:
+    """The sweep's options (``specrefine sweep``)."""
     from .pipeline import METHODS
 
-    p = OneLineParser(prog="python -m specrefine.runs.sweep", description=__doc__.split("\n")[0])
-    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
-                   help="maze names or files, or gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE); MAZE=SPEC runs "
-                        "that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
+    p.description = __doc__.split("\n")[0]
+    p.add_argument("--mazes", nargs="+", default=None,
+                   help="maze names or files, gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE) or random:RxC:SEED; "
+                        "MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G') (default: none: name "
+                        "them, or give --all)")
+    p.add_argument("--all", action="store_true",
+                   help="every benchmark maze of data/mazes/ (what a sweep without --mazes ran before it was refused)")
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
                    help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
                         "'' = the maze's own task; default: the maze's own task)")
-    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"])
-    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
-    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
-    p.add_argument("--agent", default="point", choices=list(AGENTS))
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"],
+                   metavar="METHOD", help=f"methods, of: {', '.join(METHODS)}")
+    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"],
+                   help="proposer strings, as specrefine refine --proposer (methods that ask none run once)")
+    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3], help="seeds")
+    p.add_argument("--agent", default="point", choices=list(AGENTS), help="the agent of every cell")
     add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
     add_run_options(p, ["goal_points"], suffix=" (every cell; named in the cell id when not sampled)")
     add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
@@ -587,47 +629,59 @@ def parser() -> OneLineParser:
                         "when adaptive) (default: fixed for point, adaptive for ant)")
     p.add_argument("--policy", default="shipped",
                    help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
-                        "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")
-    p.add_argument("--out", type=out_path, default="runs/sweep")
+                        "path (recorded in OUT/sweep.json and the 'policy' column)")
+    p.add_argument("--out", type=out_path, default="runs/sweep", help="the sweep folder (results.csv, cells/)")
     p.add_argument("--backend", choices=["local", "ray"], default="local",
                    help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
-                        "Ray) (default: local)")
-    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
+                        "Ray; needs the 'ray' extra)")
+    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379; default: a local one)")
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
-    return p
 
 
 def cells_of(args) -> list[Cell]:
-    """The cells of parsed sweep arguments (a relative ``--policy`` is taken from the working directory)."""
-    return grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
+    """The cells of parsed sweep arguments (no ``--mazes``: every benchmark maze; a relative ``--policy`` is taken
+    from the working directory)."""
+    from ..core.mazes import benchmark_mazes
+
+    mazes = args.mazes if args.mazes is not None else sorted(benchmark_mazes())
+    return grid(mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
                 goal_points=args.goal_points,
                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
 
 
 def main(argv=None) -> int:
-    p = parser()
-    args = p.parse_args(argv)
+    from ..core.commands import run_command
+
+    return run_command("sweep", argv, prog=PROG)
+
+
+def run(args, parser) -> int:
+    if args.mazes is None and not args.all:
+        return _fail(parser.prog, f"name the mazes (--mazes u_maze u_chain_2 ...), or give --all for every benchmark "
+                                  f"maze ({len(cells_of(args))} cells with these options)", 2)
+    if args.mazes is not None and args.all:
+        return _fail(parser.prog, "--mazes and --all: give one of them", 2)
     cells = cells_of(args)
-    bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
+    bad = maze_problem(args.mazes or []) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
-        return _fail(bad, 2)
+        return _fail(parser.prog, bad, 2)
     t0 = time.time()
     try:
         table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
     except SpecrefineError as exc:
-        return _fail(str(exc), 2)
+        return _fail(parser.prog, str(exc), 2)
     except KeyboardInterrupt:
-        return _fail(f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun the same "
-                     f"command to resume", 130)
+        return _fail(parser.prog, f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun "
+                                  f"the same command to resume", 130)
     done = {r["cell"] for r in read_table(table) if is_done(r)}
     failed = sum(c.id not in done for c in cells)
     print(f"{len(cells)} cells -> {table} ({failed} failed) in {time.time() - t0:.0f} s")
     return 1 if cells and failed == len(cells) else 0
 
 
-def _fail(message: str, code: int) -> int:
-    print(f"python -m specrefine.runs.sweep: error: {message}", file=sys.stderr)
+def _fail(prog: str, message: str, code: int) -> int:
+    print(f"{prog}: error: {message}", file=sys.stderr)
     return code
 
 

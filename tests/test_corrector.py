@@ -1,0 +1,145 @@
+"""The corrector (method ours-corrector, beyond the paper) on a stubbed straight corridor S (x = 0) -> G (x = 10).
+
+Each leg's success is a function of where it starts and ends (x of the regions' centres), the same on every draw:
+what the stub's proposer answers decides what each lever can do.
+"""
+
+from __future__ import annotations
+
+import pytest
+from test_refine_search import _Arrive, _chain_graph, _Query
+
+from specrefine.core.graph import check_refines
+from specrefine.core.regions import Box, Disc
+from specrefine.refine import RefinementSearch, SearchConfig
+from specrefine.refine.correct import CHECK_SEED_OFFSET
+
+
+class LegTable:
+    """p of a leg x0 -> x1 from a table (default 1.0), from ``fresh`` on the correction's fresh rollouts (a seed
+    given) where it has the leg; counts the rollouts and seeds it was asked for."""
+
+    n = 32
+
+    def __init__(self, table, fresh=None):
+        self.table, self.fresh, self.calls = table, fresh or {}, []
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None, n=None):
+        x0 = 0.0 if isinstance(start, Box) else start[1][0]
+        x1 = float(goal.centre()[0])
+        self.calls.append((x0, x1, n, seed))
+        p = self.fresh.get((x0, x1)) if seed is not None else None
+        return _Arrive(self.table.get((x0, x1), 1.0) if p is None else p, n=n or self.n, at=(x1, 0.0))
+
+
+class AnswerBook:
+    """Splits of the leg that ends at x (the query's goal): a list of waypoint x's per goal, or nothing."""
+
+    name, is_vlm = "stub", False
+
+    def __init__(self, book):
+        self.book, self.queries = book, []
+
+    def propose_split(self, query, w, feedback=()):
+        x = float(query.goal.centre()[0])
+        start = float(query.graph.region(query.u).centre()[0])
+        self.queries.append((start, x))
+        answer = self.book.get((start, x), self.book.get(x))
+        return [[Disc(a, 0, 0.5) for a in answer]] if answer else []
+
+
+def run(evaluator, proposer, **cfg):
+    g = _chain_graph()
+    config = SearchConfig(w=1, d=1, vertex_refinement=False, **cfg)
+    result = RefinementSearch(g, evaluator, proposer=proposer, config=config,
+                              query_for=lambda graph, u, v, r: _Query(graph, u, v)).run()
+    return g, result
+
+
+def xs(result):
+    return [result.graph.region(v).centre()[0] for v in result.path]
+
+
+# --- recursive repair ---------------------------------------------------------------------------------------
+DEAD_TWICE = {(0.0, 10.0): 0.0, (3.0, 6.0): 0.0, (3.0, 4.5): 0.0}
+SPLITS = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (3.0, 4.5): [3.75]}
+
+
+def test_one_level_of_repair_gives_up_when_the_legs_split_has_a_dead_leg_of_its_own():
+    g, result = run(LegTable(DEAD_TWICE), AnswerBook(SPLITS), repair=True)
+    assert result.path == ["S", "G"] and result.predicted_success == 0.0
+
+
+def test_repair_to_three_levels_repairs_the_dead_leg_of_the_legs_split():
+    g, result = run(LegTable(DEAD_TWICE), AnswerBook(SPLITS), repair=True, repair_depth=3)
+    assert xs(result) == [0.0, 3.0, 3.75, 4.5, 6.0, 10.0]
+    assert result.predicted_success == pytest.approx(1.0)
+    assert check_refines(result.graph, g) == []
+
+
+# --- the correction of the found path -----------------------------------------------------------------------
+LUCKY = {(0.0, 10.0): 0.0}  # the search's own estimates: every leg of S -> 3 -> 6 -> G at 1.0
+FRESH = {(3.0, 6.0): 0.75}  # on fresh rollouts the middle leg loses a quarter (the search's 32 of 32 was lucky)
+
+
+def test_a_leg_refuted_by_fresh_rollouts_is_split_when_its_split_gains_there():
+    ev, book = LegTable(LUCKY, FRESH), AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
+    g, result = run(ev, book, correct_rollouts=4)
+    assert xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]
+    assert check_refines(result.graph, g) == []
+    fresh = [(n, seed) for *_, n, seed in ev.calls if seed is not None]
+    assert fresh and set(fresh) == {(4 * 32, CHECK_SEED_OFFSET)}  # 4 x n rollouts, a seed apart
+    leg = next(s for s in result.steps if s["event"] == "correct-leg")
+    assert leg["p_leg"] == pytest.approx(0.75) and leg["accepted"] == "split"
+    done = next(s for s in result.steps if s["event"] == "correct-done")
+    assert done["p"] == pytest.approx(1.0)
+
+
+def test_without_the_correction_the_lucky_estimate_is_trusted():
+    _, result = run(LegTable(LUCKY, FRESH), AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]}))
+    assert xs(result) == [0.0, 3.0, 6.0, 10.0] and result.predicted_success == pytest.approx(1.0)
+
+
+def test_a_gain_below_one_rollout_is_not_taken():
+    # on fresh rollouts the split of 3 -> 6 is better by less than 1/128 over the window: the path stays
+    fresh = {(3.0, 6.0): 0.99, (3.0, 4.5): 0.995}
+    _, result = run(LegTable(LUCKY, fresh), AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]}),
+                    correct_rollouts=4)
+    assert xs(result) == [0.0, 3.0, 6.0, 10.0]
+    leg = next(s for s in result.steps if s["event"] == "correct-leg")
+    assert leg["accepted"] is None and leg["tried"][0]["kind"] == "split"
+
+
+def test_a_bad_waypoint_is_resplit_over():
+    # the waypoint at 6 is bad both to reach and to leave; asked over it (3 -> 10) the proposer answers 5 and 7.5
+    fresh = {(3.0, 6.0): 0.8, (6.0, 10.0): 0.8, (3.0, 10.0): 0.0, (4.5, 6.0): 0.8}
+    book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (3.0, 10.0): [5, 7.5]})
+    g, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_reach=0.0)
+    assert xs(result) == [0.0, 3.0, 5.0, 7.5, 10.0]
+    assert check_refines(result.graph, g) == []
+    assert (3.0, 10.0) in book.queries
+
+
+def test_the_correction_spends_at_most_one_split_per_leg_of_the_found_path():
+    fresh = {(0.0, 3.0): 0.5, (3.0, 6.0): 0.5, (6.0, 10.0): 0.5}
+    book = AnswerBook({(0.0, 10.0): [3, 6]})  # asked about any leg, it has nothing to say
+    _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4)
+    assert len(book.queries) == 1 + 3  # the search's split, then one per leg of the 3-leg path
+    assert xs(result) == [0.0, 3.0, 6.0, 10.0]
+
+
+def test_ours_corrector_runs_end_to_end_and_logs_its_correction(tmp_path):
+    import json
+
+    from specrefine.runs.pipeline import refine_maze
+
+    out = tmp_path / "run"
+    result = refine_maze("u_chain_2", method="ours-corrector", proposer="imperfect:moderate", out=out, agent="point",
+                         rollouts=8, episodes=20, seed=1)
+    steps = [json.loads(line) for line in (out / "steps.jsonl").read_text().splitlines()]
+    events = [s["event"] for s in steps]
+    assert events[-1] == "done" and "correct-check" in events and "correct-done" in events
+    check = next(s for s in steps if s["event"] == "correct-check")
+    assert len(check["probabilities"]) == len(check["path"]) - 1
+    assert result.data["method"] == "ours-corrector" and result.data["proposer_calls"] >= 1
+    assert result.data["refines_input"] is True
