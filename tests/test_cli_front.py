@@ -106,7 +106,7 @@ def test_py_typed_ships_with_the_package():
 
 def _doc_sections(text: str) -> dict[str, str]:
     """docs/cli.md cut at its '## specrefine COMMAND' headings."""
-    parts = re.split(r"^## `specrefine (\w+)`", text, flags=re.M)
+    parts = re.split(r"^## `specrefine ([\w-]+)`", text, flags=re.M)
     return dict(zip(parts[1::2], parts[2::2]))
 
 

@@ -37,7 +37,6 @@ from dataclasses import replace
 from pathlib import Path
 
 from .errors import RunFolderError, SpecrefineError
-from .paths import regular_file
 from .records import read_json, read_result  # noqa: F401 - read_result: its readers know it from here
 
 LOCK, RECORD = ".lock", "run.json"
@@ -165,10 +164,10 @@ def _unlock(out: Path, fd: int) -> None:
 def _check_record(out: Path, args: dict) -> None:
     """Refuse ``out`` if its run.json records other arguments."""
     record = out / RECORD
-    try:
-        old = json.loads(regular_file(record, "run record").read_text()) if os.path.lexists(record) else None
-    except (SpecrefineError, OSError, ValueError, RecursionError):
-        old = []  # unreadable (a FIFO too: never opened): refused below
+    try:  # a FIFO, a folder or a device there is refused unopened
+        old = read_json(record, "run record", RunFolderError) if record.exists() or record.is_symlink() else None
+    except RunFolderError:
+        old = []  # unreadable: refused below
     if old is not None and not isinstance(old, dict):
         raise RunFolderError(f"{record}: unreadable run record: remove it or use another --out")
     if old is not None:

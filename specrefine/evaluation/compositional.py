@@ -66,6 +66,8 @@ class CompositionalPolicy:
 
         if not legs:
             raise SpecrefineError("a compositional policy needs at least one leg (the run found no path)")
+        if isinstance(horizon, bool) or not isinstance(horizon, int | np.integer) or horizon < 1:
+            raise SpecrefineError(f"horizon {horizon!r:.40}: the decisions per leg must be a whole number >= 1")
         spec = get_agent(agent)
         self.agent, self.maze, self.legs, self.goal_policy, self.horizon = agent, maze, list(legs), goal_policy, horizon
         self.control_period = spec.timestep * spec.frame_skip
@@ -139,6 +141,8 @@ class CompositionalPolicy:
         return self.goal_policy.act(obs) if hasattr(self.goal_policy, "act") else self.goal_policy(obs)
 
     def _control(self, action: np.ndarray) -> np.ndarray:
+        if not np.isfinite(action).all():
+            raise PolicyError("the goal policy acts with NaN or infinite values: retrain it or restore its checkpoint")
         action = np.clip(action, -1.0, 1.0)
         if get_agent(self.agent).action_in_disc:
             action = action / max(float(np.linalg.norm(action)), 1.0)
