@@ -359,3 +359,20 @@ def test_every_input_in_every_form_is_exit_0_or_one_line_and_nothing_outside_out
     assert _state(base, out) == before
     if position.endswith("--out FILE") and kind in ("fifo", "folder", "device"):  # only a file may be an output
         assert code == 2 and stat.S_IFMT(target.lstat().st_mode) == planted
+
+
+def test_a_policy_with_no_whole_horizon_or_acting_with_nan_is_refused():
+    from specrefine.core.errors import PolicyError
+    from specrefine.evaluation.compositional import CompositionalPolicy, Leg
+
+    maze = load_maze("u_maze")
+    legs = [Leg("G", maze.goal, maze.obstacles, None)]
+    nan_policy = lambda obs: np.full((len(obs), 2), np.nan)  # noqa: E731 - corrupt weights, say
+    for horizon in (0, -5, 2.5, float("inf"), True):
+        with pytest.raises(SpecrefineError, match="horizon"):
+            CompositionalPolicy("point", maze, legs, nan_policy, horizon)
+    policy = CompositionalPolicy("point", maze, legs, nan_policy, 3)
+    obs = {"observation": np.array([1.0, -1.0, 0.0, 0.0]), "achieved_goal": np.array([1.0, -1.0])}
+    policy.reset(obs, seed=0)
+    with pytest.raises(PolicyError, match="NaN"):
+        policy.act(obs)
