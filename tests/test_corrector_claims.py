@@ -85,3 +85,23 @@ def test_missing_cells_mark_the_rules_partial(tmp_path):
 def test_no_table_is_one_error(tmp_path):
     with pytest.raises(cc.SpecrefineError, match="run the grids"):
         cc.point_study(tmp_path)
+
+
+def test_the_held_out_grid_is_described_per_maze_and_mix(tmp_path):
+    from specrefine.experiments.grids import HELD_OUT_MAZES, HELD_OUT_MIXES
+
+    g = GRIDS["corrector-held-out"]
+    mazes = [cc.table_name(m) for m in HELD_OUT_MAZES]
+    oracle = [row(m, "ours", 0.99, s, "geometric") for m in mazes for s in g.seeds]
+    runs = [row(m, method, 0.0 if method == "ours" else 0.95, s, mix) | {"proposer_calls": 3, "evaluations": 10,
+                                                                       "sim_steps": 100}
+            for m in mazes for method in ("ours", cc.METHOD) for mix in HELD_OUT_MIXES for s in g.seeds]
+    for path, rows in ((g.part_table(0), oracle), (g.part_table(1), runs)):
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        write_csv(tmp_path / path, rows)
+    study = cc.held_out_study(tmp_path)
+    assert mazes[0] == "unseen/spiral" and len(study["per_maze"]) == len(mazes) * len(HELD_OUT_MIXES)
+    assert study["zero"] == {cc.METHOD: 0, "ours": len(mazes) * len(HELD_OUT_MIXES) * len(g.seeds)}
+    first = study["per_maze"][0]
+    assert first["mix"] == "A" and first["difference"] == pytest.approx(0.95) and first["oracle"] == 0.99
+    assert study["costs"][0]["evaluations_ratio"] == pytest.approx(1.0)

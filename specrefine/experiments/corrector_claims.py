@@ -3,9 +3,10 @@
     specrefine corrector-claims --out data/results/corrector
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
-and the one-shot) and, where present, ``ant-corrector`` with the Ant scaling grid's one-shot and oracle; writes
-claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and figure.png
-(success over rooms per method and preset). A rule with a cell missing is marked partial.
+and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``ant-corrector`` with the Ant
+scaling grid's one-shot; writes claims.md and claims.json (every rule with its estimate, interval and verdict, every
+cell counted) and rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
+marked partial.
 """
 
 from __future__ import annotations
@@ -19,10 +20,10 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, wilson_ci
-from ..core.runfolder import write_atomic
+from ..core.runfolder import save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
-from .grids import GRIDS, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
+from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
 
 METHOD = "ours-corrector"
 ORACLE = ("ours", "geometric")
@@ -31,6 +32,8 @@ ANT_FLOOR = 0.85
 COST_CAP = 3.0
 POINT_SEEDS = GRIDS["corrector"].seeds
 ANT_SEEDS = GRIDS["ant-corrector"].seeds
+HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
+MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
 ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
 ANT_ORACLE = "data/results/ant/scaling/ours_centre.csv"
 ANT_ERRING = "data/results/ant/scaling/imperfect_centre.csv"
@@ -119,11 +122,38 @@ def point_study(root: Path = ROOT) -> dict:
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
         study["zero"].append({"proposer": proposer} | {m: zero_runs(rows, m, proposer, SCALING_MAZES)
                                                         for m in (METHOD, "ours", "ours-repair")})
+    study["curves"] = {p: {"/".join(m): [episodes_of(rows, f"u_chain_{n}", m[0], m[1] if m[1] != "*" else p,
+                                                     POINT_SEEDS) for n in range(1, 6)]
+                           for m in (ORACLE, (METHOD, "*"), ("ours", "*"), ("ours-repair", "*"), ("vlm-oneshot", "*"))}
+                       for p in ("imperfect:mild", "imperfect:moderate", "imperfect:severe")}
     study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", METHOD, "ours-repair",
                                                       POINT_SEEDS, SCALING_MAZES)
     study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS)
     study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS))
     return study
+
+
+def held_out_study(root: Path = ROOT) -> dict | None:
+    """Descriptive (no rule was fixed beyond reporting every cell): per held-out maze and error mix, ours-corrector
+    beside ours and the oracle, pooled over the seeds; and the cost ratios."""
+    rows = load(GRIDS["corrector-held-out"].tables, root)
+    if not any(r["method"] == METHOD for r in rows):
+        return None
+    mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
+    entries = []
+    for mix in HELD_OUT_MIXES:
+        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=("ours", "*")):
+            k, n, _ = episodes_of(rows, e["maze"], *ORACLE, HELD_OUT_SEEDS)
+            entries.append(e | {"mix": MIX_NAMES[mix], "oracle": k / n if n else math.nan})
+    zeros = {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in HELD_OUT_MIXES) for m in (METHOD, "ours")}
+    return {"per_maze": entries, "zero": zeros, "runs": sum(e["runs"] for e in entries),
+            "costs": [costs(rows, mix, mazes, HELD_OUT_SEEDS) | {"proposer": f"mix {MIX_NAMES[mix]}"}
+                      for mix in HELD_OUT_MIXES]}
+
+
+def table_name(maze: str) -> str:
+    """How a sweep table names a maze given as a path under data/mazes/ (its stem, with any sub-folder)."""
+    return maze.removeprefix("data/mazes/").removesuffix(".maze")
 
 
 def ant_study(root: Path = ROOT) -> dict | None:
@@ -213,7 +243,7 @@ def _verdict(ok: bool, complete: bool) -> str:
     return ("holds" if ok else "does not hold") + ("" if complete else " (partial)")
 
 
-def markdown(point: dict, ant: dict | None) -> str:
+def markdown(point: dict, ant: dict | None, held_out: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -247,6 +277,22 @@ def markdown(point: dict, ant: dict | None) -> str:
     for c in point["costs"] + ([ant["costs"] | {"proposer": "Ant " + ant["costs"]["proposer"]}] if ant else []):
         lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                      f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
+    if held_out:
+        lines += ["", "Held out (descriptive; the grid was fixed before it ran, no rule beyond reporting every cell): "
+                  "layouts outside the suite and two error mixes no method was developed on (`HELD_OUT_MIXES` in "
+                  "specrefine/experiments/grids.py, A and B), pooled over seeds "
+                  f"{list(HELD_OUT_SEEDS)}; Newcombe 95 % interval of ours-corrector - ours. Runs at 0: "
+                  + ", ".join(f"{m} {z}" for m, z in held_out["zero"].items()) + f" (of {held_out['runs']} each).",
+                  "", "| mix | maze | runs | ours-corrector | ours | ours-corrector - ours | oracle |",
+                  "|---|---|---|---|---|---|---|"]
+        for e in held_out["per_maze"]:
+            lines.append(f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
+                         f"{_num(e['reference_success'])} | {_diff(e)} | {_num(e['oracle'])} |")
+        lines += ["", "| held-out mix | pairs | evaluations | proposer calls | simulator steps |",
+                  "|---|---|---|---|---|"]
+        for c in held_out["costs"]:
+            lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
+                         f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
     if ant:
         lines += ["", "The Ant (imperfect:moderate, stage 5, centre goal points): ours-corrector pooled per maze "
                   "(Wilson 95 %).", "", "| maze | runs | success [95 % CI] |", "|---|---|---|"]
@@ -268,16 +314,44 @@ def add_arguments(p) -> None:
 
 def run(args, p) -> int:
     try:
-        point, ant = point_study(), ant_study()
+        point, ant, held_out = point_study(), ant_study(), held_out_study()
         args.out.mkdir(parents=True, exist_ok=True)
-        write_atomic(args.out / "claims.md", markdown(point, ant))
-        write_atomic(args.out / "claims.json", json.dumps({"point": point, "ant": ant, "rules": verdicts(point, ant)},
-                                                          indent=1, default=float) + "\n")
+        write_atomic(args.out / "claims.md", markdown(point, ant, held_out))
+        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant)}
+        write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
+        save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
     print(f"-> {args.out}/claims.md")
     return 0
+
+
+def rooms_figure(point: dict):
+    """Success over rooms (U-chain 1-5 without subgoals, pooled over seeds) per method, one panel per preset."""
+    from ..pictures.render import subplots
+    from .figures import METHOD_COLOURS
+
+    curves = point["curves"]
+    fig, axes = subplots(1, len(curves), figsize=(4.2 * len(curves), 3.4), sharey=True)
+    for ax, (proposer, methods) in zip(np.atleast_1d(axes), curves.items()):
+        for name, points in methods.items():
+            method = name.split("/")[0]
+            xs = [n for n, (k, total, _) in zip(range(1, 6), points) if total]
+            ys = [k / total for k, total, _ in points if total]
+            if xs:
+                oracle = name == "/".join(ORACLE)
+                ax.plot(xs, ys, marker="o", color="black" if oracle else METHOD_COLOURS.get(method, "#757575"),
+                        ls="--" if oracle else "-", label="oracle (ours, geometric)" if oracle else method)
+        ax.set_title(f"{proposer} (offline, not a VLM)", fontsize=9)
+        ax.set_xlabel("rooms (U-chain, no subgoals)")
+        ax.set_xticks(range(1, 6))
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+    np.atleast_1d(axes)[0].set_ylabel("success (pooled over seeds)")
+    np.atleast_1d(axes)[0].legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    return fig
 
 
 def main(argv=None) -> int:

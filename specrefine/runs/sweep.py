@@ -128,12 +128,17 @@ class Cell:
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
         # a standard map 'gr:NAME' -> 'gr-NAME', a shipped folder's 'held_out/x' -> 'held_out-x' (folder names)
         name = name.replace(":", "-").replace("/", "-")
-        name, prop = _bounded(name), _bounded(prop)
-        task = f"{name}__{_bounded(spec_slug(self.spec))}" if self.spec else name
         tail = "" if self.evaluation == PAPER.evaluation else f"__{self.evaluation}"  # older ids stay valid
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
                         if getattr(self, knob) != getattr(PAPER, knob))  # the paper's w, d, k: the id they had
         tail += "" if self.goal_points == PAPER.goal_points else f"__{self.goal_points}"
+        whole = self._id(name, spec_slug(self.spec), prop, tail)
+        if len(whole.encode()) <= ID_LIMIT:  # every id a shipped table holds
+            return whole
+        return self._id(_bounded(name), _bounded(spec_slug(self.spec)), _bounded(prop), tail)
+
+    def _id(self, name: str, spec: str, prop: str, tail: str) -> str:
+        task = f"{name}__{spec}" if self.spec else name
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
 
     def row(self) -> dict:
@@ -147,11 +152,12 @@ ROW_SETTINGS = ("agent", "method", "proposer", "seed", "rollouts", "episodes", "
                 "d", "k", "goal_points")
 
 
-ID_PART = 64  # characters of one part of a cell id (maze, spec, proposer): an id stays a file name (255 bytes)
+ID_LIMIT = 240  # bytes of a cell id kept whole: it is a folder's name (255 bytes at most)
+ID_PART = 64  # characters of one part of a longer id (maze, spec, proposer), cut and hashed
 
 
 def _bounded(part: str) -> str:
-    """A part of a cell id as it is when short (every id so far); a longer one (an 80-branch spec, a long path)
+    """A part of a cell id that is too long as a whole (an 80-branch spec): as it is when short, a longer one
     cut, and ended with a hash of the whole so that different parts keep different ids."""
     if len(part) <= ID_PART:
         return part
