@@ -60,6 +60,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "package's (the Ant's qpos +-0.1, qvel 0.1 N(0,1))")
     o.add_argument("--out", type=out_path, default=None, help="where to write the result (default: "
                                                               "RUN_DIR/official.json)")
+    from .runs import show
+
+    show.add_arguments(sub.add_parser("show", help="a finished run at a glance: summary, path leg by leg, time, "
+                                                   "pictures"))
     return parser
 
 
@@ -103,6 +107,10 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "official":
         return official(args)
+    if args.command == "show":
+        from .runs.show import show
+
+        return _command(lambda: show(args.run_dir), str, "nothing was written")
 
     def work():
         from .runs.pipeline import refine_maze  # heavy imports only after argument parsing

@@ -80,7 +80,8 @@ def new_figure(bounds, size_px: int = 768, title: str | None = None, legend_row:
     fs = _font(size_px)
     # margins in pixels: left for y tick labels, bottom for x tick labels, top for title + legend
     left, right, bottom = 4.2 * fs, 1.2 * fs, 3.4 * fs
-    top = (2.2 * fs if title else 0.8 * fs) + (2.0 * fs if legend_row else 0.0)
+    title_lines = title.count("\n") + 1 if title else 0
+    top = 0.8 * fs + 1.4 * fs * title_lines + (2.0 * fs if legend_row else 0.0)
     aspect = (y1 - y0) / (x1 - x0)
     if aspect <= 1.0:
         w = size_px
