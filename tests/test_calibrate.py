@@ -93,7 +93,7 @@ def test_a_finished_run_is_predicted_again_from_its_folder(tmp_path, capsys):
     moved.write_text(json.dumps({**json.loads(shipped.read_text()), "maze": "my_maze"}))
     assert main([str(moved), "--table", str(tmp_path / "moved.csv")]) == 2  # not found: one line, no traceback
     err = capsys.readouterr().err
-    assert "moved_result.json: my_maze: cannot read maze file" in err and len(err.strip().splitlines()) == 1
+    assert "moved_result.json: my_maze: no such maze" in err and len(err.strip().splitlines()) == 1
     assert main([str(moved), "--table", str(tmp_path / "moved.csv"), "--maze-dir", str(elsewhere)]) == 0
     assert predict_run(moved, elsewhere)["prediction_successes"] == data["prediction_successes"]
     with pytest.raises(SystemExit) as exit_:

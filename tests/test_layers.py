@@ -68,9 +68,10 @@ def _imports() -> nx.DiGraph:
 
 
 def _part(module: str) -> str:
-    """A module's layer unit: its sub-package (``specrefine.runs.sweep`` -> ``runs``), ``cli``, or ``specrefine``."""
+    """A module's layer unit: its sub-package (``specrefine.runs.sweep`` -> ``runs``), ``cli``, or ``specrefine`` (the
+    package's ``__init__.py`` and ``__main__.py``)."""
     parts = module.split(".")
-    return parts[1] if len(parts) > 1 else "specrefine"
+    return parts[1] if len(parts) > 1 and parts[1] != "__main__" else "specrefine"
 
 
 def _parts_graph() -> nx.DiGraph:

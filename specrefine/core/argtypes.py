@@ -14,9 +14,25 @@ import sys
 from pathlib import Path
 
 
+class DefaultsShown(argparse.HelpFormatter):
+    """Help that ends each option's text in its default, ``(default: 32)``, unless the text already says it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text.lower() or not action.option_strings or action.default in (None, argparse.SUPPRESS) \
+                or action.nargs == 0:  # flags (store_true) and options that explain their own None
+            return text
+        return f"{text} (default: %(default)s)" if text else "(default: %(default)s)"
+
+
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line (no usage block), still exit code 2; the environment the commands
-    depend on is checked with the arguments, before any work (``MPLBACKEND``, read when matplotlib is imported)."""
+    depend on is checked with the arguments, before any work (``MPLBACKEND``, read when matplotlib is imported).
+    Its help shows every option's default (:class:`DefaultsShown`)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", DefaultsShown)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

@@ -60,5 +60,9 @@ class RunFolderError(SpecrefineError):
     """An output folder that cannot be used: not a directory, unwritable, in use, or holding another run."""
 
 
+class RecordError(SpecrefineError):
+    """A run's record (result.json, policy.json) that cannot be read or breaks its schema (``core.records``)."""
+
+
 class SweepError(SpecrefineError):
     """A sweep that cannot go on as asked (its --out holds cells run with other parameters)."""

@@ -180,13 +180,40 @@ class TaskGraph:
 
     @classmethod
     def from_dict(cls, d: dict) -> TaskGraph:
-        tg = cls(d["initial"])
-        for vd in d["vertices"]:
-            tg.add_vertex(vd["name"], from_dict(vd["region"]), point=vd.get("point"),
-                          refines=vd.get("refines", vd["name"]), label=vd.get("label"))
-        for ed in d["edges"]:
-            tg.add_edge(ed["u"], ed["v"], from_dict(ed["avoid"]), parent=ed.get("parent"))
-        tg.finals = set(d["finals"])
+        """The graph ``to_dict`` wrote; anything else (a wrong type, a non-finite point, an edge, the initial vertex
+        or a final naming no vertex, a cycle) is one GraphError (or RegionError) line."""
+        try:
+            return cls._from_dict(d)
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise GraphError(f"malformed task graph ({type(exc).__name__}: {str(exc)[:60]})") from None
+
+    @classmethod
+    def _from_dict(cls, d: dict) -> TaskGraph:
+        tg = cls(_name(d["initial"], "initial vertex"))
+        for vd in _listed(d["vertices"], "vertices"):
+            name = _name(vd["name"], "vertex name")
+            if name in tg:
+                raise GraphError(f"vertex {name!r} is listed twice")
+            refines, label = vd.get("refines", name), vd.get("label")
+            tg.add_vertex(name, from_dict(vd["region"]), point=_point(vd.get("point"), name),
+                          refines=None if refines is None else _name(refines, "refines"),
+                          label=None if label is None else _name(label, "label"))
+        for ed in _listed(d["edges"], "edges"):
+            u, v = _name(ed["u"], "edge end"), _name(ed["v"], "edge end")
+            parent = ed.get("parent")
+            if parent is not None and (not isinstance(parent, list) or len(parent) != 2):
+                raise GraphError(f"edge {u}->{v}: its parent must be a pair of vertex names")
+            if u not in tg or v not in tg:
+                raise GraphError(f"edge {u}->{v} names a vertex the graph does not have")
+            tg.add_edge(u, v, from_dict(ed["avoid"]), parent=None if parent is None else
+                        [_name(x, "parent") for x in parent])
+        tg.finals = {_name(f, "final vertex") for f in _listed(d["finals"], "finals")}
+        unknown = sorted(({tg.initial} | tg.finals) - set(tg.vertices()))
+        if unknown:
+            names = ", ".join(map(repr, unknown))[:60]
+            raise GraphError(f"{names}: named as the initial or a final vertex, but no vertex of the graph")
+        if not tg.finals:
+            raise GraphError("a task graph needs at least one final vertex")
         return tg
 
     @classmethod
@@ -195,6 +222,27 @@ class TaskGraph:
 
     def __eq__(self, other):
         return isinstance(other, TaskGraph) and self.to_dict() == other.to_dict()
+
+
+def _name(value, what: str) -> str:
+    if not isinstance(value, str):
+        raise GraphError(f"{what} must be a string, got {type(value).__name__} {value!r:.40}")
+    return value
+
+
+def _listed(value, what: str) -> list:
+    if not isinstance(value, list):
+        raise GraphError(f"a task graph's {what} must be a list, got {type(value).__name__}")
+    return value
+
+
+def _point(value, vertex: str):
+    if value is None:
+        return None
+    if not isinstance(value, list | tuple) or len(value) != 2 or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) for v in value):
+        raise GraphError(f"vertex {vertex!r}: its point must be two finite numbers, got {value!r:.60}")
+    return value
 
 
 def path_graph(regions: list[Region], avoid: Region, names: list[str] | None = None) -> TaskGraph:

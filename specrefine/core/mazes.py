@@ -9,6 +9,10 @@ wall.  A comment line ``; spec: EXPR`` gives the maze's default task as a spec e
 (``specrefine.core.spec.parse_spec``, e.g. ``; spec: (a | b) -> G``) in place of the chain
 S -> a -> b -> ... -> G; ``--spec`` on the command line overrides it.
 
+A grid has at most ``MAX_SIDE`` rows and as many columns (every shipped and standard map has at most 21), wherever
+it comes from (a file, ``random:RxC:SEED``, ``gr:NAME``, ``Maze.from_gymnasium``); a larger one is one MazeError
+line before anything is built from it.
+
 Coordinates follow Gymnasium-Robotics' ``maze_v4.py``: the origin is the centre of the
 map, x grows with the column, y grows upwards (row 0 is the top row), and every cell is
 ``cell_size`` metres wide (1.0 for the point mass, 4.0 for the Ant).
@@ -34,6 +38,8 @@ CELL_SIZE = {name: agent.cell_size for name, agent in AGENTS.items()}  # metres 
 _LEGAL = set("#.SG~") | set("abcdefghijklmnopqrstuvwxyz")
 HAZARD = "~"
 _SPEC_LINE = re.compile(r"^\s*;\s*spec\s*:\s*(.*)$")
+MAX_SIDE = 100  # rows, and columns, of a grid: the shipped and Gymnasium-Robotics maps have at most 21
+MAX_FILE_BYTES = 1_000_000  # a .maze file: a full 100 x 100 grid is 10 kB, the rest is room for comments
 
 
 @dataclass(frozen=True)
@@ -63,6 +69,9 @@ class Maze:
         :mod:`specrefine.core.standard_maps`."""
         from .standard_maps import maze_text
 
+        if isinstance(map_list, (list, tuple)) and (len(map_list) > MAX_SIDE or any(
+                isinstance(row, (list, tuple)) and len(row) > MAX_SIDE for row in map_list)):
+            raise MazeError(f"{name}: the map is larger than {MAX_SIDE} x {MAX_SIDE} cells")
         return parse_maze(maze_text(map_list, name=name), name, cell_size)
 
     # --- coordinates (Gymnasium-Robotics convention) -------------------------------
@@ -199,6 +208,8 @@ def parse_maze(text: str, name: str = "<maze>", cell_size: float = 1.0) -> Maze:
         for col, ch in enumerate(line, start=1):
             if ch not in _LEGAL:
                 raise MazeError(f"{name}:{lineno}:{col}: unknown character {ch!r} (use # . S G ~ or a-z)")
+        if len(line) > MAX_SIDE or len(rows) == MAX_SIDE:
+            raise MazeError(f"{name}:{lineno}:1: the grid is larger than {MAX_SIDE} x {MAX_SIDE} cells")
         if width is None:
             width, first_line = len(line), lineno
         elif len(line) != width:
@@ -271,6 +282,10 @@ def random_maze(rooms: tuple[int, int], seed: int, loops: float = 0.25, cell_siz
     rows, cols = (int(k) for k in rooms)
     if rows < 2 or cols < 2 or not 0 <= loops <= 1:
         raise MazeError(f"random maze {rows}x{cols}, loops {loops:g}: needs at least 2x2 rooms and 0 <= loops <= 1")
+    if 2 * max(rows, cols) + 1 > MAX_SIDE:
+        most = (MAX_SIDE - 1) // 2
+        raise MazeError(f"random maze {rows}x{cols}: at most {most}x{most} rooms (a grid of {MAX_SIDE} x {MAX_SIDE} "
+                        "cells)")
     rng = np.random.default_rng(seed)
     grid = [["#"] * (2 * cols + 1) for _ in range(2 * rows + 1)]
     seen, stack = {(0, 0)}, [(0, 0)]
@@ -312,8 +327,12 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     path = Path(path)
     if not path.exists() and not path.suffix and (MAZE_DIR / f"{path}.maze").exists():
         path = MAZE_DIR / f"{path}.maze"
+    if not path.exists() and not path.is_symlink() and not path.suffix:
+        raise MazeError(_unknown_name(str(path)))
     try:
-        text = regular_file(path, "maze file").read_text(encoding="utf-8")
+        if regular_file(path, "maze file").stat().st_size > MAX_FILE_BYTES:
+            raise MazeError(f"{path}: larger than {MAX_FILE_BYTES:,} bytes: not a maze file")
+        text = path.read_text(encoding="utf-8")
     except SpecrefineError as exc:
         raise MazeError(str(exc)) from None
     except OSError as exc:
@@ -321,6 +340,17 @@ def load_maze(path, cell_size: float = 1.0) -> Maze:
     except UnicodeDecodeError:
         raise MazeError(f"{path}:1:1: not a text file") from None
     return parse_maze(text, str(path), cell_size)
+
+
+def _unknown_name(name: str) -> str:
+    """One line for a maze name that is neither a file nor a shipped maze: the nearest shipped names."""
+    import difflib
+
+    names = sorted(p.relative_to(MAZE_DIR).with_suffix("").as_posix() for p in MAZE_DIR.rglob("*.maze"))
+    near = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+    hint = f"nearest: {', '.join(near)}" if near else f"shipped: {', '.join(n for n in names if '/' not in n)}"
+    return (f"{name}: no such maze (not a file, not in data/mazes/; {hint}; or gr:NAME, random:RxC:SEED, "
+            f"a path to a .maze file)")
 
 
 def _random_from_text(text: str, cell_size: float) -> Maze:

@@ -48,6 +48,19 @@ class Region:
         return (self,)
 
 
+def _set_finite(region, fields) -> None:
+    """The region's ``fields`` as floats; a NaN, an infinity or a non-number is a RegionError."""
+    for f in fields:
+        value = getattr(region, f)
+        try:
+            number = float(value) if not isinstance(value, (str, bytes, bool)) else None
+        except (TypeError, ValueError):
+            number = None
+        if number is None or not np.isfinite(number):
+            raise RegionError(f"a {type(region).__name__.lower()}'s {f} must be a finite number, got {value!r:.40}")
+        object.__setattr__(region, f, number)
+
+
 def _as_points(points) -> np.ndarray:
     pts = np.asarray(points, dtype=float)
     if pts.shape[-1] != 2:
@@ -63,8 +76,7 @@ class Box(Region):
     ymax: float
 
     def __post_init__(self):
-        for f in ("xmin", "ymin", "xmax", "ymax"):
-            object.__setattr__(self, f, float(getattr(self, f)))
+        _set_finite(self, ("xmin", "ymin", "xmax", "ymax"))
         if not (self.xmax > self.xmin and self.ymax > self.ymin):
             raise RegionError(f"empty box {self}")
 
@@ -106,8 +118,7 @@ class Disc(Region):
     r: float
 
     def __post_init__(self):
-        for f in ("cx", "cy", "r"):
-            object.__setattr__(self, f, float(getattr(self, f)))
+        _set_finite(self, ("cx", "cy", "r"))
         if not self.r > 0:
             raise RegionError(f"disc radius must be positive, got {self.r}")
 
@@ -201,15 +212,25 @@ def union(regions: Iterable[Region]) -> Region:
     return regions[0] if len(regions) == 1 else Union(tuple(regions))
 
 
+_FIELDS = {"box": (Box, ("xmin", "ymin", "xmax", "ymax")), "disc": (Disc, ("cx", "cy", "r"))}
+
+
 def from_dict(d: dict) -> Region:
+    """The region ``to_dict`` wrote; anything else (a list, a missing or non-finite number) is a RegionError."""
+    if not isinstance(d, dict):
+        raise RegionError(f"a region is a JSON object with a type, got {type(d).__name__} {d!r:.40}")
     kind = d.get("type")
-    if kind == "box":
-        return Box(float(d["xmin"]), float(d["ymin"]), float(d["xmax"]), float(d["ymax"]))
-    if kind == "disc":
-        return Disc(float(d["cx"]), float(d["cy"]), float(d["r"]))
     if kind == "union":
+        if not isinstance(d.get("members"), list):
+            raise RegionError("a union's members must be a list of regions")
         return Union(tuple(from_dict(m) for m in d["members"]))  # Union even for one member: lossless
-    raise RegionError(f"unknown region type {kind!r}")
+    if kind not in _FIELDS:
+        raise RegionError(f"unknown region type {kind!r:.40}")
+    cls, fields = _FIELDS[kind]
+    missing = [f for f in fields if f not in d]
+    if missing:
+        raise RegionError(f"a {kind} needs {', '.join(missing)}")
+    return cls(*(d[f] for f in fields))
 
 
 def _elementary_cells(boxes, extra_bounds):

@@ -24,8 +24,8 @@ from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
-from .errors import RunFolderError, SpecrefineError
-from .paths import regular_file
+from .errors import RunFolderError
+from .records import read_json, read_result  # noqa: F401 - read_result: its readers know it from here
 
 LOCK, RECORD = ".lock", "run.json"
 
@@ -137,7 +137,7 @@ def _check_record(out: Path, args: dict) -> None:
         old = json.loads(record.read_text())
     except FileNotFoundError:
         old = None
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         old = []  # unreadable: refused below
     if old is not None and not isinstance(old, dict):
         raise RunFolderError(f"{record}: unreadable run record: remove it or use another --out")
@@ -205,10 +205,7 @@ def recorded_maze(result_path, name: str, maze_dir=None):
 
     result_path = Path(result_path)
     record = result_path.with_name(RECORD) if result_path.name == "result.json" else None
-    try:
-        args = json.loads(record.read_text()) if record is not None and record.is_file() else {}
-    except (OSError, ValueError):
-        raise RunFolderError(f"{record}: unreadable run record") from None
+    args = read_json(record, "run record", RunFolderError) if record is not None and record.is_file() else {}
     grid = args.get("maze_grid") if isinstance(args, dict) else None
     if isinstance(grid, list) and grid and all(isinstance(row, str) for row in grid):
         spec = args.get("maze_spec")
@@ -218,19 +215,3 @@ def recorded_maze(result_path, name: str, maze_dir=None):
     if maze_dir is not None and (Path(maze_dir) / f"{name}.maze").is_file():
         return Path(maze_dir) / f"{name}.maze"
     return name
-
-
-def read_result(path) -> dict:
-    """A finished run's result.json, checked to hold what a re-run needs; anything else is a one-line error."""
-    try:
-        result = json.loads(regular_file(path, "result file").read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: not a readable result.json ({type(exc).__name__})") from None
-    if not isinstance(result, dict):
-        raise SpecrefineError(f"{path}: not a run's result.json (a JSON {type(result).__name__})")
-    missing = [key for key in ("maze", "agent") if not isinstance(result.get(key), str)]
-    if missing:
-        raise SpecrefineError(f"{path}: not a run's result.json (no {' or '.join(missing)} named)")
-    if not isinstance(result.get("path", []), list) or not isinstance(result.get("graph", {}), dict):
-        raise SpecrefineError(f"{path}: a malformed result.json (its path or graph is of the wrong type)")
-    return result

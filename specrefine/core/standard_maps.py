@@ -82,17 +82,18 @@ def maze_text(map_list, name: str = "gymnasium_map") -> str:
         raise MazeError(f"{name}: the map has no free cell")
     of = lambda kind: [(r, c) for r, c in free if rows[r][c] == kind]  # noqa: E731
     starts = of("r") or (of("c") or free)[:1]
+    is_start = set(starts)
     distance = _steps(walls, starts)
     d4rl = D4RL_GOALS.get(_d4rl_name(walls)) if not (of("g") or of("c")) else None
-    candidates = [cell for cell in of("g") + of("c") if cell not in starts] or free
-    reachable = [cell for cell in candidates if cell in distance and cell not in starts]
+    candidates = [cell for cell in of("g") + of("c") if cell not in is_start] or free
+    reachable = [cell for cell in candidates if cell in distance and cell not in is_start]
     if d4rl is None and not reachable:
         raise MazeError(f"{name}: no goal cell is reachable from the start {starts[0]}")
     goal = d4rl or max(sorted(reachable), key=lambda cell: distance[cell])  # max keeps the first on a tie
-    grid = ["".join("#" if wall else "." for wall in row) for row in walls]
+    grid = [["#" if wall else "." for wall in row] for row in walls]
     for (r, c), ch in [(cell, "S") for cell in starts] + [(goal, "G")]:
-        grid[r] = grid[r][:c] + ch + grid[r][c + 1:]
-    return "\n".join(grid)
+        grid[r][c] = ch
+    return "\n".join("".join(row) for row in grid)
 
 
 def to_gymnasium(maze) -> list[list[int]]:

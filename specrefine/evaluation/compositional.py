@@ -78,6 +78,9 @@ class CompositionalPolicy:
 
     def match_env_dt(self, env_dt: float | None) -> None:
         """``act`` is called every ``env_dt`` seconds: decide every ``hold`` calls (None: every call)."""
+        if env_dt is not None and (isinstance(env_dt, bool) or not isinstance(env_dt, int | float | np.number)
+                                   or not np.isfinite(env_dt) or env_dt <= 0):
+            raise SpecrefineError(f"env_dt {env_dt!r:.40}: the seconds between act calls must be a positive number")
         self.env_dt = None if env_dt is None else float(env_dt)
         self.hold = 1 if env_dt is None else max(1, round(self.control_period / self.env_dt))
 
@@ -145,25 +148,21 @@ class CompositionalPolicy:
     @classmethod
     def load(cls, run_dir, env_dt: float | None = None) -> CompositionalPolicy:
         """The policy saved in ``run_dir`` (``policy.json`` + its goal policy); problems are one PolicyError line."""
+        from ..core.records import check_policy, read_json
+
         path = Path(run_dir) / POLICY_JSON
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
+        if not path.exists() and not path.is_symlink():
             raise PolicyError(f"{path}: no compositional policy (not a finished run folder, or the run found no "
-                              "path)") from None
-        except (OSError, ValueError) as exc:
-            raise PolicyError(f"{path}: unreadable ({type(exc).__name__})") from None
+                              "path)")
+        data = read_json(path, "compositional policy", PolicyError)
         if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("version") != VERSION:
             raise PolicyError(f"{path}: not a specrefine compositional policy (format {FORMAT} v{VERSION})")
-        try:
-            maze = Maze(data["maze"], tuple(data["maze_grid"]), float(data["cell_size"]))
-            legs = [Leg(leg["vertex"], from_dict(leg["goal"]), from_dict(leg["avoid"]),
-                        None if leg["point"] is None else tuple(float(v) for v in leg["point"]))
-                    for leg in data["legs"]]
-            goal_policy = _load_goal_policy(data["agent"], data["goal_policy"])
-            return cls(data["agent"], maze, legs, goal_policy, int(data["horizon"]), env_dt=env_dt)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise PolicyError(f"{path}: malformed ({type(exc).__name__}: {str(exc)[:80]})") from None
+        check_policy(data, path, PolicyError)
+        maze = Maze(data["maze"], tuple(data["maze_grid"]), float(data["cell_size"]))
+        legs = [Leg(leg["vertex"], from_dict(leg["goal"]), from_dict(leg["avoid"]),
+                    None if leg["point"] is None else tuple(float(v) for v in leg["point"])) for leg in data["legs"]]
+        goal_policy = _load_goal_policy(data["agent"], data["goal_policy"])
+        return cls(data["agent"], maze, legs, goal_policy, data["horizon"], env_dt=env_dt)
 
     def to_dict(self, goal_policy_record: dict) -> dict:
         return {"format": FORMAT, "version": VERSION, "agent": self.agent, "maze": self.maze.name,
@@ -232,7 +231,21 @@ def _load_goal_policy(agent: str, record: dict):
 # --- observations ------------------------------------------------------------------------------------
 def agent_xy(observation) -> np.ndarray:
     """The agent's (x, y) from a Gymnasium-Robotics maze observation (its ``achieved_goal``)."""
-    return np.asarray(observation["achieved_goal"], dtype=float).reshape(2)
+    xy = _finite(observation, "achieved_goal")
+    if xy.size != 2:
+        raise SpecrefineError(f"an observation's achieved_goal is the agent's (x, y), got {xy.size} values")
+    return xy.reshape(2)
+
+
+def _finite(observation, key: str) -> np.ndarray:
+    """``observation[key]`` as finite floats, else one SpecrefineError line (a diverged or foreign environment)."""
+    try:
+        values = np.asarray(observation[key], dtype=float).ravel()
+    except (KeyError, IndexError, TypeError, ValueError):
+        raise SpecrefineError(f"not a Gymnasium-Robotics maze observation: no numbers under {key!r}") from None
+    if not np.isfinite(values).all():
+        raise SpecrefineError(f"the observation's {key} holds NaN or infinite values (a diverged simulation?)")
+    return values
 
 
 def policy_observation(agent: str, observation, goal, frame: str = "world") -> np.ndarray:
@@ -241,7 +254,7 @@ def policy_observation(agent: str, observation, goal, frame: str = "world") -> n
     from ..sim.simulator import free_body_observation
 
     spec = get_agent(agent)
-    body = np.asarray(observation["observation"], dtype=float).ravel()
+    body = _finite(observation, "observation")
     rel = (np.asarray(goal, dtype=float).reshape(2) - agent_xy(observation))[None]
     if spec.planar:  # PointMaze: (x, y, vx, vy) -> velocity, goal - xy
         if body.size != 4:
@@ -260,4 +273,7 @@ def torso_flipped(agent: str, observation) -> bool:
 
     if get_agent(agent).planar:
         return False
-    return bool(torso_up(np.asarray(observation["observation"], dtype=float)[1:5][None])[0] < 0.0)
+    body = _finite(observation, "observation")
+    if body.size < 5:
+        raise SpecrefineError(f"an {agent} observation starts with z and the torso's quaternion: {body.size} values")
+    return bool(torso_up(body[1:5][None])[0] < 0.0)

@@ -163,24 +163,34 @@ def summary(report: dict) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, bounded_int, out_path
-    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+def add_arguments(p) -> None:
+    from ..core.argtypes import bounded_int, out_path
     from ..evaluation.evaluator import GOAL_POINTS
 
-    p = OneLineParser(prog="python -m specrefine.experiments.failures", description=__doc__.split("\n\n")[0])
+    p.description = __doc__.split("\n\n")[0]
     p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
     p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
-    p.add_argument("--policy", default="shipped", help="'shipped' or a policy checkpoint")
+    p.add_argument("--policy", default="shipped", help="'shipped' (the run's agent's) or a policy checkpoint")
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
                         "centre: at the set's centre (beyond the paper) (default: as the run measured it)")
     p.add_argument("--estimates", type=bounded_int("seed"), nargs="+", default=None, metavar="SEED",
-                   help="instead of re-running episodes: estimate every leg again along the chain, once per seed")
-    p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON")
-    args = p.parse_args(argv)
+                   help="instead of re-running episodes: estimate every leg again along the chain, once per seed "
+                        "(default: none: re-run episodes)")
+    p.add_argument("--out", type=out_path, default=None, help="write the report here as JSON (default: printed only)")
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("failures", argv, prog="python -m specrefine.experiments.failures")
+
+
+def run(args, p) -> int:
+    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+
     try:
         if args.out is not None:
             writable_parent(args.out)  # before the re-run, not after it

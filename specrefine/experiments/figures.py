@@ -204,19 +204,28 @@ def calibration_figure(tables: dict):
     return fig
 
 
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
+
+    p.description = "Figures 4-6 from a sweep table"
+    p.add_argument("table", help="results.csv written by specrefine sweep")
+    p.add_argument("--out", type=out_path, default=None,
+                   help="folder for figure4/5/6.png and summary.md (default: the table's)")
+
+
 def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("figures", argv, prog="python -m specrefine.experiments.figures")
+
+
+def run(args, p) -> int:
     from pathlib import Path
 
-    from ..core.argtypes import OneLineParser, out_path
     from ..core.errors import SpecrefineError
     from ..core.runfolder import ensure_dir
     from ..runs.sweep import read_checked_table
 
-    p = OneLineParser(prog="python -m specrefine.experiments.figures", description="Figures 4-6 from a sweep table")
-    p.add_argument("table", help="results.csv written by specrefine.runs.sweep")
-    p.add_argument("--out", type=out_path, default=None,
-                   help="folder for figure4/5/6.png and summary.md (default: the table's)")
-    args = p.parse_args(argv)
     try:
         rows = read_checked_table(args.table)
         out = ensure_dir(args.out or Path(args.table).parent)

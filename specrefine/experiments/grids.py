@@ -393,44 +393,55 @@ def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, li
     return out
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, bounded_int
+def add_arguments(p) -> None:
+    from ..core.argtypes import bounded_int
 
-    p = OneLineParser(prog="python -m specrefine.experiments.grids", description=__doc__.split("\n")[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    p.description = __doc__.split("\n")[0]
+    sub = p.add_subparsers(dest="grids_command", required=True, metavar="{list,show,args,plan,status}")
     sub.add_parser("list", help="every grid: name, agent, cells, where it was fixed")
     for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),
                        ("args", "one step's sweep arguments, shell-quoted on one line"),
                        ("plan", "the code and steps run_grid.sh runs"),
                        ("status", "cells done per part, from the shipped tables (--missing: which are not)")):
-        sp = sub.add_parser(name, help=what)
-        sp.add_argument("grid")
+        sp = sub.add_parser(name, help=what, description=what)
+        sp.add_argument("grid", help="a grid's name (specrefine grids list)")
         if name == "args":
-            sp.add_argument("--part", type=int, required=True)
-            sp.add_argument("--step", type=int, default=0)
-            sp.add_argument("--workers", type=bounded_int("workers"), default=None)
+            sp.add_argument("--part", type=int, required=True, help="the part, from 0 (required)")
+            sp.add_argument("--step", type=int, default=0, help="the step of the part, from 0")
+            sp.add_argument("--workers", type=bounded_int("workers"), default=None,
+                            help="local processes of the sweep (default: the grid's)")
         if name == "status":
             sp.add_argument("--missing", action="store_true", help="list the cells still to run")
         if name == "plan":
-            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it)")
-            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids)")
-    args = p.parse_args(argv)
+            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it) "
+                                                        "(default: the grid's)")
+            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids) "
+                                                            "(default: the grid's)")
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("grids", argv, prog="python -m specrefine.experiments.grids")
+
+
+def run(args, p) -> int:
     try:
-        if args.command == "list":
+        if args.grids_command == "list":
             for g in GRIDS.values():
                 print(f"{g.name}\t{g.agent}\t{len(cells(g))} cells\t{g.doc}")
             return 0
         g = get(args.grid)
-        if args.command == "show":
+        if args.grids_command == "show":
             print("\n".join(show(g)))
-        elif args.command == "status":
+        elif args.grids_command == "status":
             for i, done, total, missing in status(g):
                 part = g.parts[i]
                 print(f"part {i}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {done}/{total} done "
                       f"({g.part_table(i)})")
                 if args.missing:
                     print("".join(f"  {cell}\n" for cell in missing), end="")
-        elif args.command == "plan":
+        elif args.grids_command == "plan":
             print("\n".join(plan(g, args.out, args.shipped)))
         else:
             steps = sweep_args(g, args.part, workers=args.workers)

@@ -3,7 +3,9 @@
 ``propose_split`` returns up to ``w`` candidate edge splits, each the ordered list of intermediate
 waypoint regions x1..x_{k-1} (u -> x1 -> ... -> v); ``propose_graph`` returns up to ``w`` whole task
 graphs (the one-shot VLM baseline of the paper's Sec. 5.1).  A new proposer subclasses
-:class:`Proposer`, implements those two methods and is named in :func:`~specrefine.proposers.make_proposer`.
+:class:`Proposer`, implements :meth:`~Proposer.split` and :meth:`~Proposer.graph` (the base class's
+``propose_split`` / ``propose_graph`` count each query, then ask them) and is registered with
+:func:`~specrefine.proposers.register_proposer`, whose ``make_proposer`` gives it its ``spec`` string.
 """
 
 from __future__ import annotations
@@ -73,15 +75,24 @@ class GraphFeedback:
 
 
 class Proposer:
-    """Base class.  ``calls``/``cost_usd`` count VLM API calls and dollars (0 for offline proposers)."""
+    """Base class. Its two contracts, kept here rather than by each subclass:
+
+    * it counts its queries: ``propose_split`` / ``propose_graph`` add one to ``queries`` and ask :meth:`split` /
+      :meth:`graph`, which a subclass implements (``proposer_calls``, in result.json, reads the count);
+    * it carries the string that named it: ``spec`` (``make_proposer`` sets it to the ``--proposer`` string; the
+      constructor takes it for proposers built by hand).
+
+    ``calls``/``cost_usd`` count VLM API calls and dollars (0 for offline proposers)."""
 
     name: str = "?"
-    spec: str = "?"
+    spec: str = "?"  # a subclass may name its default string here (GeometricProposer: "geometric")
     is_vlm: bool = False
     #: whether its answers depend on the queries' pictures (offline proposers: no, so none are rendered)
     sees_images: bool = False
 
-    def __init__(self):
+    def __init__(self, spec: str | None = None):
+        if spec is not None:
+            self.spec = spec  # the proposer string that names it (result.json's "proposer")
         self.queries = 0  # propose_* calls answered
         self.history: list[dict] = []  # per query: accepted candidates (with reasoning) and rejections
 
@@ -99,10 +110,22 @@ class Proposer:
         return self.queries
 
     def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
-        raise NotImplementedError  # pragma: no cover
+        """Up to ``w`` candidate splits of ``q``'s edge (counted as one query)."""
+        self.queries += 1
+        return self.split(q, w, feedback)
 
     def propose_graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:
-        raise NotImplementedError  # pragma: no cover
+        """Up to ``w`` whole task graphs for ``q`` (counted as one query)."""
+        self.queries += 1
+        return self.graph(q, w, feedback)
+
+    def split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback]) -> list[list[Region]]:
+        """What a subclass answers to an edge query: each candidate the waypoint regions x1..x_{k-1}."""
+        raise NotImplementedError(f"{type(self).__name__} does not propose edge splits")
+
+    def graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback]) -> list[TaskGraph]:
+        """What a subclass answers to a whole-graph query (the one-shot baseline)."""
+        raise NotImplementedError(f"{type(self).__name__} does not propose whole task graphs")
 
     def describe(self) -> dict:
         """What a result file should say about the proposer."""

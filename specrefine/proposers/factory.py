@@ -14,6 +14,9 @@ A proposer string is ``KIND`` or ``KIND:OPTIONS``; :data:`PROPOSERS` maps each k
 A new proposer is its module and one :func:`register_proposer` call: ``parse`` checks the options (the text
 after ``KIND:``) without side effects and returns what ``build`` needs; ``build(options, spec=..., seed=...,
 record_path=..., **client_kw)`` returns the :class:`Proposer`.  :func:`parse_proposer` checks a whole string.
+What every proposer promises (it counts its queries, it carries the string that named it) is kept by the
+:class:`Proposer` base class and by :func:`make_proposer`, not by each builder. A registration is checked when it
+is made: a safe name, a built-in not replaced unless ``replace=True``, functions for ``build`` and ``parse``.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
+from ..core.names import check_callable, check_registration
 from ..vlm import LiteLLMClient, ReplayClient
 from .base import Proposer
 from .geometric import GeometricProposer, RandomProposer
@@ -43,14 +47,17 @@ class ProposerKind:
 
 
 PROPOSERS: dict[str, ProposerKind] = {}
+BUILT_IN: frozenset[str] = frozenset()  # set below, once the package's own proposers are registered
 
 
 def register_proposer(name: str, build: Callable[..., Proposer], parse: Callable[[str], object], *,
-                      usage: str | None = None, description: str = "") -> ProposerKind:
-    """Make ``NAME`` / ``NAME:OPTIONS`` a proposer string everywhere (``make_proposer``, the sweep, notebooks)."""
-    if ":" in name or not name:
-        raise ValueError(f"a proposer kind is a non-empty name without ':', got {name!r}")
-    kind = ProposerKind(name, build, parse, usage or name, description)
+                      usage: str | None = None, description: str = "", replace: bool = False) -> ProposerKind:
+    """Make ``NAME`` / ``NAME:OPTIONS`` a proposer string everywhere (``make_proposer``, the sweep, notebooks). A
+    built-in kind is replaced only with ``replace=True``; a bad name, build or parse is a one-line SpecrefineError."""
+    check_registration("proposer", name, PROPOSERS, BUILT_IN, replace)
+    check_callable("proposer", name, "build", build)
+    check_callable("proposer", name, "parse", parse)
+    kind = ProposerKind(name, build, parse, usage or name, str(description))
     PROPOSERS[name] = kind
     return kind
 
@@ -72,9 +79,12 @@ def parse_proposer(spec: str) -> tuple[ProposerKind, object]:
 
 
 def make_proposer(spec: str, *, seed: int = 0, record_path: str | Path | None = None, **client_kw) -> Proposer:
-    """The proposer a ``--proposer`` string names (extra keywords go to LiteLLMClient)."""
+    """The proposer a ``--proposer`` string names (extra keywords go to LiteLLMClient); its ``spec`` is that string."""
     kind, options = parse_proposer(spec)
     proposer = kind.build(options, spec=spec, seed=seed, record_path=record_path, **client_kw)
+    if not isinstance(proposer, Proposer):
+        raise SpecrefineError(f"proposer {kind.name!r}: its build returned {type(proposer).__name__}, not a Proposer")
+    proposer.spec = spec  # what result.json and a sweep's rows name it by
     log.info("proposer: %s", proposer.name)
     return proposer
 
@@ -141,3 +151,5 @@ register_proposer("replay", _replay, _needs("replay", "recording's path"), usage
 register_proposer("litellm", _litellm, _needs("litellm", "model"), usage="litellm:MODEL",
                   description="any LiteLLM model, e.g. litellm:gpt-4o, litellm:gemini/gemini-2.0-flash; keys from "
                               "the environment")
+
+BUILT_IN = frozenset(PROPOSERS)  # registered by the package itself: replaced only with replace=True

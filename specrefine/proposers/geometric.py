@@ -136,8 +136,9 @@ class _GridProposer(Proposer):
 
     is_vlm = False
 
-    def __init__(self, seed: int = 0, radius: tuple[float, float] = (0.3, 0.5), max_waypoints: int = 32):
-        super().__init__()
+    def __init__(self, seed: int = 0, radius: tuple[float, float] = (0.3, 0.5), max_waypoints: int = 32,
+                 spec: str | None = None):
+        super().__init__(spec)
         self.seed = seed
         self.rng = np.random.default_rng(seed)
         self.radius = radius
@@ -168,8 +169,7 @@ class _GridProposer(Proposer):
                    agent: str = "") -> list[Region]:  # pragma: no cover
         raise NotImplementedError
 
-    def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
-        self.queries += 1
+    def split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         out = []
         for j in range(w):
             cand = None
@@ -190,9 +190,8 @@ class _GridProposer(Proposer):
     def _adapt(self, q, feedback, j, rng) -> list[Region] | None:  # default: ignore feedback
         return None
 
-    def propose_graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:
+    def graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:
         """The same per edge: each edge of the input graph (or the weakest edge of the best earlier graph)."""
-        self.queries += 1
         out = []
         for j in range(w):
             if feedback:

@@ -302,13 +302,13 @@ class ImperfectProposer(VLMProposer):
     def calls(self) -> int:  # no VLM was called
         return 0
 
-    def propose_split(self, q, w, feedback=()):
+    def split(self, q, w, feedback=()):
         self.client.context = ("split", q, list(feedback))
-        return super().propose_split(q, w, feedback)
+        return super().split(q, w, feedback)
 
-    def propose_graph(self, q, w, feedback=()):
+    def graph(self, q, w, feedback=()):
         self.client.context = ("graph", q, list(feedback))
-        return super().propose_graph(q, w, feedback)
+        return super().graph(q, w, feedback)
 
     def describe(self) -> dict:
         return {**super().describe(), "error_model": asdict(self.config)}

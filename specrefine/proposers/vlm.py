@@ -26,9 +26,8 @@ class VLMProposer(Proposer):
     sees_images = True
 
     def __init__(self, client: VLMClient, *, spec: str | None = None, reask: bool = True, max_waypoints: int = 32):
-        super().__init__()
+        super().__init__(spec or client.name)
         self.client = client
-        self.spec = spec or client.name
         self.name = client.name if not isinstance(client, ReplayClient) else f"{client.name} (recorded {client.model})"
         self.reask = reask
         self.max_waypoints = max_waypoints
@@ -51,18 +50,17 @@ class VLMProposer(Proposer):
         """Answers the client could not read (no chat completion, no choices, too long)."""
         return self.client.bad_replies
 
-    def propose_split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
+    def split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         messages = split_messages(q, feedback)
         parse = lambda text: parse_split(text, q.maze, max_waypoints=self.max_waypoints)  # noqa: E731
         return self._ask(messages, w, parse, "edge split", round_=1 + bool(feedback))
 
-    def propose_graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:
+    def graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:
         messages = graph_messages(q, feedback)
         parse = lambda text: parse_graph(text, q.maze, q.graph)  # noqa: E731
         return self._ask(messages, w, parse, "task graph", round_=1 + bool(feedback))
 
     def _ask(self, messages, w, parse, kind, round_):
-        self.queries += 1
         entry = {"kind": kind, "round": round_, "accepted": [], "rejected": [], "reasked": False}
         self.history.append(entry)
         self.last_messages = messages

@@ -73,6 +73,29 @@ class SearchConfig:
         if self.evaluation not in EVALUATIONS:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
 
+    @classmethod
+    def from_run(cls, run, **changes) -> SearchConfig:
+        """The search a run's configuration asks for (``run``: a resolved ``runs.config.RunConfig``: its w, d, k,
+        seed and evaluation), with ``changes`` to any field; an unknown field is a one-line SpecrefineError."""
+        check_changes(changes)
+        taken = {name: getattr(run, name) for name in FROM_RUN}
+        return cls(**{**taken, **changes})
+
+
+FROM_RUN = ("w", "d", "k", "seed", "evaluation")  # what a run's configuration sets in its search
+
+
+def check_changes(changes: dict) -> None:
+    """A one-line SpecrefineError if ``changes`` names a field SearchConfig does not have."""
+    from dataclasses import fields
+
+    from ..core.errors import SpecrefineError
+
+    unknown = sorted(set(changes) - {f.name for f in fields(SearchConfig)})
+    if unknown:
+        raise SpecrefineError(f"SearchConfig has no field {', '.join(map(repr, unknown))}: use "
+                              f"{', '.join(f.name for f in fields(SearchConfig))}")
+
 
 @dataclass
 class Refinement:

@@ -163,11 +163,11 @@ NEEDED = ("success_rate", "seed", "rollouts_per_evaluation", "episodes", "path",
 def checked_run(run, maze_dir=None):
     """(result file, its data with the graphs built, run.json's arguments, the maze) of a finished run, checked
     before any simulation: anything unusable is a one-line :class:`~specrefine.core.errors.SpecrefineError`."""
-    import json
 
     from ..core.errors import SpecrefineError
     from ..core.graph import TaskGraph
     from ..core.mazes import load_maze
+    from ..core.records import read_json
     from ..core.runfolder import read_result, recorded_maze
 
     path = result_file(run)
@@ -176,10 +176,7 @@ def checked_run(run, maze_dir=None):
     if missing:
         raise SpecrefineError(f"{path}: result.json lacks {', '.join(missing)}")
     run_json = path.with_name("run.json") if path.name == "result.json" else None
-    try:
-        args = json.loads(run_json.read_text()) if run_json and run_json.is_file() else {}
-    except (OSError, ValueError):
-        raise SpecrefineError(f"{run_json}: unreadable run record") from None
+    args = read_json(run_json, "run record") if run_json and run_json.is_file() else {}
     if not isinstance(args, dict):
         raise SpecrefineError(f"{run_json}: unreadable run record")
     if args.get("policy", "shipped") != "shipped":
@@ -287,21 +284,31 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     return failed
 
 
+def add_arguments(ap) -> None:
+    """``specrefine calibrate RUN... --table OUT.csv``: predictions made again, and coverage;
+    ``specrefine calibrate --coverage TABLE...``: the coverage of existing tables."""
+    from ..core.argtypes import out_path
+
+    ap.description = "Predictions made again, and their coverage (--coverage: of existing tables)"
+    ap.add_argument("runs", nargs="+", type=Path,
+                    help="run folders (each with result.json) or result.json files; with --coverage, tables")
+    ap.add_argument("--table", type=out_path, help="CSV: one row per run (resumed if it exists; default: none, "
+                                                   "required unless --coverage)")
+    ap.add_argument("--coverage", action="store_true", help="only report the coverage of the given tables")
+    ap.add_argument("--maze-dir", type=Path, help="where mazes named by stem live when not in data/mazes/ and the "
+                                                   "run has no run.json (a bare result file) (default: none)")
+
+
 def main(argv=None) -> int:
-    """``python -m specrefine.runs.calibrate RUN... --table OUT.csv``: predictions made again, and coverage;
-    ``python -m specrefine.runs.calibrate --coverage TABLE...``: the coverage of existing tables."""
-    from ..core.argtypes import OneLineParser, out_path
+    from ..core.commands import run_command
+
+    return run_command("calibrate", argv, prog="python -m specrefine.runs.calibrate")
+
+
+def run(args, ap) -> int:
     from ..core.errors import SpecrefineError
     from ..core.runfolder import writable_parent
 
-    ap = OneLineParser(prog="python -m specrefine.runs.calibrate", description=main.__doc__.split(":")[0])
-    ap.add_argument("runs", nargs="+", type=Path,
-                    help="run folders (each with result.json) or result.json files; with --coverage, tables")
-    ap.add_argument("--table", type=out_path, help="CSV: one row per run (resumed if it exists)")
-    ap.add_argument("--coverage", action="store_true", help="only report the coverage of the given tables")
-    ap.add_argument("--maze-dir", type=Path, help="where mazes named by stem live when not in data/mazes/ and the "
-                                                   "run has no run.json (a bare result file)")
-    args = ap.parse_args(argv)
     try:
         if args.coverage:
             absent = [t for t in args.runs if not t.is_file()]

@@ -3,7 +3,10 @@
 :data:`METHODS` maps a method's name to its :class:`Method`; ``specrefine refine --method``, the sweep's
 ``--methods``, the pipeline's dispatch (:func:`run_search`) and the figures' colours all read it.  A new method is
 its module (a function ``search(job: SearchJob) -> SearchResult``) and one :func:`register_method` call; a
-variant of ours is one entry with :func:`ours_variant` (what it changes in ``SearchConfig``).
+variant of ours is one entry with :func:`ours_variant` (what it changes in ``SearchConfig``). A registration is
+checked when it is made (a safe name, a built-in not replaced unless ``replace=True``, a function to search with,
+``ours_variant``'s fields), so a mistake is one line there, never a traceback after a run has started. Plugins
+(:mod:`specrefine.core.plugins`) register through the same call before the command line is built.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
+from ..core.names import check_callable, check_registration
 from .queries import candidate_picture, edge_query_builder
 
 if TYPE_CHECKING:  # an annotation only: runs.config reads the registry for its choices
@@ -45,15 +49,20 @@ class Method:
 
 
 METHODS: dict[str, Method] = {}
+BUILT_IN: frozenset[str] = frozenset()  # set below, once the package's own methods are registered
 
 
 def register_method(name: str, search: Callable[[SearchJob], object], description: str, *,
-                    asks_proposer: bool = True, colour: str = "#757575", knobs: tuple[str, ...] = KNOBS) -> Method:
-    """Make ``name`` a method everywhere (``--method``, the sweep, the figures)."""
+                    asks_proposer: bool = True, colour: str = "#757575", knobs: tuple[str, ...] = KNOBS,
+                    replace: bool = False) -> Method:
+    """Make ``name`` a method everywhere (``--method``, the sweep, the figures). A built-in method is replaced only
+    with ``replace=True``; a bad name, search or knob is a one-line :class:`SpecrefineError`."""
+    check_registration("method", name, METHODS, BUILT_IN, replace)
+    check_callable("method", name, "search", search)
     unknown = set(knobs) - set(KNOBS)
-    if unknown:
-        raise ValueError(f"knobs must be among {KNOBS}, got {sorted(unknown)}")
-    method = Method(name, search, description, asks_proposer, colour, tuple(knobs))
+    if isinstance(knobs, str) or unknown:
+        raise SpecrefineError(f"method {name!r}: knobs must be a tuple of {', '.join(KNOBS)}, got {knobs!r}")
+    method = Method(name, search, str(description), bool(asks_proposer), colour, tuple(knobs))
     METHODS[name] = method
     return method
 
@@ -105,13 +114,16 @@ def dirl(job: SearchJob):
 def symbolic(job: SearchJob):
     from ..refine import RefinementSearch, SearchConfig
 
-    c = job.config
-    cfg = SearchConfig(k=c.k, edge_refinement=False, seed=c.seed, evaluation=c.evaluation)
+    cfg = SearchConfig.from_run(job.config, edge_refinement=False)
     return RefinementSearch(job.graph, job.evaluator, config=cfg, on_step=job.on_step).run()
 
 
 def ours_variant(**changes) -> Callable[[SearchJob], object]:
-    """Algorithm 3 with ``changes`` to its SearchConfig (``shortcut_reach="policy"``: the agent's goal range)."""
+    """Algorithm 3 with ``changes`` to its SearchConfig (``shortcut_reach="policy"``: the agent's goal range); a
+    field SearchConfig lacks is a one-line :class:`SpecrefineError` here, when the variant is made."""
+    from ..refine.search import check_changes
+
+    check_changes(changes)
 
     def search(job: SearchJob):
         from ..refine import RefinementSearch, SearchConfig
@@ -120,7 +132,7 @@ def ours_variant(**changes) -> Callable[[SearchJob], object]:
         for reach in ("shortcut_reach", "correct_reach"):
             if variant.get(reach) == "policy":  # as far as the policy was trained to reach a goal
                 variant[reach] = get_agent(c.agent).reach_task.goal_max
-        cfg = SearchConfig(**{"w": c.w, "d": c.d, "k": c.k, "seed": c.seed, "evaluation": c.evaluation, **variant})
+        cfg = SearchConfig.from_run(c, **variant)
         images = getattr(job.proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(job.maze, c.agent, job.evaluator.facts(), images=images)
         return RefinementSearch(job.graph, job.evaluator, proposer=job.proposer, config=cfg, on_step=job.on_step,
@@ -199,3 +211,5 @@ register_method("symbolic", symbolic, "baseline: the search with vertex subsets 
                 colour="#8d6e63", knobs=("k",))
 register_method("dirl", dirl, "baseline: no refinement, Dijkstra on the input graph", asks_proposer=False,
                 colour="#9e9e9e", knobs=())
+
+BUILT_IN = frozenset(METHODS)  # registered by the package itself: replaced only with replace=True

@@ -317,17 +317,29 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
     return 1 if failed else 0
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, out_path
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
 
-    p = OneLineParser(prog="python -m specrefine.runs.notebook",
-                                description="Executed copies of the numbered notebooks (make executed).")
-    sub = p.add_subparsers(dest="command", required=True)
-    ex = sub.add_parser("executed", help="run the notebooks with a tier's parameters and keep the outputs")
-    ex.add_argument("--tier", choices=sorted(TIERS), default="full")
-    ex.add_argument("--out", type=out_path, default=NB_DIR / "executed")
+    p.description = "Executed copies of the numbered notebooks (make executed); needs the 'notebooks' extra."
+    sub = p.add_subparsers(dest="notebook_command", required=True, metavar="{executed}")
+    what = "run the notebooks with a tier's parameters and keep the outputs"
+    ex = sub.add_parser("executed", help=what, description=what)
+    ex.add_argument("--tier", choices=sorted(TIERS), default="full", help="the parameters (notebooks/TIER.json)")
+    ex.add_argument("--out", type=out_path, default=NB_DIR / "executed", help="where the executed copies go")
     ex.add_argument("notebooks", nargs="*", help="stems or number prefixes (e.g. 05); default all")
-    args = p.parse_args(argv)
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("notebook", argv, prog="python -m specrefine.runs.notebook")
+
+
+def run(args, p) -> int:
+    from ..core.extras import require
+
+    for module in ("papermill", "nbformat", "jupyterlab"):
+        require(module, "notebooks", "specrefine notebook")
     return write_executed(args.notebooks, args.tier, args.out)
 
 

@@ -46,6 +46,7 @@ from tqdm.auto import tqdm
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
+from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import write_atomic
 from ..core.standard_maps import to_gymnasium
@@ -100,9 +101,13 @@ def judged_env(run_dir, seed=None, *, start: str = "official", reset_noise: str 
         if rule not in RESET_RULES:
             raise SpecrefineError(f"{name} {rule!r}: expected one of {', '.join(RESET_RULES)}")
     run_dir = Path(run_dir)
-    original = _original_task(run_dir, _read_result(run_dir))
+    result = _read_result(run_dir)
+    original = _original_task(run_dir, result)
     policy = CompositionalPolicy.load(run_dir)
     agent, maze = policy.agent, policy.maze
+    if (result["agent"], result["maze"]) != (agent, maze.name):
+        raise SpecrefineError(f"{run_dir}: result.json is of the {result['agent']} in {result['maze']!r:.40}, "
+                              f"policy.json of the {agent} in {maze.name!r:.40}: not one run's records")
     if agent not in ENVIRONMENTS:
         raise SpecrefineError(f"{run_dir}: no official Gymnasium-Robotics environment for the {agent}")
     probe = make_env(maze, agent, 1)
@@ -132,6 +137,8 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     if out is not None and not Path(out).parent.is_dir():
         raise SpecrefineError(f"--out {out}: its folder {Path(out).parent} does not exist")
     result = _read_result(run_dir)
+    sim = {f"sim_{key}": result.get(key) for key in ("success_rate", "success_ci", "episodes")}  # the run's own
+    sim = sim if None not in sim.values() else dict.fromkeys(sim)  # measurement, whole or not at all
     env = judged_env(run_dir, seed, start=start, reset_noise=reset_noise)
     policy, maze = env.policy, env.policy.maze
     success, outcomes = [], {}
@@ -147,9 +154,8 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     env.close()
     k, n = int(np.sum(success)), len(success)
     data = {"env_id": env_id(maze, policy.agent), "episodes": n, "success_rate": k / n if n else 0.0,
-            "success_ci": list(wilson_ci(k, n)), "sim_success_rate": result.get("success_rate"),
-            "sim_success_ci": result.get("success_ci"), "sim_episodes": result.get("episodes"),
-            "outcomes": outcomes, "seed": seed, "agent": policy.agent, "maze": maze.name,
+            "success_ci": list(wilson_ci(k, n)), **sim, "outcomes": outcomes, "seed": seed, "agent": policy.agent,
+            "maze": maze.name,
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
@@ -224,16 +230,14 @@ def _original_task(run_dir: Path, result: dict):
 
 
 def _read_result(run_dir: Path) -> dict:
+    """The run's result.json, checked by the records' schema, with the task the episodes are judged on."""
     path = run_dir / "result.json"
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder") from None
-    except (OSError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
-    if not isinstance(data, dict):
-        raise SpecrefineError(f"{path}: not a run result")
-    return data
+    if not path.exists() and not path.is_symlink():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+    result = read_result(path)
+    if "input_graph" not in result:
+        raise SpecrefineError(f"{path}: no input_graph (the original task the episodes are judged on)")
+    return result
 
 
 def summary(data: dict) -> str:

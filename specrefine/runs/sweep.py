@@ -66,6 +66,7 @@ from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
 from ..core.paths import code_commit
+from ..core.plugins import loaded
 from ..core.runfolder import replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
 from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
@@ -201,13 +202,16 @@ def _knob_values(method: str, axes: dict[str, list[int]]) -> list[dict[str, int]
     return [dict(zip(KNOBS, combo)) for combo in dict.fromkeys(itertools.product(*values))]
 
 
-def run_cell(cell: Cell, out_root: str) -> dict:
-    """Run one cell; never raises: a failure becomes a row with status 'error'."""
+def run_cell(cell: Cell, out_root: str, plugins: tuple[str, ...] = ()) -> dict:
+    """Run one cell; never raises: a failure becomes a row with status 'error'. ``plugins``: the ``--plugin``
+    modules the sweep loaded (a Ray worker is a fresh process: it loads them, and the entry points, here)."""
+    from ..core.plugins import load_plugins
     from .pipeline import refine_maze
 
     row = {**asdict(cell), "cell": cell.id, "commit": code_commit()}  # a failed cell's row names its code too
     out = Path(out_root) / "cells" / cell.id
     try:
+        load_plugins(plugins)
         with cell_log(out / "log.txt"):
             result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
@@ -375,7 +379,8 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
             if not todo:
                 break
             runner = _run_ray if backend == "ray" else _run_local
-            for row in tqdm(runner(todo, str(out_root), workers, address), total=len(todo),
+            where = (str(out_root), *([tuple(loaded())] if loaded() else []))  # run_cell's arguments after the cell
+            for row in tqdm(runner(todo, where, workers, address), total=len(todo),
                             desc=f"sweep ({backend}, try {attempt + 1})"):
                 _append(table, row)
     finally:
@@ -383,11 +388,12 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
     return table
 
 
-def _run_local(cells, out_root, workers, _address):
+def _run_local(cells, where, workers, _address):
+    """``where``: run_cell's arguments after the cell (the sweep folder, and its plugins if any)."""
     workers = workers or max(1, (os.cpu_count() or 1))
     if workers == 1:
         for cell in cells:
-            yield run_cell(cell, out_root)
+            yield run_cell(cell, *where)
         return
     # Imported once here, before the fork: importing mujoco starts a short-lived `python -c` (glfw's library
     # probe); in a worker, Ctrl-C could end the worker under it and the orphan printed a BrokenPipeError.
@@ -397,7 +403,7 @@ def _run_local(cells, out_root, workers, _address):
                                mp_context=_mp_context())
     finished = False
     try:
-        futures = {pool.submit(run_cell, cell, out_root): cell for cell in cells}
+        futures = {pool.submit(run_cell, cell, *where): cell for cell in cells}
         for fut in as_completed(futures):
             yield _row_of(fut, futures[fut])
         finished = True
@@ -446,13 +452,15 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     os._exit(1)  # orphaned: the sweep that started this worker was killed
 
 
-def _run_ray(cells, out_root, _workers, address):
-    import ray
+def _run_ray(cells, where, _workers, address):
+    from ..core.extras import require
+
+    ray = require("ray", "ray", "--backend ray")
 
     if not ray.is_initialized():
         ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
     remote = ray.remote(num_cpus=1)(run_cell)
-    refs = [remote.remote(cell, out_root) for cell in cells]
+    refs = [remote.remote(cell, *where) for cell in cells]
     try:
         while refs:
             ready, refs = ray.wait(refs, num_returns=1)
@@ -530,22 +538,36 @@ def _check_policy(policy: str, agent: str) -> str | None:
     return None
 
 
+PROG = "python -m specrefine.runs.sweep"  # its older path; `specrefine sweep` is the same command
+
+
 def parser() -> OneLineParser:
-    """The sweep's command line."""
-    from ..core.mazes import benchmark_mazes
+    """The sweep's command line (as its older path names it)."""
+    from ..core.commands import command_parser
+
+    return command_parser("sweep", PROG)
+
+
+def add_arguments(p) -> None:
+    """The sweep's options (``specrefine sweep``)."""
     from .pipeline import METHODS
 
-    p = OneLineParser(prog="python -m specrefine.runs.sweep", description=__doc__.split("\n")[0])
-    p.add_argument("--mazes", nargs="+", default=sorted(benchmark_mazes()),
-                   help="maze names or files, or gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE); MAZE=SPEC runs "
-                        "that maze with the task SPEC (e.g. 'x=(a | b) -> G')")
+    p.description = __doc__.split("\n")[0]
+    p.add_argument("--mazes", nargs="+", default=None,
+                   help="maze names or files, gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE) or random:RxC:SEED; "
+                        "MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G') (default: none: name "
+                        "them, or give --all)")
+    p.add_argument("--all", action="store_true",
+                   help="every benchmark maze of data/mazes/ (what a sweep without --mazes ran before it was refused)")
     p.add_argument("--specs", nargs="+", default=[None], metavar="SPEC",
                    help="task expressions run on every maze without its own =SPEC (as specrefine refine --spec; "
                         "'' = the maze's own task; default: the maze's own task)")
-    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"])
-    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"])
-    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3])
-    p.add_argument("--agent", default="point", choices=list(AGENTS))
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=["dirl", "symbolic", "vlm-oneshot", "ours"],
+                   metavar="METHOD", help=f"methods, of: {', '.join(METHODS)}")
+    p.add_argument("--proposers", nargs="+", type=proposer_arg, default=["geometric", "random"],
+                   help="proposer strings, as specrefine refine --proposer (methods that ask none run once)")
+    p.add_argument("--seeds", nargs="+", type=bounded_int("seed"), default=[0, 1, 2, 3], help="seeds")
+    p.add_argument("--agent", default="point", choices=list(AGENTS), help="the agent of every cell")
     add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
     add_run_options(p, ["goal_points"], suffix=" (every cell; named in the cell id when not sampled)")
     add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
@@ -555,47 +577,59 @@ def parser() -> OneLineParser:
                         "when adaptive) (default: fixed for point, adaptive for ant)")
     p.add_argument("--policy", default="shipped",
                    help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
-                        "path (recorded in OUT/sweep.json and the 'policy' column) (default: shipped)")
-    p.add_argument("--out", type=out_path, default="runs/sweep")
+                        "path (recorded in OUT/sweep.json and the 'policy' column)")
+    p.add_argument("--out", type=out_path, default="runs/sweep", help="the sweep folder (results.csv, cells/)")
     p.add_argument("--backend", choices=["local", "ray"], default="local",
                    help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
-                        "Ray) (default: local)")
-    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379); default: local")
+                        "Ray; needs the 'ray' extra)")
+    p.add_argument("--address", default=None, help="Ray cluster address (e.g. 127.0.0.1:6379; default: a local one)")
     p.add_argument("--workers", type=bounded_int("workers"), default=None, help="local processes (default: CPU count)")
-    return p
 
 
 def cells_of(args) -> list[Cell]:
-    """The cells of parsed sweep arguments (a relative ``--policy`` is taken from the working directory)."""
-    return grid(args.mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
+    """The cells of parsed sweep arguments (no ``--mazes``: every benchmark maze; a relative ``--policy`` is taken
+    from the working directory)."""
+    from ..core.mazes import benchmark_mazes
+
+    mazes = args.mazes if args.mazes is not None else sorted(benchmark_mazes())
+    return grid(mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
                 goal_points=args.goal_points,
                 policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
 
 
 def main(argv=None) -> int:
-    p = parser()
-    args = p.parse_args(argv)
+    from ..core.commands import run_command
+
+    return run_command("sweep", argv, prog=PROG)
+
+
+def run(args, parser) -> int:
+    if args.mazes is None and not args.all:
+        return _fail(parser.prog, f"name the mazes (--mazes u_maze u_chain_2 ...), or give --all for every benchmark "
+                                  f"maze ({len(cells_of(args))} cells with these options)", 2)
+    if args.mazes is not None and args.all:
+        return _fail(parser.prog, "--mazes and --all: give one of them", 2)
     cells = cells_of(args)
-    bad = maze_problem(args.mazes) or _check_specs(cells) or _check_policy(args.policy, args.agent)
+    bad = maze_problem(args.mazes or []) or _check_specs(cells) or _check_policy(args.policy, args.agent)
     if bad:
-        return _fail(bad, 2)
+        return _fail(parser.prog, bad, 2)
     t0 = time.time()
     try:
         table = run_sweep(cells, args.out, backend=args.backend, workers=args.workers, address=args.address)
     except SpecrefineError as exc:
-        return _fail(str(exc), 2)
+        return _fail(parser.prog, str(exc), 2)
     except KeyboardInterrupt:
-        return _fail(f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun the same "
-                     f"command to resume", 130)
+        return _fail(parser.prog, f"interrupted; finished cells are kept in {Path(args.out) / 'results.csv'}: rerun "
+                                  f"the same command to resume", 130)
     done = {r["cell"] for r in read_table(table) if is_done(r)}
     failed = sum(c.id not in done for c in cells)
     print(f"{len(cells)} cells -> {table} ({failed} failed) in {time.time() - t0:.0f} s")
     return 1 if cells and failed == len(cells) else 0
 
 
-def _fail(message: str, code: int) -> int:
-    print(f"python -m specrefine.runs.sweep: error: {message}", file=sys.stderr)
+def _fail(prog: str, message: str, code: int) -> int:
+    print(f"{prog}: error: {message}", file=sys.stderr)
     return code
 
 

@@ -32,7 +32,7 @@ from torch import nn
 from tqdm.auto import tqdm
 
 from ..core.agents import AGENTS, get_agent
-from ..core.argtypes import OneLineParser, bounded_int, out_path
+from ..core.argtypes import bounded_int, out_path
 from ..core.errors import SpecrefineError
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
@@ -353,20 +353,33 @@ def train(agent: str, frames: int, out, resume: bool = False, progress: bool = T
 
 
 # --- command line -----------------------------------------------------------------------------
-def main(argv=None) -> int:
-    ap = OneLineParser(prog="python -m specrefine.sim.train", description=__doc__.splitlines()[0])
-    ap.add_argument("--agent", choices=list(AGENTS), required=True)
-    ap.add_argument("--out", type=out_path, default=None, help="run directory (checkpoint, log, curve)")
+def add_arguments(ap) -> None:
+    ap.description = __doc__.splitlines()[0]
+    ap.add_argument("--agent", choices=list(AGENTS), required=True, help="the agent to train (required)")
+    ap.add_argument("--out", type=out_path, default=None,
+                    help="run directory (checkpoint, log, curve) (default: none; required for training)")
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
-    ap.add_argument("--evaluate", metavar="POLICY", help="only evaluate POLICY ('point', 'ant' or a path)")
-    ap.add_argument("--episodes", type=bounded_int("episodes"), default=500)
-    ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"))
-    ap.add_argument("--plot", metavar="PNG", help="with --evaluate: save the success-vs-distance plot here")
-    ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--evaluate", metavar="POLICY",
+                    help="only evaluate POLICY ('point', 'ant' or a path) (default: none: train)")
+    ap.add_argument("--episodes", type=bounded_int("episodes"), default=500, help="with --evaluate: episodes")
+    ap.add_argument("--goal-range", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                    help="with --evaluate: goal distances in m (default: the agent's reach task's)")
+    ap.add_argument("--plot", metavar="PNG",
+                    help="with --evaluate: save the success-vs-distance plot here (default: none)")
+    ap.add_argument("--no-progress", action="store_true", help="no progress bar")
     ap.add_argument("--chain", type=bounded_int("chain"), default=None, metavar="K",
-                    help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain)")
+                    help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain) "
+                         "(default: one goal per episode)")
     config_arguments(ap)
-    args = ap.parse_args(argv)
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("train", argv, prog="python -m specrefine.sim.train")
+
+
+def run(args, ap) -> int:
     seed = args.seed or 0
     try:
         if args.evaluate and args.chain:

@@ -40,8 +40,10 @@ _MODEL_HINT = "use a LiteLLM model string such as gpt-4o, gemini/gemini-2.0-flas
 
 
 def _litellm():
+    from ..core.extras import require
+
     os.environ.setdefault("LITELLM_LOCAL_MODEL_COST_MAP", "True")  # never fetch the price list at import
-    import litellm
+    litellm = require("litellm", "vlm", "a litellm: proposer")
 
     litellm.suppress_debug_info = True
     return litellm

@@ -1,0 +1,7 @@
+"""``python -m specrefine``: the ``specrefine`` command line."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())
