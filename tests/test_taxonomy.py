@@ -15,9 +15,9 @@ from specrefine.experiments.taxonomy import CAUSES, classify, read_runs
 def write_run(folder, *, success, estimates, measured, steps, method="ours", maze="u_chain_3"):
     folder.mkdir(parents=True)
     path = ["S"] + [f"x{i}" for i in range(len(estimates) - 1)] + ["G"]
-    result = {"maze": maze, "method": method, "proposer": "imperfect:mild", "seed": 0, "success_rate": success,
-              "episodes": 200, "path": path, "edge_probabilities": estimates, "leg_success": measured,
-              "proposer_calls": 3}
+    result = {"maze": maze, "agent": "point", "method": method, "proposer": "imperfect:mild", "seed": 0,
+              "success_rate": success, "episodes": 200, "path": path, "edge_probabilities": estimates,
+              "leg_success": measured, "proposer_calls": 3}
     (folder / "result.json").write_text(json.dumps(result))
     (folder / "steps.jsonl").write_text("".join(json.dumps(s) + "\n" for s in steps))
 

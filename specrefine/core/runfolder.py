@@ -133,11 +133,9 @@ def _unlock(out: Path, fd: int) -> None:
 def _check_record(out: Path, args: dict) -> None:
     """Refuse ``out`` if its run.json records other arguments."""
     record = out / RECORD
-    try:
-        old = json.loads(record.read_text())
-    except FileNotFoundError:
-        old = None
-    except (OSError, ValueError, RecursionError):
+    try:  # a FIFO, a folder or a device there is refused unopened
+        old = read_json(record, "run record", RunFolderError) if record.exists() or record.is_symlink() else None
+    except RunFolderError:
         old = []  # unreadable: refused below
     if old is not None and not isinstance(old, dict):
         raise RunFolderError(f"{record}: unreadable run record: remove it or use another --out")

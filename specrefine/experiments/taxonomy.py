@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
+from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import write_atomic
 
@@ -63,8 +64,8 @@ def read_run(folder: Path) -> Run | None:
     result_path, steps_path = folder / "result.json", folder / "steps.jsonl"
     if not (result_path.is_file() and steps_path.is_file()):
         return None
+    result = read_result(result_path)
     try:
-        result = json.loads(result_path.read_text())
         steps = [json.loads(line) for line in steps_path.read_text().splitlines() if line.strip()]
     except (OSError, ValueError) as exc:
         raise SpecrefineError(f"{folder}: unreadable run ({exc})") from None
