@@ -64,9 +64,15 @@ def test_show_gives_the_path_leg_by_leg_the_time_and_the_pictures(runs, capsys):
     assert "official environment: not run" in out
 
 
-@pytest.mark.parametrize("content", [None, "{x", "[]"])
+@pytest.mark.parametrize("content", [None, "{x", "[]", '{"maze": "u_maze", "agent": "point"}', "fifo", "folder"])
 def test_show_refuses_what_is_not_a_run_in_one_line(tmp_path, capsys, content):
-    if content is not None:
+    import os
+
+    if content == "fifo":  # refused unopened: reading it would wait forever
+        os.mkfifo(tmp_path / "result.json")
+    elif content == "folder":
+        (tmp_path / "result.json").mkdir()
+    elif content is not None:
         (tmp_path / "result.json").write_text(content)
     assert main(["show", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip()

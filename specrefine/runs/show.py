@@ -26,16 +26,17 @@ FILES = (("refined.png", "the refined task and the measured episodes"), ("graph.
 
 
 def load_run(run_dir) -> dict:
-    """``RUN_DIR/result.json``, or one SpecrefineError line saying why it is not a finished run."""
+    """``RUN_DIR/result.json`` checked by the records' schema (``core.records``: a FIFO, a folder or a device is
+    refused unopened), or one SpecrefineError line saying why it is not a finished run."""
+    from ..core.records import read_result
+
     path = Path(run_dir) / "result.json"
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder") from None
-    except (OSError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: unreadable ({type(exc).__name__})") from None
-    if not isinstance(data, dict) or "success_rate" not in data or "path" not in data:
-        raise SpecrefineError(f"{path}: not a run result (no success_rate or path)")
+    if not path.exists() and not path.is_symlink():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+    data = read_result(path)
+    missing = [key for key in ("success_rate", "success_ci", "episodes", "path") if key not in data]
+    if missing:
+        raise SpecrefineError(f"{path}: not a finished run's result (no {', '.join(missing)})")
     return data
 
 
