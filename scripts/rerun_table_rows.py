@@ -22,9 +22,10 @@ SEARCH_COLUMNS = ("success_rate", "evaluations", "proposer_calls", "path_edges",
 
 
 def cells_of(rows) -> list[Cell]:
-    return [Cell(r["maze"], r["agent"], r["method"], r["proposer"], int(r["seed"]),
-                 int(r.get("rollouts_per_evaluation") or 32), int(r.get("episodes") or 200), r.get("spec") or "",
-                 r.get("evaluation") or "fixed", r.get("policy") or "shipped") for r in rows]
+    return [Cell.of(r["maze"], r["agent"], r["method"], r["proposer"], int(r["seed"]),
+                    rollouts=int(r.get("rollouts_per_evaluation") or 32), episodes=int(r.get("episodes") or 200),
+                    spec=r.get("spec") or "", evaluation=r.get("evaluation") or "fixed",
+                    policy=r.get("policy") or "shipped", goal_points=r.get("goal_points") or "sampled") for r in rows]
 
 
 def compare(old_rows, new_rows) -> list[str]:

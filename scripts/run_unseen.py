@@ -42,7 +42,8 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     table = out / "results.csv"
     files = {Path(m).stem: Path(m) for m in args.mazes}
-    cells = [Cell(name, args.agent, args.method, args.proposer, seed, args.rollouts, args.episodes)
+    cells = [Cell.of(name, args.agent, args.method, args.proposer, seed, rollouts=args.rollouts,
+                     episodes=args.episodes)
              for name in files for seed in args.seeds]
     for cell in pending(cells, table):
         result = refine_maze(files[cell.maze], agent=cell.agent, method=cell.method, proposer=cell.proposer,

@@ -106,7 +106,7 @@ def test_py_typed_ships_with_the_package():
 
 def _doc_sections(text: str) -> dict[str, str]:
     """docs/cli.md cut at its '## specrefine COMMAND' headings."""
-    parts = re.split(r"^## `specrefine (\w+)`", text, flags=re.M)
+    parts = re.split(r"^## `specrefine ([\w-]+)`", text, flags=re.M)
     return dict(zip(parts[1::2], parts[2::2]))
 
 
@@ -121,4 +121,4 @@ def test_docs_cli_names_every_option_method_and_proposer_of_the_help():
     assert not absent, absent
     assert all(f"`{name}`" in text for name in METHODS), [m for m in METHODS if f"`{m}`" not in text]
     assert all(kind.usage.split(" or ")[0].split(":")[0] in text for kind in PROPOSERS.values())
-    assert "random:RxC:SEED" in text and "--plugin" in text
+    assert "random:RxC:SEED" in text and "--plugin" in text and "--preset paper" in text

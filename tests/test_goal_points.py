@@ -113,7 +113,7 @@ def test_a_given_evaluator_with_the_other_rule_is_refused():
 def test_sweep_cells_name_the_rule_and_old_tables_refuse_it(tmp_path):
     (cell,) = sweep.grid(["u_maze"], ["dirl"], ["none"], [0], goal_points="centre")
     (paper,) = sweep.grid(["u_maze"], ["dirl"], ["none"], [0])
-    assert cell.id == paper.id + "__centre" and cell.config().goal_points == "centre"
+    assert cell.id == paper.id + "__centre" and cell.config.goal_points == "centre"
     table = tmp_path / "old.csv"
     table.write_text(",".join(c for c in sweep.COLUMNS if c != "goal_points") + "\n")
     with pytest.raises(ValueError, match="goal_points"):

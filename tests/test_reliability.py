@@ -96,7 +96,7 @@ def test_a_maze_in_a_folder_of_data_mazes_has_the_same_name_and_cell_on_every_ma
     monkeypatch.chdir(tmp_path)  # from anywhere, by its path there or by its name
     assert by_path == sweep.maze_ref("held_out/u_chain_3_rotated") == "held_out/u_chain_3_rotated"
     assert sweep.maze_ref(str(MAZE_DIR / "u_maze.maze")) == "u_maze"
-    cell = sweep.Cell(by_path, "ant", "ours", "geometric", 0)
+    cell = sweep.Cell.of(by_path, "ant", "ours", "geometric", 0, preset="paper")
     assert cell.id == "held_out-u_chain_3_rotated__ant__ours__geometric__s0"
 
 

@@ -310,26 +310,12 @@ def _run_main(argv) -> tuple[int, str]:
         signal.signal(signal.SIGALRM, previous)
 
 
-#: cases that wait on issue 40's part A (another branch): (position, kind) -> (the item, whether it hangs)
-PART_A = {("official --out FILE", "fifo"): ("2", False), ("official --out FILE", "folder"): ("10", False),
-          ("official --out FILE", "device"): ("2", False), ("sweep OUT/sweep.json", "random bytes"): ("11", False),
-          ("sweep OUT/sweep.json", "symlink"): ("11", False), ("sweep OUT/sweep.json", "fifo"): ("7", True),
-          ("sweep OUT/sweep.json", "folder"): ("11", False), ("sweep OUT/sweep.json", "device"): ("7", False)}
+POSITIONS = ("refine MAZE_FILE", "refine --policy", "refine replay recording", "refine OUT/run.json",
+             "official RUN/result.json", "official RUN/policy.json", "official --out FILE", "failures RESULT",
+             "failures RUN/run.json", "sweep OUT/sweep.json", "sweep OUT/results.csv")
 
 
-def _cases():
-    cases = []
-    for position in ("refine MAZE_FILE", "refine --policy", "refine replay recording", "refine OUT/run.json",
-                     "official RUN/result.json", "official RUN/policy.json", "official --out FILE", "failures RESULT",
-                     "failures RUN/run.json", "sweep OUT/sweep.json", "sweep OUT/results.csv"):
-        for kind in KINDS:
-            item, hangs = PART_A.get((position, kind), (None, False))
-            marks = [pytest.mark.xfail(reason=f"issue 40 item {item}, part A (rel-io)", run=not hangs)] if item else []
-            cases.append(pytest.param(position, kind, marks=marks))
-    return cases
-
-
-@pytest.mark.parametrize("position,kind", _cases())
+@pytest.mark.parametrize("position,kind", [(p, k) for p in POSITIONS for k in KINDS])
 def test_every_input_in_every_form_is_exit_0_or_one_line_and_nothing_outside_out_changes(
         finished_run, tmp_path, monkeypatch, capsys, position, kind):
     where, valid, argv_of = _positions(finished_run)[position]
@@ -359,3 +345,20 @@ def test_every_input_in_every_form_is_exit_0_or_one_line_and_nothing_outside_out
     assert _state(base, out) == before
     if position.endswith("--out FILE") and kind in ("fifo", "folder", "device"):  # only a file may be an output
         assert code == 2 and stat.S_IFMT(target.lstat().st_mode) == planted
+
+
+def test_a_policy_with_no_whole_horizon_or_acting_with_nan_is_refused():
+    from specrefine.core.errors import PolicyError
+    from specrefine.evaluation.compositional import CompositionalPolicy, Leg
+
+    maze = load_maze("u_maze")
+    legs = [Leg("G", maze.goal, maze.obstacles, None)]
+    nan_policy = lambda obs: np.full((len(obs), 2), np.nan)  # noqa: E731 - corrupt weights, say
+    for horizon in (0, -5, 2.5, float("inf"), True):
+        with pytest.raises(SpecrefineError, match="horizon"):
+            CompositionalPolicy("point", maze, legs, nan_policy, horizon)
+    policy = CompositionalPolicy("point", maze, legs, nan_policy, 3)
+    obs = {"observation": np.array([1.0, -1.0, 0.0, 0.0]), "achieved_goal": np.array([1.0, -1.0])}
+    policy.reset(obs, seed=0)
+    with pytest.raises(PolicyError, match="NaN"):
+        policy.act(obs)

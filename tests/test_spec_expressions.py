@@ -193,7 +193,7 @@ def test_refine_with_a_spec_records_it(tmp_path, capsys):
 
 
 def test_cell_ids_carry_the_spec_only_when_given():
-    plain = Cell("u_maze", "point", "dirl", "none", 0)
+    plain = Cell.of("u_maze", "point", "dirl", "none", 0)
     assert plain.id == "u_maze__point__dirl__none__s0" and plain.spec == ""
     cells = grid(["two_doors"], ["dirl"], ["geometric"], [0], specs=[None, "(a | b) -> c -> G", "b -> c -> G"])
     ids = [c.id for c in cells]

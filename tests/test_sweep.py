@@ -202,7 +202,7 @@ def test_w_d_k_are_grid_axes_and_the_paper_values_keep_their_ids(tmp_path):
                           "u_maze__point__symbolic__none__s0", "u_maze__point__symbolic__none__s0__k10",
                           "u_maze__point__dirl__none__s0"])  # symbolic reads k only, dirl none
     assert {(c.w, c.k) for c in cells if c.method == "ours"} == {(3, 5), (5, 5), (3, 10), (5, 10)}
-    assert Cell("u_maze", "point", "ours", "geometric", 0, k=10).config().k == 10
+    assert Cell.of("u_maze", "point", "ours", "geometric", 0, k=10).config.k == 10
     # a table from before the w, d, k columns: its rows read as the paper's values, its cells stay done
     old = [c for c in COLUMNS if c not in ("w", "d", "k")]
     table = tmp_path / "results.csv"

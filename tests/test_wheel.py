@@ -46,6 +46,7 @@ def test_wheel_runs_refine_outside_the_checkout(tmp_path):
     where = subprocess.run([sys.executable, "-c", probe], cwd=work, env=env, capture_output=True, text=True,
                            check=True).stdout.split()
     assert len(where) == 3 and all(Path(p).is_relative_to(site) for p in where), where
+    assert (site / "specrefine" / "py.typed").is_file()  # type hints ship (PEP 561)
     run = subprocess.run([str(site / "bin" / "specrefine"), "refine", "split_doorway", "--agent", "point",
                           "--proposer", "geometric", "--rollouts", "4", "--episodes", "4", "-w", "1", "-d", "1",
                           "-k", "1", "--out", str(work / "run")], cwd=work, env=env, capture_output=True,

@@ -14,6 +14,7 @@ class PaperSettings:
     rollouts: int = 32  # rollouts per subtask evaluation
     episodes: int = 200  # fresh end-to-end episodes of the final measurement
     goal_points: str = "sampled"  # a leg aims at a point drawn in its goal vertex's set, a new one per rollout
+    evaluation: str = "fixed"  # every subtask estimate on `rollouts` rollouts (no adaptive racing)
 
 
 PAPER = PaperSettings()

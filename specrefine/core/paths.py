@@ -30,6 +30,11 @@ def data_dir() -> Path:
     return _find("data")
 
 
+def shipped_name(text) -> bool:
+    """Whether ``text`` names a shipped policy checkpoint by its stem (``ant_stage5``: data/policies/ant_stage5.pt)."""
+    return isinstance(text, str) and text.isidentifier() and (data_dir() / "policies" / f"{text}.pt").is_file()
+
+
 @functools.lru_cache(maxsize=1)
 def code_commit() -> str:
     """The commit this package's code runs from (``git rev-parse --short=7 HEAD`` of its checkout or worktree), with

@@ -66,6 +66,8 @@ class CompositionalPolicy:
 
         if not legs:
             raise SpecrefineError("a compositional policy needs at least one leg (the run found no path)")
+        if isinstance(horizon, bool) or not isinstance(horizon, int | np.integer) or horizon < 1:
+            raise SpecrefineError(f"horizon {horizon!r:.40}: the decisions per leg must be a whole number >= 1")
         spec = get_agent(agent)
         self.agent, self.maze, self.legs, self.goal_policy, self.horizon = agent, maze, list(legs), goal_policy, horizon
         self.control_period = spec.timestep * spec.frame_skip
@@ -139,6 +141,8 @@ class CompositionalPolicy:
         return self.goal_policy.act(obs) if hasattr(self.goal_policy, "act") else self.goal_policy(obs)
 
     def _control(self, action: np.ndarray) -> np.ndarray:
+        if not np.isfinite(action).all():
+            raise PolicyError("the goal policy acts with NaN or infinite values: retrain it or restore its checkpoint")
         action = np.clip(action, -1.0, 1.0)
         if get_agent(self.agent).action_in_disc:
             action = action / max(float(np.linalg.norm(action)), 1.0)
@@ -199,6 +203,7 @@ def save_run_policy(run_dir, maze: Maze, agent: str, graph, path: list[str], eva
 
 
 def _goal_policy_record(run_dir: Path, goal_policy) -> dict | None:
+    from ..core.paths import shipped_name
     from ..core.runfolder import RECORD
     from ..sim.policy import GoalPolicy, PointController
 
@@ -211,17 +216,23 @@ def _goal_policy_record(run_dir: Path, goal_policy) -> dict | None:
         checkpoint = json.loads((run_dir / RECORD).read_text()).get("policy", "shipped")
     except (OSError, ValueError, AttributeError):
         checkpoint = "shipped"
-    checkpoint = "shipped" if checkpoint in (None, "shipped") else str(Path(checkpoint).resolve())
+    if checkpoint in (None, "shipped"):
+        checkpoint = "shipped"
+    elif not shipped_name(checkpoint):  # a shipped checkpoint stays a name, found wherever the package is
+        checkpoint = str(Path(checkpoint).resolve())
     return {"checkpoint": checkpoint, "fingerprint": goal_policy.fingerprint}
 
 
 def _load_goal_policy(agent: str, record: dict):
+    from ..core.paths import shipped_name
     from ..sim.policy import PointController, load_policy
 
     if "scripted" in record:
         policy = PointController(**{k: float(v) for k, v in record["scripted"].items()})
     else:
-        policy = load_policy(agent if record["checkpoint"] == "shipped" else Path(record["checkpoint"]))
+        checkpoint = record["checkpoint"]
+        policy = load_policy(agent if checkpoint == "shipped" else checkpoint if shipped_name(checkpoint)
+                             else Path(checkpoint))
     if getattr(policy, "agent", agent) != agent or policy.fingerprint != record.get("fingerprint"):
         raise PolicyError(f"goal policy {record.get('checkpoint', 'scripted')}: fingerprint {policy.fingerprint}, "
                           f"the run used {record.get('fingerprint')} (retrained or replaced since the run)")

@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import sys
 from collections import Counter
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -66,7 +67,7 @@ def leg_table(run, n_legs: int) -> list[dict]:
     return rows
 
 
-def path_failures(result: dict, episodes: int, seed: int, policy="shipped", goal_points: str | None = None) -> dict:
+def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_points: str | None = None) -> dict:
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
 
     ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
@@ -108,6 +109,8 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     if goal_points is None:
         goal_points = goal_points_of(result.get("config") or {})
+    if policy is None:  # the run's own (a run from before the config was recorded: the shipped one)
+        policy = (result.get("config") or {}).get("policy") or "shipped"
     rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation")
                    or PAPER.rollouts)
     exp = setup(result["maze"], agent=result["agent"], seed=seed, policy=policy, goal_points=goal_points,
@@ -120,7 +123,7 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
     return exp, graph, path, legs
 
 
-def leg_estimates(result: dict, seeds, policy="shipped", goal_points: str | None = None) -> dict:
+def leg_estimates(result: dict, seeds, policy=None, goal_points: str | None = None) -> dict:
     """Every leg of ``result``'s path estimated again along the chain, once per seed (see the module docstring)."""
     from ..refine.common import Leg, estimate_legs
     from ..refine.polish import Rollouts
@@ -172,7 +175,8 @@ def add_arguments(p) -> None:
     p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
-    p.add_argument("--policy", default="shipped", help="'shipped' (the run's agent's) or a policy checkpoint")
+    p.add_argument("--policy", default=None, help="'shipped' (data/policies/AGENT.pt), a shipped one's name or a "
+                                                  "policy checkpoint (default: the run's own)")
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
                         "centre: at the set's centre (beyond the paper) (default: as the run measured it)")
@@ -189,19 +193,20 @@ def main(argv=None) -> int:
 
 
 def run(args, p) -> int:
-    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic, writing_into
 
     try:
-        if args.out is not None:
-            writable_parent(args.out)  # before the re-run, not after it
+        out = None if args.out is None else writable_parent(args.out)  # before the re-run, not after it
         result = read_result(args.result)
-        maze = recorded_maze(args.result, result["maze"])
-        if args.estimates:
-            report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
-        else:
-            report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
-        if args.out is not None:
-            write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+        with nullcontext() if out is None else writing_into(out):  # into a run folder: under its lock
+            maze = recorded_maze(args.result, result["maze"])
+            if args.estimates:
+                report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
+            else:
+                report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy,
+                                       args.goal_points)
+            if args.out is not None:
+                write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:
         print(f"{p.prog}: error: {e}", file=sys.stderr)
         return 2

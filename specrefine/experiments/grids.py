@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
-from ..runs.config import DEFAULTS
+from ..core.paper import PAPER
 from ..runs.sweep import Cell, grid
 
 ROOT = Path(__file__).resolve().parents[2]  # the checkout: a grid's paths are relative to it
@@ -56,7 +56,7 @@ class ExperimentGrid:
     policy: str = "shipped"  # or a checkout-relative path to a checkpoint
     policy_in_checkout: bool = False  # the checkout's copy (an absolute path), not the pinned code tree's
     evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
-    goal_points: str | None = None  # None: the sweep's default, the paper's sampled points (not passed)
+    goal_points: str | None = None  # None: what the pinned code defaulted to, the paper's sampled points (not passed)
     rollouts: int | None = None  # None: the sweep's default (not passed)
     episodes: int | None = None
     workers: int = 2
@@ -169,7 +169,7 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      goal_points=g.goal_points or DEFAULTS.goal_points, **_budget(g))
+                      goal_points=g.goal_points or PAPER.goal_points, **_budget(g))
     return list(dict.fromkeys(cells))
 
 
@@ -368,14 +368,17 @@ def show(g: ExperimentGrid, root: Path = ROOT) -> list[str]:
 
 
 def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) -> list[str]:
-    """What run_grid.sh reads: 'code COMMIT' (or 'code -': the checkout's HEAD), then 'step PART STEP OUT TABLE'
-    per sweep, in order."""
+    """What run_grid.sh reads, fields separated by tabs (a path may hold spaces): 'code COMMIT' (or 'code -': the
+    checkout's HEAD), then 'step PART STEP OUT TABLE' per sweep, in order."""
     if shipped and len(g.tables) > 1:
         raise GridError(f"grid {g.name} writes {len(g.tables)} tables: SHIPPED names one table only")
-    lines = [f"code {g.code or '-'}"]
+    for name, path in (("OUT", out), ("SHIPPED", shipped)):
+        if path is not None and (not path.strip() or any(ch in path for ch in "\t\n\r")):
+            raise GridError(f"{name}={path!r}: name a path (not empty, no tab or line break)")
+    lines = [f"code\t{g.code or '-'}"]
     for i in range(len(g.parts)):
         for j in range(len(_steps(g, g.parts[i]))):
-            lines.append(f"step {i} {j} {g.part_out(i, out)} {shipped or g.part_table(i)}")
+            lines.append(f"step\t{i}\t{j}\t{g.part_out(i, out)}\t{shipped or g.part_table(i)}")
     return lines
 
 

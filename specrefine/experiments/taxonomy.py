@@ -1,7 +1,6 @@
 """Why a refinement run ended below the oracle: one cause per run, read from its folder (issue 39).
 
-    python -m specrefine.experiments.taxonomy runs/taxonomy --oracle data/results/corrector/taxonomy_oracle.csv \
-        --out data/results/corrector
+    specrefine taxonomy runs/taxonomy --oracle data/results/corrector/taxonomy_oracle.csv --out data/results/corrector
 
 A run "ends below the oracle" when its success is more than ``--margin`` (0.05) below the mean success of ``ours``
 with the ``geometric`` proposer (the oracle planner) on the same maze. Each such run gets the first cause that
@@ -29,6 +28,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import sys
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -186,29 +186,39 @@ def read_runs(folders: list[Path]) -> list[Run]:
     return runs
 
 
-def main(argv=None) -> int:
-    from ..core.argtypes import OneLineParser, out_path
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
 
-    p = OneLineParser(prog="python -m specrefine.experiments.taxonomy", description=__doc__.split("\n")[0])
+    p.description = __doc__.split("\n\n")[0]
     p.add_argument("runs", nargs="+", type=Path, help="sweep folders (their cells/) or run folders")
     p.add_argument("--oracle", type=Path, required=True, help="a results table with ours x geometric rows")
-    p.add_argument("--margin", type=float, default=MARGIN, help="below the oracle by more than this (default 0.05)")
-    p.add_argument("--out", type=out_path, default=None, help="folder for taxonomy.csv and taxonomy.md")
-    args = p.parse_args(argv)
+    p.add_argument("--margin", type=float, default=MARGIN, help="below the oracle by more than this (default: 0.05)")
+    p.add_argument("--out", type=out_path, default=None,
+                   help="folder for taxonomy.csv and taxonomy.md (default: the summary printed only)")
+
+
+def run(args, p) -> int:
     try:
         runs = read_runs(args.runs)
         rows = classify(runs, oracle_means(args.oracle), args.margin)
         text = summary_md(rows, runs, args.margin)
         if args.out is None:
             print(text, end="")
-        else:
-            args.out.mkdir(parents=True, exist_ok=True)
-            write_atomic(args.out / "taxonomy.csv", to_csv(rows))
-            write_atomic(args.out / "taxonomy.md", text)
-            print(f"{len(rows)} of {len(runs)} runs below the oracle -> {args.out}/taxonomy.{{csv,md}}")
+            return 0
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_atomic(args.out / "taxonomy.csv", to_csv(rows))
+        write_atomic(args.out / "taxonomy.md", text)
     except (SpecrefineError, OSError) as exc:
-        p.exit(2, f"{p.prog}: error: {exc}\n")
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{len(rows)} of {len(runs)} runs below the oracle -> {args.out}/taxonomy.{{csv,md}}")
     return 0
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("taxonomy", argv, prog="python -m specrefine.experiments.taxonomy")
 
 
 if __name__ == "__main__":

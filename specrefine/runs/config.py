@@ -1,4 +1,11 @@
-"""One refinement run's configuration: :class:`RunConfig`, with the paper's defaults written once.
+"""One refinement run's configuration: :class:`RunConfig`, the one carrier of a run's settings.
+
+The defaults are the best measured settings (``preset="best"``: per agent, ``core.agents.Agent.default_*``);
+``preset="paper"`` restores every rule of the paper they depart from (docs/choices.md, "Presets"). The settings a
+preset decides (``evaluation``, ``goal_points``, ``policy``) default to None, filled in by :meth:`RunConfig.resolved`.
+A sweep cell is a maze and a RunConfig, ``run.json`` is :meth:`RunConfig.record`, and every method's search
+settings are ``SearchConfig.from_run(config, **changes)``: a new run setting is a field here and the code that
+uses it.
 
 Every field is documented, and the documentation is the command line: :func:`add_run_options` turns the fields
 into ``specrefine refine``'s options (flags, defaults, help, bounds), as ``train.Config`` does for training,
@@ -71,13 +78,15 @@ def _goal_points() -> tuple[str, ...]:
 
 
 def policy_arg(text: str) -> str:
-    """'shipped' and 'scripted' as they are; a checkpoint path as ``str(Path(text))`` (the form run.json records)."""
+    """'shipped', 'scripted' and a shipped checkpoint's name as they are; a path as ``str(Path(text))`` (the form
+    run.json records)."""
     return text if text in ("shipped", "scripted") else str(Path(text))
 
 
 @dataclass(frozen=True)
 class RunConfig:
-    """Every argument of one refinement run (the maze and the output folder aside); defaults are the paper's."""
+    """Every argument of one refinement run (the maze and the output folder aside); the defaults are the best
+    measured settings, and ``preset="paper"`` the paper's rules."""
 
     agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
     method: str = option("ours", _methods_help, choices=_methods)
@@ -90,9 +99,11 @@ class RunConfig:
     rollouts: int = option(PAPER.rollouts, "rollouts per subtask evaluation", type=bounded_int("rollouts"))
     episodes: int = option(PAPER.episodes, "fresh end-to-end episodes to measure the final policy on the original task",
                            type=bounded_int("episodes"))
-    policy: str = option("shipped", "policy checkpoint: a path, 'shipped' (data/policies/AGENT.pt) or 'scripted' "
-                                    "(the point mass's straight-line controller)", type=policy_arg,
-                         shown="the shipped data/policies/AGENT.pt")
+    policy: str | None = option(None, "policy checkpoint: a path, 'shipped' (data/policies/AGENT.pt), the name of "
+                                      "another shipped one (e.g. ant_stage5: data/policies/ant_stage5.pt) or "
+                                      "'scripted' (the point mass's straight-line controller)", type=policy_arg,
+                                shown="the agent's adopted policy: shipped for point, ant_stage5 for ant, under "
+                                      "either preset")
     w: int = option(PAPER.w, "candidate edge splits per VLM query (at most 20)", flags=("-w",),
                     type=bounded_int("w"))
     d: int = option(PAPER.d, "VLM query rounds per edge split (at most 10)", flags=("-d",), type=bounded_int("d"))
@@ -102,21 +113,50 @@ class RunConfig:
                                           "adaptive: the vertex refinement's candidates in stages, stopping those "
                                           "that cannot be chosen (same full budget for what is chosen; far fewer "
                                           "simulator steps)", choices=_evaluations,
-                                    shown="the agent's: fixed for point, adaptive for ant")
-    goal_points: str = option(PAPER.goal_points,
-                              "where a subtask's policy aims when its goal vertex has no fixed point, in the search, "
-                              "the measurement and the calibration alike: sampled (a point drawn in the goal region "
-                              "per rollout, the paper's rule) or centre (the goal region's centre in every rollout; "
-                              "beyond the paper)", choices=_goal_points)
+                                    shown="the preset's: best: fixed for point, adaptive for ant; paper: fixed")
+    goal_points: str | None = option(None,
+                                     "where a subtask's policy aims when its goal vertex has no fixed point, in the "
+                                     "search, the measurement and the calibration alike: sampled (a point drawn in "
+                                     "the goal region per rollout, the paper's rule) or centre (the goal region's "
+                                     "centre in every rollout; beyond the paper)", choices=_goal_points,
+                                     shown="the preset's: best: sampled for point, centre for ant; paper: sampled")
+    preset: str = option("best", "what the settings left unset default to: best (the best measured settings, per "
+                                 "agent) or paper (every rule of the paper they depart from: docs/choices.md, "
+                                 "'Presets')", choices=lambda: PRESETS)
 
     def resolved(self) -> RunConfig:
-        """This configuration with ``evaluation`` filled in: None becomes the agent's ``default_evaluation``."""
+        """This configuration with what its preset decides filled in (``evaluation``, ``goal_points``, ``policy``):
+        the agent's ``default_*`` under ``best``, the paper's rules under ``paper`` (the policy is the agent's
+        adopted one under either: the paper does not fix how its policy is trained)."""
         from ..core.agents import get_agent
+        from ..core.errors import SpecrefineError
 
-        return replace(self, evaluation=self.evaluation or get_agent(self.agent).default_evaluation)
+        if self.preset not in PRESETS:
+            raise SpecrefineError(f"preset {self.preset!r}: use one of {', '.join(PRESETS)}")
+        agent = get_agent(self.agent)
+        best = self.preset == "best"
+        return replace(self, evaluation=self.evaluation or (agent.default_evaluation if best else PAPER.evaluation),
+                       goal_points=self.goal_points or (agent.default_goal_points if best else PAPER.goal_points),
+                       policy=self.policy or agent.default_policy)
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def record(self) -> dict:
+        """What ``run.json`` records of this (resolved) configuration: a rerun into the folder with another record is
+        refused. Derived from the fields, with three rules that keep older folders' records valid: no proposer for a
+        method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not sampled; the preset
+        is not recorded (what it decided is)."""
+        from .methods import get_method
+
+        data = {k: v for k, v in self.to_dict().items() if k != "preset"}
+        if not get_method(self.method).asks_proposer:
+            data["proposer"] = None
+        if data["evaluation"] == PAPER.evaluation:
+            del data["evaluation"]
+        if data["goal_points"] == PAPER.goal_points:
+            del data["goal_points"]
+        return data
 
     @classmethod
     def from_namespace(cls, args: argparse.Namespace) -> RunConfig:
@@ -124,7 +164,8 @@ class RunConfig:
         return cls(**{f.name: getattr(args, f.name) for f in fields(cls) if hasattr(args, f.name)})
 
 
-DEFAULTS = RunConfig()  # the paper's settings: read them here rather than writing the numbers again
+PRESETS = ("best", "paper")
+DEFAULTS = RunConfig()  # the defaults (w, d, k, rollouts, episodes: the paper's): read them here, not written again
 
 
 def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[str, Callable] | None = None,

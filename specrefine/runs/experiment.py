@@ -40,7 +40,9 @@ class Experiment:
 
 
 def load_goal_policy(agent: str, policy="shipped"):
-    """``(policy, name)``: ``"shipped"`` (``data/policies/AGENT.pt``), ``"scripted"`` (point only) or a path."""
+    """``(policy, name)``: ``"shipped"`` (``data/policies/AGENT.pt``), the stem of another shipped checkpoint
+    (``"ant_stage5"``), ``"scripted"`` (point only) or a path."""
+    from ..core.paths import shipped_name
     from ..sim.policy import PointController, load_policy
 
     if policy == "scripted":
@@ -49,11 +51,14 @@ def load_goal_policy(agent: str, policy="shipped"):
         return PointController(), "scripted straight-line controller (no learning)"
     if policy in (None, "shipped"):
         return load_policy(agent), f"shipped data/policies/{agent}.pt"
-    loaded = load_policy(Path(policy))
+    if shipped_name(policy):
+        loaded, name = load_policy(policy), f"shipped data/policies/{policy}.pt"
+    else:
+        loaded, name = load_policy(Path(policy)), f"trained policy {Path(policy).name}"
     if getattr(loaded, "agent", agent) != agent:
         raise PolicyError(f"{policy}: holds a {loaded.agent} policy, not one for the {agent}: pick the {agent}'s "
                           f"checkpoint (or leave --policy out for the shipped one)")
-    return loaded, f"trained policy {Path(policy).name}"
+    return loaded, name
 
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = PAPER.rollouts,

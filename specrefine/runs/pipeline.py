@@ -25,7 +25,7 @@ from ..evaluation.compositional import save_run_policy
 from ..evaluation.monitor import measure
 from ..refine.search import EVALUATIONS
 from .calibrate import predict
-from .config import DEFAULTS, RunConfig
+from .config import RunConfig
 from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
 from .progress import RunProgress
 from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
@@ -43,7 +43,7 @@ class RunResult:
         d = self.data
         lo, hi = d["success_ci"]
         return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
-                f"seed={d['seed']}\n"
+                f"seed={d['seed']} preset={d.get('preset', '?')}\n"
                 f"  success on the original task: {_before(d, 'success_rate')}{d['success_rate']:.3f} "
                 f"(95% CI {lo:.3f}-{hi:.3f}, {d['episodes']} episodes)\n"
                 f"  estimated: {_before(d, 'estimate')}{d['search_estimate']:.3f} (the search's own); "
@@ -84,9 +84,10 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     maze's letters (``specrefine.core.spec.parse_spec``, e.g. ``"(a | b) -> c -> G"``); None = the maze's own task (its
     ``; spec:`` line, else its chain).  ``evaluation``: "fixed" (every subtask estimate on ``rollouts`` rollouts,
     the paper's protocol) or "adaptive" (the chain DP by branch and bound with staged rollouts:
-    :mod:`specrefine.refine.racing`); None: the agent's ``default_evaluation`` (fixed for the point mass,
-    adaptive for the Ant).  ``evaluator``: use this one instead of building one.  ``progress``: the live line on
-    stderr (:mod:`specrefine.runs.progress`); None shows it when stderr is a terminal or in a notebook.
+    :mod:`specrefine.refine.racing`); None, like ``goal_points`` and ``policy``: what ``preset`` decides (``best``:
+    the agent's best measured settings; ``paper``: the paper's rules).  ``evaluator``: use this one instead of
+    building one.  ``progress``: the live line on stderr (:mod:`specrefine.runs.progress`); None shows it when
+    stderr is a terminal or in a notebook.
 
     ``out`` holds this run only (:mod:`specrefine.core.runfolder`): its arguments go to ``out/run.json``, a
     rerun with other arguments into it is refused, and so is a folder another live run is using.
@@ -104,14 +105,7 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     maze_task(maze.for_agent(config.agent), config.spec)  # a bad agent or spec fails before the folder is touched
     proposer = config.proposer if get_method(config.method).asks_proposer else None
     config = config.resolved()
-    args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, "agent": config.agent,
-            "method": config.method, "proposer": proposer, "seed": config.seed, "rollouts": config.rollouts,
-            "episodes": config.episodes, "policy": config.policy, "w": config.w, "d": config.d, "k": config.k,
-            "spec": config.spec}
-    if config.evaluation != "fixed":  # run folders of the fixed protocol keep the records they always had
-        args["evaluation"] = config.evaluation
-    if config.goal_points != DEFAULTS.goal_points:  # so do those of the paper's goal points
-        args["goal_points"] = config.goal_points
+    args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, **config.record()}
     if config.evaluation not in EVALUATIONS:
         raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {config.evaluation!r}")
     with claim(out, args) as out:
@@ -150,7 +144,8 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["commit"] = code_commit()  # which code: the checkout's commit, "-dirty" if specrefine/ was edited
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])
-    data["config"] = config.to_dict()  # everything this run was asked to do (evaluation resolved)
+    data["config"] = config.to_dict()  # everything this run was asked to do (what its preset decides resolved)
+    data["preset"] = config.preset  # best (the best measured settings) or paper (the paper's rules)
     phases["input_seconds"] = time.time()
     shown.phase(f"input task as it is: {episodes} episodes")
     data["input_task"] = _input_task(exp, config, search, measured)

@@ -57,20 +57,20 @@ import warnings
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
-
-from tqdm.auto import tqdm
 
 from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
-from ..core.paths import code_commit
+from ..core.paper import PAPER
+from ..core.paths import code_commit, regular_file
 from ..core.plugins import loaded
-from ..core.runfolder import replacing, write_atomic
+from ..core.runfolder import open_append, replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
 from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
 from .methods import METHODS, PROPOSER_METHODS
+from .progress import counted
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -91,20 +91,34 @@ PROVENANCE = ("policy_fingerprint", "commit")
 
 @dataclass(frozen=True)
 class Cell:
+    """One run of a sweep: a maze and the :class:`RunConfig` it runs with (resolved: what its preset decides filled
+    in). Its settings read as its own (``cell.seed``, ``cell.w``, ...); ``proposer`` is "none" for a method that asks
+    none and ``spec`` "" for the maze's own task, as the table's rows name them."""
+
     maze: str  # a shipped maze's name, or the absolute path of any other maze file (see maze_ref)
-    agent: str
-    method: str
-    proposer: str  # "none" for methods that use no proposer
-    seed: int
-    rollouts: int = DEFAULTS.rollouts
-    episodes: int = DEFAULTS.episodes
-    spec: str = ""  # the task as a spec expression; "" = the maze's own task
-    evaluation: str = "fixed"  # "fixed" (the paper's protocol) or "adaptive" (specrefine.refine.racing)
-    policy: str = "shipped"  # the goal-conditioned policy: "shipped" (data/policies/AGENT.pt) or a checkpoint path
-    w: int = DEFAULTS.w
-    d: int = DEFAULTS.d
-    k: int = DEFAULTS.k
-    goal_points: str = DEFAULTS.goal_points  # "sampled" (the paper's) or "centre": named in the id when not sampled
+    config: RunConfig
+
+    @classmethod
+    def of(cls, maze: str, agent: str = "point", method: str = "ours", proposer: str = "none", seed: int = 0,
+           **settings) -> Cell:
+        """A cell from its settings as a row names them (the other RunConfig fields by name)."""
+        spec = settings.pop("spec", None) or None
+        proposer = DEFAULTS.proposer if proposer == "none" else proposer
+        return cls(maze, RunConfig(agent=agent, method=method, proposer=proposer, seed=int(seed), spec=spec,
+                                   **settings).resolved())
+
+    def __getattr__(self, name):  # only called for what the cell itself lacks: the configuration's settings
+        if name in _SETTINGS:
+            return getattr(self.config, name)
+        raise AttributeError(name)
+
+    @property
+    def proposer(self) -> str:
+        return self.config.proposer if self.config.method in PROPOSER_METHODS else "none"
+
+    @property
+    def spec(self) -> str:
+        return self.config.spec or ""
 
     @property
     def id(self) -> str:
@@ -114,19 +128,34 @@ class Cell:
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
         # a standard map 'gr:NAME' -> 'gr-NAME', a shipped folder's 'held_out/x' -> 'held_out-x' (folder names)
         name = name.replace(":", "-").replace("/", "-")
-        task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
-        tail = "" if self.evaluation == "fixed" else f"__{self.evaluation}"  # older ids stay valid
+        name, prop = _bounded(name), _bounded(prop)
+        task = f"{name}__{_bounded(spec_slug(self.spec))}" if self.spec else name
+        tail = "" if self.evaluation == PAPER.evaluation else f"__{self.evaluation}"  # older ids stay valid
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
-                        if getattr(self, knob) != getattr(DEFAULTS, knob))  # the paper's w, d, k: the id they had
-        tail += "" if self.goal_points == DEFAULTS.goal_points else f"__{self.goal_points}"
+                        if getattr(self, knob) != getattr(PAPER, knob))  # the paper's w, d, k: the id they had
+        tail += "" if self.goal_points == PAPER.goal_points else f"__{self.goal_points}"
         return f"{task}__{self.agent}__{self.method}__{prop}__s{self.seed}{tail}"
 
-    def config(self) -> RunConfig:
-        """What ``refine_maze`` runs for this cell."""
-        return RunConfig(agent=self.agent, method=self.method, seed=self.seed, rollouts=self.rollouts,
-                         episodes=self.episodes, spec=self.spec or None, evaluation=self.evaluation,
-                         proposer="geometric" if self.proposer == "none" else self.proposer, policy=self.policy,
-                         w=self.w, d=self.d, k=self.k, goal_points=self.goal_points)
+    def row(self) -> dict:
+        """The cell's own columns of its results row."""
+        return {"maze": self.maze, **{name: getattr(self, name) for name in ROW_SETTINGS}, "cell": self.id}
+
+
+_SETTINGS = frozenset(f.name for f in fields(RunConfig))
+#: the settings a results row records, in the order of the table's columns
+ROW_SETTINGS = ("agent", "method", "proposer", "seed", "rollouts", "episodes", "spec", "evaluation", "policy", "w",
+                "d", "k", "goal_points")
+
+
+ID_PART = 64  # characters of one part of a cell id (maze, spec, proposer): an id stays a file name (255 bytes)
+
+
+def _bounded(part: str) -> str:
+    """A part of a cell id as it is when short (every id so far); a longer one (an 80-branch spec, a long path)
+    cut, and ended with a hash of the whole so that different parts keep different ids."""
+    if len(part) <= ID_PART:
+        return part
+    return f"{part[:ID_PART - 13]}-{hashlib.sha256(part.encode()).hexdigest()[:12]}"
 
 
 def spec_slug(spec: str) -> str:
@@ -162,24 +191,23 @@ def split_maze_arg(arg: str) -> tuple[str, str]:
 
 def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str], seeds: Iterable[int], *,
          agent: str = "point", rollouts: int = DEFAULTS.rollouts, episodes: int = DEFAULTS.episodes,
-         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str = "shipped",
+         specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str | None = None,
          w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,),
-         goal_points: str = DEFAULTS.goal_points) -> list[Cell]:
+         goal_points: str | None = None, preset: str = DEFAULTS.preset) -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
 
     ``w``, ``d``, ``k``: the values of each search setting; a method gets one cell per combination of the settings
     it reads (``methods.Method.knobs``: dirl none, symbolic k only), the others at the paper's defaults.
 
-    ``evaluation``: None = the agent's ``default_evaluation`` (fixed for the point mass, adaptive for the Ant).
-    ``goal_points``: every cell's (``RunConfig.goal_points``).
+    ``evaluation``, ``goal_points``, ``policy``: every cell's; None = what ``preset`` decides for the agent
+    (:meth:`RunConfig.resolved`).
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
     ``MAZE=SPEC`` runs that spec only.
     """
-    from ..core.agents import get_agent
-
-    evaluation = evaluation or get_agent(agent).default_evaluation
     axes = {"w": list(w), "d": list(d), "k": list(k)}
+    common = dict(rollouts=rollouts, episodes=episodes, evaluation=evaluation, policy=policy, goal_points=goal_points,
+                  preset=preset)
     cells = []
     for arg in mazes:
         maze, own = split_maze_arg(str(arg))
@@ -189,8 +217,8 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
                 for proposer in props:
                     for seed in seeds:
                         for knobs in _knob_values(method, axes):
-                            cells.append(Cell(maze_ref(maze), agent, method, proposer, int(seed), rollouts, episodes,
-                                              spec, evaluation, policy, **knobs, goal_points=goal_points))
+                            cells.append(Cell.of(maze_ref(maze), agent, method, proposer, seed, spec=spec,
+                                                 **common, **knobs))
     return cells
 
 
@@ -208,12 +236,12 @@ def run_cell(cell: Cell, out_root: str, plugins: tuple[str, ...] = ()) -> dict:
     from ..core.plugins import load_plugins
     from .pipeline import refine_maze
 
-    row = {**asdict(cell), "cell": cell.id, "commit": code_commit()}  # a failed cell's row names its code too
+    row = {**cell.row(), "commit": code_commit()}  # a failed cell's row names its code too
     out = Path(out_root) / "cells" / cell.id
     try:
         load_plugins(plugins)
         with cell_log(out / "log.txt"):
-            result = refine_maze(cell.maze, cell.config(), out=out, progress=False)  # the sweep has its own bar
+            result = refine_maze(cell.maze, cell.config, out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return {**row, "status": "error", "error": last[:300]}
@@ -227,7 +255,7 @@ def cell_log(path: Path):
     adds to it), not printed."""
     path.parent.mkdir(parents=True, exist_ok=True)
     logger = logging.getLogger("specrefine")
-    handler = logging.FileHandler(path, encoding="utf-8")
+    handler = logging.StreamHandler(open_append(path, "cell's log"))
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     propagate = logger.propagate
     logger.addHandler(handler)
@@ -245,6 +273,7 @@ def cell_log(path: Path):
         logger.removeHandler(handler)
         logger.propagate = propagate
         handler.close()
+        handler.stream.close()
 
 
 def result_row(data: dict, row: dict | None = None) -> dict:
@@ -267,34 +296,21 @@ def is_done(row: dict) -> bool:
 def _drop_cut_row(path: Path) -> None:
     """A last row cut off by a kill (no newline at its end) is removed: it was not done, and ending it instead
     could leave an open quote that would swallow every row after it."""
-    with path.open("rb+") as fh:
+    with os.fdopen(os.open(path, os.O_RDWR | os.O_NOFOLLOW), "rb+") as fh:
         data = fh.read()
         if data and not data.endswith(b"\n"):
             fh.truncate(data.rfind(b"\n") + 1)
 
 
 def _append(path: Path, row: dict) -> None:
-    new = not path.exists() or path.stat().st_size == 0
-    columns = COLUMNS
-    if not new:  # an older table (without the later columns, e.g. spec) keeps its own header
-        with path.open(newline="") as fh:
-            columns = next(csv.reader(fh), None) or COLUMNS
-        if row.get("spec") and "spec" not in columns:
-            raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
-        if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
-            raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
-        if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
-            raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
-        if any(row.get(knob, getattr(DEFAULTS, knob)) != getattr(DEFAULTS, knob) for knob in KNOBS) \
-                and "w" not in columns:
-            raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
-        if row.get("goal_points", DEFAULTS.goal_points) != DEFAULTS.goal_points and "goal_points" not in columns:
-            raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
+    new = not os.path.lexists(path) or os.lstat(path).st_size == 0
+    columns = COLUMNS if new else _header(path)  # an older table (without later columns) keeps its own header
     if not new:
+        _check_fits(path, columns, row)
         _drop_cut_row(path)
         if missing := [c for c in PROVENANCE if c not in columns]:
             columns = _add_columns(path, columns, missing)
-    with path.open("a", newline="") as fh:
+    with open_append(path, "results table") as fh:  # a link or a FIFO is refused, never written through
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
@@ -302,6 +318,42 @@ def _append(path: Path, row: dict) -> None:
                          for k in columns})  # one line per row: a cut row is then always the last line
         fh.flush()
         os.fsync(fh.fileno())
+
+
+def _header(path: Path) -> list[str]:
+    with regular_file(path, "results table").open(newline="") as fh:
+        return next(csv.reader(fh), None) or COLUMNS
+
+
+def _check_fits(path: Path, columns: list[str], row: dict) -> None:
+    """A row whose values an older table has no column for is refused (it would be read back as another cell)."""
+    if row.get("spec") and "spec" not in columns:
+        raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
+    if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
+        raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
+    if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
+        raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
+    if any(row.get(knob, getattr(PAPER, knob)) != getattr(PAPER, knob) for knob in KNOBS) and "w" not in columns:
+        raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
+    if row.get("goal_points", PAPER.goal_points) != PAPER.goal_points and "goal_points" not in columns:
+        raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
+
+
+def check_table(table: Path, cells: list[Cell]) -> None:
+    """Before any cell runs: a table the sweep can append ``cells``' rows to (a regular file it can write, with the
+    sweep's header and the columns those rows need), or none yet; else a one-line SweepError."""
+    if not os.path.lexists(table):
+        return
+    open_append(table, "results table").close()  # a link, read-only: refused now, not after the first cell
+    columns = _raw_rows(table)[0]  # a FIFO, a folder, a device, bytes that are not a table: one line
+    if columns and not {"cell", "status"} <= set(columns):
+        raise SweepError(f"{table}: not a sweep's results table (its header has no 'cell' and 'status' columns): "
+                         f"use another --out")
+    for cell in cells if columns else []:
+        try:
+            _check_fits(table, columns, cell.row())
+        except ValueError as exc:
+            raise SweepError(str(exc)) from None
 
 
 def _add_columns(path: Path, columns: list[str], missing: list[str]) -> list[str]:
@@ -348,7 +400,7 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
     """Refuse cells whose id ``OUT`` already holds with other ``PARAMS`` (``OUT/sweep.json``, or for older
     tables the rows' ``rollouts_per_evaluation``); record the new cells' parameters."""
     record = out_root / "sweep.json"
-    known = json.loads(record.read_text())["cells"] if record.exists() else {}
+    known = _recorded_cells(record) if os.path.lexists(record) else {}
     for row in read_table(out_root / "results.csv"):
         if row.get("cell") not in known and isinstance(row.get("rollouts_per_evaluation"), float):
             known[row["cell"]] = {"rollouts": int(row["rollouts_per_evaluation"])}
@@ -362,16 +414,33 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
     write_atomic(record, json.dumps({"cells": known}, indent=1, sort_keys=True))
 
 
+def _recorded_cells(record: Path) -> dict:
+    """``sweep.json``'s cells ({cell id: {param: value}}), or a one-line SweepError."""
+    try:
+        cells = json.loads(regular_file(record, "sweep record").read_text(encoding="utf-8")).get("cells")
+    except SpecrefineError as exc:
+        raise SweepError(str(exc)) from None
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as exc:
+        raise SweepError(f"{record}: not a sweep record ({type(exc).__name__}): remove it to start over, or use "
+                         f"another --out") from None
+    if not isinstance(cells, dict) or not all(isinstance(v, dict) for v in cells.values()):
+        raise SweepError(f"{record}: not a sweep record ('cells' is not a mapping of cell ids to their settings): "
+                         f"remove it to start over, or use another --out")
+    return cells
+
+
 def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
               address: str | None = None, retries: int = 1) -> Path:
     """Run every pending cell, appending rows to OUT/results.csv; returns the table's path.
 
-    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters.
+    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters, or its
+    ``sweep.json`` or ``results.csv`` cannot be read back or written (``check_table``).
     """
     from ..core.runfolder import ensure_dir
 
     out_root = ensure_dir(out_root)
     table = out_root / "results.csv"
+    check_table(table, cells)
     check_params(cells, out_root)
     try:
         for attempt in range(retries + 1):
@@ -380,8 +449,8 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
                 break
             runner = _run_ray if backend == "ray" else _run_local
             where = (str(out_root), *([tuple(loaded())] if loaded() else []))  # run_cell's arguments after the cell
-            for row in tqdm(runner(todo, where, workers, address), total=len(todo),
-                            desc=f"sweep ({backend}, try {attempt + 1})"):
+            for row in counted(runner(todo, where, workers, address), len(todo),
+                               f"sweep ({backend}, try {attempt + 1})", "cell", every=1):
                 _append(table, row)
     finally:
         compact(table)
@@ -417,7 +486,7 @@ def _row_of(fut, cell: Cell) -> dict:
     try:
         return fut.result()
     except BrokenProcessPool:  # a worker was killed (out of memory?) or crashed: the cell failed, the sweep goes on
-        return {**asdict(cell), "cell": cell.id, "status": "error",
+        return {**cell.row(), "status": "error",
                 "error": "the worker process running this cell died (killed or crashed)"}
 
 
@@ -479,7 +548,7 @@ def summarise(rows: list[dict], by=("maze", "method", "proposer")) -> list[dict]
             if r.get("spec") and "maze" in by:  # a task other than the maze's own is its own group
                 r = {**r, "maze": f"{r['maze']} [{r['spec']}]"}
             tuned = [f"{knob}={r[knob]}" for knob in (*KNOBS, "goal_points")
-                     if knob not in by and r.get(knob) not in (None, "", getattr(DEFAULTS, knob))]
+                     if knob not in by and r.get(knob) not in (None, "", getattr(PAPER, knob))]
             if tuned and "method" in by:  # so is a method run with other w, d or k than the paper's
                 r = {**r, "method": f"{r['method']} [{', '.join(tuned)}]"}
             groups.setdefault(tuple(r[k] for k in by), []).append(r)
@@ -525,16 +594,15 @@ def _check_specs(cells: list[Cell]) -> str | None:
     return None
 
 
-def _check_policy(policy: str, agent: str) -> str | None:
-    """One line if ``policy`` is not a usable checkpoint for ``agent`` (before any cell runs)."""
+def _check_policy(cells: list[Cell]) -> str | None:
+    """One line if a cell's policy is not a usable checkpoint for its agent (before any cell runs)."""
     from .experiment import load_goal_policy
 
-    if policy == "shipped":
-        return None
-    try:
-        load_goal_policy(agent, policy)
-    except SpecrefineError as exc:
-        return f"--policy {exc}"
+    for agent, policy in sorted({(c.agent, c.policy) for c in cells if c.policy != "shipped"}):
+        try:
+            load_goal_policy(agent, policy)
+        except SpecrefineError as exc:
+            return f"--policy {exc}"
     return None
 
 
@@ -570,14 +638,16 @@ def add_arguments(p) -> None:
     p.add_argument("--agent", default="point", choices=list(AGENTS), help="the agent of every cell")
     add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
     add_run_options(p, ["goal_points"], suffix=" (every cell; named in the cell id when not sampled)")
+    add_run_options(p, ["preset"], suffix=" (every cell)")
     add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
                                                "of w, d, k it reads)")
     p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
                    help="subtask evaluation of every cell (as specrefine refine --evaluation; part of the cell id "
-                        "when adaptive) (default: fixed for point, adaptive for ant)")
-    p.add_argument("--policy", default="shipped",
-                   help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt) or a checkpoint "
-                        "path (recorded in OUT/sweep.json and the 'policy' column)")
+                        "when adaptive) (default: the preset's: best: fixed for point, adaptive for ant; paper: fixed)")
+    p.add_argument("--policy", default=None,
+                   help="goal-conditioned policy of every cell: 'shipped' (data/policies/AGENT.pt), a shipped one's "
+                        "name (ant_stage5) or a checkpoint path (recorded in OUT/sweep.json and the 'policy' column) "
+                        "(default: the agent's adopted one: shipped for point, ant_stage5 for ant)")
     p.add_argument("--out", type=out_path, default="runs/sweep", help="the sweep folder (results.csv, cells/)")
     p.add_argument("--backend", choices=["local", "ray"], default="local",
                    help="local: a process pool; ray: Ray tasks (Ctrl-C cancels them; a killed sweep leaves them to "
@@ -594,8 +664,14 @@ def cells_of(args) -> list[Cell]:
     mazes = args.mazes if args.mazes is not None else sorted(benchmark_mazes())
     return grid(mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
-                goal_points=args.goal_points,
-                policy=args.policy if args.policy == "shipped" else str(Path(args.policy).resolve()))
+                goal_points=args.goal_points, preset=args.preset, policy=_policy_ref(args.policy))
+
+
+def _policy_ref(policy: str | None) -> str | None:
+    """A --policy as cells record it: a name (None, 'shipped', a shipped checkpoint's) as given, a path absolute."""
+    from ..core.paths import shipped_name
+
+    return policy if policy in (None, "shipped") or shipped_name(policy) else str(Path(policy).resolve())
 
 
 def main(argv=None) -> int:
@@ -611,7 +687,7 @@ def run(args, parser) -> int:
     if args.mazes is not None and args.all:
         return _fail(parser.prog, "--mazes and --all: give one of them", 2)
     cells = cells_of(args)
-    bad = maze_problem(args.mazes or []) or _check_specs(cells) or _check_policy(args.policy, args.agent)
+    bad = maze_problem(args.mazes or []) or _check_specs(cells) or _check_policy(cells)
     if bad:
         return _fail(parser.prog, bad, 2)
     t0 = time.time()

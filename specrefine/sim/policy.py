@@ -17,7 +17,7 @@ from torch import nn
 
 from ..core.agents import AGENTS, OBSERVATION_FRAMES
 from ..core.errors import PolicyError
-from ..core.paths import data_dir
+from ..core.paths import data_dir, shipped_name
 
 FORMAT = "specrefine-policy"
 VERSION = 1
@@ -110,7 +110,7 @@ def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
 
 
 def _resolve(path_or_agent) -> Path:
-    if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS:
+    if isinstance(path_or_agent, str) and (path_or_agent in OBS_ACT_DIMS or shipped_name(path_or_agent)):
         return POLICY_DIR / f"{path_or_agent}.pt"
     return Path(path_or_agent)
 
@@ -124,7 +124,8 @@ def safe_load(path):
 
 
 def load_policy(path_or_agent) -> GoalPolicy:
-    """``'point'`` / ``'ant'`` (the shipped files) or a path -> :class:`GoalPolicy` in eval mode."""
+    """``'point'`` / ``'ant'`` (the shipped files), a shipped checkpoint's stem (``'ant_stage5'``) or a path ->
+    :class:`GoalPolicy` in eval mode."""
     path = _resolve(path_or_agent)
     if not path.is_file():
         raise PolicyError(f"{path}: policy file not found")

@@ -1,0 +1,290 @@
+"""The corrector grids' claims (docs/corrector.md, "The rules"), decided as fixed there.
+
+    specrefine corrector-claims --out data/results/corrector
+
+Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
+and the one-shot) and, where present, ``ant-corrector`` with the Ant scaling grid's one-shot and oracle; writes
+claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and figure.png
+(success over rooms per method and preset). A rule with a cell missing is marked partial.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import SpecrefineError
+from ..core.results import newcombe_ci, wilson_ci
+from ..core.runfolder import write_atomic
+from ..runs.sweep import read_checked_table
+from . import comparison as cmp
+from .grids import GRIDS, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
+
+METHOD = "ours-corrector"
+ORACLE = ("ours", "geometric")
+TOLERANCE = 0.05  # within this of the oracle, and flat within this
+ANT_FLOOR = 0.85
+COST_CAP = 3.0
+POINT_SEEDS = GRIDS["corrector"].seeds
+ANT_SEEDS = GRIDS["ant-corrector"].seeds
+ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
+ANT_ORACLE = "data/results/ant/scaling/ours_centre.csv"
+ANT_ERRING = "data/results/ant/scaling/imperfect_centre.csv"
+
+
+def load(paths, root: Path = ROOT) -> list[dict]:
+    rows = []
+    for path in paths:
+        if (root / path).is_file():
+            rows += read_checked_table(root / path)
+    return rows
+
+
+def episodes_of(rows, maze, method, proposer, seeds) -> tuple[int, int, int]:
+    """(successes, episodes, runs) of ``method`` with ``proposer`` on ``maze`` pooled over ``seeds``."""
+    k = n = runs = 0
+    for r in rows:
+        if (r["maze"], r["method"], r["proposer"]) == (maze, method, proposer) and r["seed"] in seeds \
+                and cmp.is_done(r):
+            k += round(float(r["success_rate"]) * int(r["episodes"]))
+            n += int(r["episodes"])
+            runs += 1
+    return k, n, runs
+
+
+def per_maze(rows, proposer, mazes, seeds, reference=ORACLE, method=METHOD) -> list[dict]:
+    """Per maze: the method's and the reference's pooled success and their Newcombe difference."""
+    out = []
+    for maze in mazes:
+        k1, n1, r1 = episodes_of(rows, maze, method, proposer, seeds)
+        k2, n2, r2 = episodes_of(rows, maze, *reference, seeds) if reference[1] != "*" else \
+            episodes_of(rows, maze, reference[0], proposer, seeds)
+        entry = {"maze": maze, "proposer": proposer, "method": method, "reference": "/".join(reference),
+                 "runs": r1, "reference_runs": r2, "success": k1 / n1 if n1 else math.nan,
+                 "reference_success": k2 / n2 if n2 else math.nan}
+        if n1 and n2:
+            lo, hi = newcombe_ci(k1, n1, k2, n2)
+            entry |= {"difference": k1 / n1 - k2 / n2, "ci_low": lo, "ci_high": hi}
+        out.append(entry)
+    return out
+
+
+def zero_runs(rows, method, proposer, mazes) -> tuple[int, int]:
+    done = [r for r in rows if r["method"] == method and r["proposer"] == proposer and r["maze"] in mazes
+            and cmp.is_done(r)]
+    return sum(1 for r in done if float(r["success_rate"]) == 0.0), len(done)
+
+
+def costs(rows, proposer, mazes, seeds, first=METHOD, second="ours") -> dict:
+    """Mean evaluations and proposer calls of ``first`` over those of ``second`` on the cells where both ran."""
+    by = {(r["maze"], r["method"], r["seed"]): r for r in rows if r["proposer"] == proposer and cmp.is_done(r)}
+    pairs = [(by[(m, first, s)], by[(m, second, s)]) for m in mazes for s in seeds
+             if (m, first, s) in by and (m, second, s) in by]
+
+    def ratio(key):
+        return float(np.mean([float(a[key]) for a, _ in pairs]) / np.mean([float(b[key]) for _, b in pairs])) \
+            if pairs else math.nan
+
+    return {"proposer": proposer, "pairs": len(pairs), "evaluations_ratio": ratio("evaluations"),
+            "proposer_calls_ratio": ratio("proposer_calls"), "sim_steps_ratio": ratio("sim_steps")}
+
+
+def as_ours(cells: dict, method: str) -> dict:
+    """The cells with ``method`` in the place of ours (comparison's claims are written about 'ours')."""
+    return {(maze, "ours" if m == method else m, p, s): v for (maze, m, p, s), v in cells.items() if m != "ours"}
+
+
+def point_study(root: Path = ROOT) -> dict:
+    tax, cor = GRIDS["taxonomy"], GRIDS["corrector"]
+    rows = load(tax.tables + cor.tables, root)
+    if not rows:
+        raise SpecrefineError("no corrector or taxonomy table found: run the grids (docs/corrector.md)")
+    cells, failed = cmp.table_cells(rows, "point")
+    study = {"per_maze": [], "rooms": [], "ratio": [], "zero": [], "costs": [], "versus_ours": [],
+             "severe_vs_repair": None}
+    for proposer in ("imperfect:mild", "imperfect:moderate"):
+        study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS)
+        study["versus_ours"] += per_maze(rows, proposer, SCALING_MAZES + OTHER_POINT_MAZES, POINT_SEEDS,
+                                         reference=("ours", "*"))
+        for method in (METHOD, "ours", "ours-repair", "vlm-oneshot"):
+            study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, method, POINT_SEEDS))
+        study["ratio"].append(cmp.ratio_claim(as_ours(cells, METHOD), set(as_ours(dict.fromkeys(failed), METHOD)),
+                                              proposer, POINT_SEEDS) | {"method": f"{METHOD} / vlm-oneshot"})
+        study["ratio"].append(cmp.ratio_claim(cells, failed, proposer, POINT_SEEDS) | {"method": "ours / vlm-oneshot"})
+        study["costs"].append(costs(rows, proposer, SCALING_MAZES + OTHER_POINT_MAZES, POINT_SEEDS))
+    for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
+        study["zero"].append({"proposer": proposer} | {m: zero_runs(rows, m, proposer, SCALING_MAZES)
+                                                        for m in (METHOD, "ours", "ours-repair")})
+    study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", METHOD, "ours-repair",
+                                                      POINT_SEEDS, SCALING_MAZES)
+    study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS)
+    study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS))
+    return study
+
+
+def ant_study(root: Path = ROOT) -> dict | None:
+    rows = load(GRIDS["ant-corrector"].tables + (ANT_ONESHOT, ANT_ORACLE, ANT_ERRING), root)
+    if not any(r["method"] == METHOD for r in rows):
+        return None
+    proposer = "imperfect:moderate"
+    maze_rows = []
+    for maze in SCALING_MAZES:
+        k, n, runs = episodes_of(rows, maze, METHOD, proposer, ANT_SEEDS)
+        entry = {"maze": maze, "runs": runs, "success": k / n if n else math.nan}
+        if n:
+            entry["ci_low"], entry["ci_high"] = wilson_ci(k, n)
+        maze_rows.append(entry)
+    cells, failed = cmp.table_cells(rows, "ant")
+    ratios = [cmp.ratio_claim(as_ours(cells, METHOD), set(as_ours(dict.fromkeys(failed), METHOD)), proposer,
+                              ANT_SEEDS) | {"method": f"{METHOD} / vlm-oneshot"},
+              cmp.ratio_claim(cells, failed, proposer, ANT_SEEDS) | {"method": "ours / vlm-oneshot"}]
+    return {"per_maze": maze_rows, "ratio": ratios, "costs": costs(rows, proposer, SCALING_MAZES, ANT_SEEDS),
+            "zero": zero_runs(rows, METHOD, proposer, SCALING_MAZES)}
+
+
+def _num(x, fmt="{:.3f}") -> str:
+    return "—" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
+
+
+def _diff(e) -> str:
+    if "difference" not in e:
+        return "—"
+    return f"{e['difference']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}]"
+
+
+def verdicts(point: dict, ant: dict | None) -> list[dict]:
+    """Each rule of docs/corrector.md with its verdict ("partial" while a cell is missing)."""
+    out = []
+    for proposer in ("imperfect:mild", "imperfect:moderate"):
+        mazes = [e for e in point["per_maze"] if e["proposer"] == proposer]
+        complete = all(e["runs"] == len(POINT_SEEDS) for e in mazes)
+        within = [e for e in mazes if e["success"] >= e["reference_success"] - TOLERANCE]
+        out.append({"rule": f"{proposer}: within {TOLERANCE} of the oracle on every U-chain",
+                    "value": f"{len(within)} of {len(mazes)} mazes", "verdict": _verdict(len(within) == len(mazes),
+                                                                                        complete)})
+        rooms = next(e for e in point["rooms"] if e["proposer"] == proposer and e["method"] == METHOD)
+        out.append({"rule": f"{proposer}: flat from 1 to 5 rooms", "value": cmp._interval_text(rooms),
+                    "verdict": rooms["verdict"] + ("" if rooms["complete"] else " (partial)")})
+        zero = next(z for z in point["zero"] if z["proposer"] == proposer)[METHOD]
+        out.append({"rule": f"{proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
+                    "verdict": _verdict(zero[0] == 0, complete)})
+        versus = [e for e in point["versus_ours"] if e["proposer"] == proposer]
+        below = [e["maze"] for e in versus if "ci_high" in e and e["ci_high"] < 0]
+        out.append({"rule": f"{proposer}: not below ours on any suite maze (Newcombe)",
+                    "value": f"below on {len(below)} of {len(versus)}" + (f" ({', '.join(below)})" if below else ""),
+                    "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in versus))})
+        ratio = next(e for e in point["ratio"] if e["proposer"] == proposer and e["method"].startswith(METHOD))
+        out.append({"rule": f"{proposer}: {METHOD} >= 2x the one-shot on multi-room (point)",
+                    "value": cmp._interval_text(ratio), "verdict": ratio["verdict"]
+                    + ("" if ratio["complete"] else " (partial)")})
+    severe = point["severe_vs_repair"]
+    out.append({"rule": "imperfect:severe: no worse than ours-repair (paired, U-chains)",
+                "value": cmp._interval_text(severe), "verdict": ("no worse" if severe["verdict"] != "lower"
+                                                                  else "worse") + ("" if severe["complete"]
+                                                                                   else " (partial)")})
+    for c in point["costs"]:
+        out.append({"rule": f"{c['proposer']}: cost at most {COST_CAP}x ours (evaluations, proposer calls)",
+                    "value": f"{_num(c['evaluations_ratio'], '{:.2f}x')}, {_num(c['proposer_calls_ratio'], '{:.2f}x')}"
+                             f" over {c['pairs']} pairs",
+                    "verdict": _cost_verdict(c)})
+    if ant:
+        complete = all(e["runs"] == len(ANT_SEEDS) for e in ant["per_maze"])
+        low = [e["maze"] for e in ant["per_maze"] if not e["success"] >= ANT_FLOOR]
+        out.append({"rule": f"Ant, imperfect:moderate: at least {ANT_FLOOR} on every maze",
+                    "value": f"below on {len(low)} of {len(ant['per_maze'])}", "verdict": _verdict(not low, complete)})
+        ratio = ant["ratio"][0]
+        out.append({"rule": f"Ant: {METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
+                    "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
+    return out
+
+
+def _cost_verdict(c: dict) -> str:
+    worst = max(c["evaluations_ratio"], c["proposer_calls_ratio"])
+    if math.isnan(worst):
+        return "undecided (no pairs)"
+    return "holds" if worst <= COST_CAP else "does not hold"
+
+
+def _verdict(ok: bool, complete: bool) -> str:
+    return ("holds" if ok else "does not hold") + ("" if complete else " (partial)")
+
+
+def markdown(point: dict, ant: dict | None) -> str:
+    lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
+             f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
+             "", "| rule | estimate | verdict |", "|---|---|---|"]
+    lines += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in verdicts(point, ant)]
+    lines += ["", "Per U-chain (point): ours-corrector vs the oracle (ours x geometric), pooled over seeds; Newcombe "
+              "95 % interval of the difference.", "",
+              "| proposer | maze | runs | ours-corrector | oracle | difference |", "|---|---|---|---|---|---|"]
+    for e in point["per_maze"] + point["severe"]:
+        lines.append(f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
+                     f"{_num(e['reference_success'])} | {_diff(e)} |")
+    lines += ["", "Every suite maze (point): ours-corrector - ours, pooled over seeds (Newcombe 95 %).", "",
+              "| proposer | maze | runs (ours) | ours-corrector | ours | difference |", "|---|---|---|---|---|---|"]
+    for e in point["versus_ours"]:
+        lines.append(f"| {e['proposer']} | {e['maze']} | {e['runs']} ({e['reference_runs']}) | {_num(e['success'])} | "
+                     f"{_num(e['reference_success'])} | {_diff(e)} |")
+    lines += ["", "Change from 1 to 5 rooms (least-squares slope x 4 on u_chain_1..5; 95 % bootstrap over seeds), and "
+              "runs at 0 on the U-chains.", "", "| proposer | method | change 1→5 rooms | verdict |",
+              "|---|---|---|---|"]
+    for e in point["rooms"]:
+        lines.append(f"| {e['proposer']} | {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |")
+    lines += ["", "| proposer | " + " | ".join(f"{m} at 0" for m in (METHOD, "ours", "ours-repair")) + " |",
+              "|---|---|---|---|"]
+    for z in point["zero"]:
+        lines.append(f"| {z['proposer']} | " + " | ".join(f"{z[m][0]}/{z[m][1]}" for m in
+                                                          (METHOD, "ours", "ours-repair")) + " |")
+    lines += ["", "| proposer | ratio | estimate [95 % CI] | verdict |", "|---|---|---|---|"]
+    for e in point["ratio"]:
+        lines.append(f"| {e['proposer']} | {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |")
+    lines += ["", "Cost: mean of ours-corrector over mean of ours on the same cells.", "",
+              "| proposer | pairs | evaluations | proposer calls | simulator steps |", "|---|---|---|---|---|"]
+    for c in point["costs"] + ([ant["costs"] | {"proposer": "Ant " + ant["costs"]["proposer"]}] if ant else []):
+        lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
+                     f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
+    if ant:
+        lines += ["", "The Ant (imperfect:moderate, stage 5, centre goal points): ours-corrector pooled per maze "
+                  "(Wilson 95 %).", "", "| maze | runs | success [95 % CI] |", "|---|---|---|"]
+        for e in ant["per_maze"]:
+            ci = f" [{e['ci_low']:.3f}, {e['ci_high']:.3f}]" if "ci_low" in e else ""
+            lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} |")
+        lines += ["", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
+        lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+    return "\n".join(lines) + "\n"
+
+
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
+
+    p.description = __doc__.split("\n\n")[0]
+    p.add_argument("--out", type=out_path, default=Path("data/results/corrector"),
+                   help="folder for claims.md and claims.json (default: data/results/corrector)")
+
+
+def run(args, p) -> int:
+    try:
+        point, ant = point_study(), ant_study()
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_atomic(args.out / "claims.md", markdown(point, ant))
+        write_atomic(args.out / "claims.json", json.dumps({"point": point, "ant": ant, "rules": verdicts(point, ant)},
+                                                          indent=1, default=float) + "\n")
+    except (SpecrefineError, OSError) as exc:
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"-> {args.out}/claims.md")
+    return 0
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("corrector-claims", argv, prog="python -m specrefine.experiments.corrector_claims")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

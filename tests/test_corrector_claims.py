@@ -1,0 +1,87 @@
+"""specrefine.experiments.corrector_claims on synthetic tables laid where the grids' tables go: each rule of
+docs/corrector.md decided from known success rates."""
+
+from __future__ import annotations
+
+import pytest
+from test_comparison import row, write_csv
+
+from specrefine.experiments import corrector_claims as cc
+from specrefine.experiments.grids import GRIDS, OTHER_POINT_MAZES, SCALING_MAZES
+
+LEVELS = ("imperfect:mild", "imperfect:moderate")
+
+
+def lay(root, success, zero_cell=None):
+    """The taxonomy and corrector tables under ``root``; success(maze, method, proposer) -> rate."""
+    def rows(methods, proposers, mazes):
+        out = []
+        for maze in mazes:
+            for m in methods:
+                for p in proposers:
+                    for s in cc.POINT_SEEDS:
+                        rate = 0.0 if (maze, m, p, s) == zero_cell else success(maze, m, p)
+                        out.append(row(maze, m, rate, s, p) | {"proposer_calls": 6 if m == cc.METHOD else 3,
+                                                                "evaluations": 20 if m == cc.METHOD else 10,
+                                                                "sim_steps": 1000})
+        return out
+
+    everything = SCALING_MAZES + OTHER_POINT_MAZES
+    tables = {GRIDS["taxonomy"].part_table(0): rows(["ours"], ["geometric"], everything),
+              GRIDS["taxonomy"].part_table(1): rows(["ours", "ours-repair"], LEVELS + ("imperfect:severe",),
+                                                    everything),
+              GRIDS["corrector"].table: rows([cc.METHOD, "vlm-oneshot"], LEVELS, SCALING_MAZES)
+              + rows([cc.METHOD], ["imperfect:severe"], SCALING_MAZES) + rows([cc.METHOD], LEVELS, OTHER_POINT_MAZES)}
+    for path, content in tables.items():
+        (root / path).parent.mkdir(parents=True, exist_ok=True)
+        write_csv(root / path, content)
+
+
+def rates(maze, method, proposer):
+    return {"ours": 0.99 if proposer == "geometric" else 0.6, "ours-repair": 0.7, cc.METHOD: 0.97,
+            "vlm-oneshot": 0.3}[method]
+
+
+def rules(root):
+    return {v["rule"]: v for v in cc.verdicts(cc.point_study(root), None)}
+
+
+def test_a_corrector_near_the_oracle_everywhere_meets_every_rule(tmp_path):
+    lay(tmp_path, rates)
+    r = rules(tmp_path)
+    for level in LEVELS:
+        assert r[f"{level}: within 0.05 of the oracle on every U-chain"]["verdict"] == "holds"
+        assert r[f"{level}: flat from 1 to 5 rooms"]["verdict"] == "flat"
+        assert r[f"{level}: no run at 0"]["verdict"] == "holds"
+        assert r[f"{level}: not below ours on any suite maze (Newcombe)"]["verdict"] == "holds"
+        ratio = r[f"{level}: ours-corrector >= 2x the one-shot on multi-room (point)"]
+        assert ratio["verdict"] == "holds" and "ratio 3.233" in ratio["value"]
+        assert r[f"{level}: cost at most 3.0x ours (evaluations, proposer calls)"]["value"].startswith("2.00x, 2.00x")
+    assert r["imperfect:severe: no worse than ours-repair (paired, U-chains)"]["verdict"] == "no worse"
+
+
+def test_one_run_at_zero_and_one_maze_far_from_the_oracle_are_named(tmp_path):
+    far = "u_chain_5_subgoals"
+    lay(tmp_path, lambda maze, m, p: 0.8 if (m == cc.METHOD and maze == far) else rates(maze, m, p),
+        zero_cell=("u_chain_3", cc.METHOD, "imperfect:mild", 2))
+    r = rules(tmp_path)
+    assert r["imperfect:mild: within 0.05 of the oracle on every U-chain"]["value"] == "7 of 9 mazes"
+    assert r["imperfect:moderate: within 0.05 of the oracle on every U-chain"]["value"] == "8 of 9 mazes"
+    assert r["imperfect:mild: no run at 0"]["verdict"] == "does not hold"
+    assert r["imperfect:moderate: no run at 0"]["verdict"] == "holds"
+    md = cc.markdown(cc.point_study(tmp_path), None)
+    assert f"| imperfect:moderate | {far} | 4 | 0.800 | 0.990 | -0.190 [" in md
+
+
+def test_missing_cells_mark_the_rules_partial(tmp_path):
+    lay(tmp_path, rates)
+    table = tmp_path / GRIDS["corrector"].table
+    lines = table.read_text().splitlines()
+    table.write_text("\n".join(lines[:-5]) + "\n")
+    r = rules(tmp_path)
+    assert any(v["verdict"].endswith("(partial)") for v in r.values())
+
+
+def test_no_table_is_one_error(tmp_path):
+    with pytest.raises(cc.SpecrefineError, match="run the grids"):
+        cc.point_study(tmp_path)

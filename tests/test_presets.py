@@ -1,0 +1,111 @@
+"""The best measured settings by default, the paper's rules one switch away (--preset paper), every departure listed
+in docs/choices.md, and one carrier of a run's settings (a sweep cell is a maze and a RunConfig)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from specrefine.cli import build_parser, main
+from specrefine.core.agents import AGENTS
+from specrefine.core.paper import PAPER
+from specrefine.refine.search import SearchConfig
+from specrefine.runs import sweep
+from specrefine.runs.config import RunConfig
+
+ROOT = Path(__file__).resolve().parent.parent
+TINY = ["--rollouts", "8", "--episodes", "10", "-w", "1", "-d", "1", "-k", "1"]
+
+
+def resolved(*argv: str) -> RunConfig:
+    """The configuration `specrefine refine ARGV` runs with."""
+    return RunConfig.from_namespace(build_parser("refine").parse_args(["refine", "u_maze", *argv])).resolved()
+
+
+def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules():
+    best, paper = resolved("--agent", "ant"), resolved("--agent", "ant", "--preset", "paper")
+    assert (best.evaluation, best.goal_points, best.policy) == ("adaptive", "centre", "ant_stage5")
+    assert (paper.evaluation, paper.goal_points, paper.policy) == ("fixed", "sampled", "ant_stage5")
+    assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
+    point = resolved()
+    assert point == resolved("--preset", "paper").__class__(**{**point.to_dict(), "preset": "best"})
+    assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "sampled", "shipped")
+    explicit = resolved("--agent", "ant", "--preset", "paper", "--goal-points", "centre", "--policy", "shipped")
+    assert (explicit.goal_points, explicit.policy, explicit.evaluation) == ("centre", "shipped", "fixed")
+    with pytest.raises(SystemExit):
+        build_parser("refine").parse_args(["refine", "u_maze", "--preset", "fast"])
+
+
+def test_a_run_records_its_preset_and_official_prints_it(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["refine", "split_doorway", *TINY, "--out", str(out)]) == 0
+    assert "preset=best" in capsys.readouterr().out
+    data = json.loads((out / "result.json").read_text())
+    assert data["preset"] == "best" and data["config"]["goal_points"] == "sampled"
+    assert data["config"]["evaluation"] == "fixed" and data["config"]["policy"] == "shipped"
+    # the point mass's presets are the same settings: the folder takes the rerun (run.json records what runs)
+    assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--out", str(out)]) == 0
+    assert json.loads((out / "result.json").read_text())["preset"] == "paper"
+    capsys.readouterr()
+    assert main(["official", str(out), "--episodes", "2"]) == 0
+    assert "the run's preset: paper" in capsys.readouterr().out
+    assert json.loads((out / "official.json").read_text())["preset"] == "paper"
+
+
+def test_an_ant_folder_from_before_the_new_defaults_refuses_them(tmp_path, capsys):
+    """An Ant run made with the old defaults (adaptive, sampled points, ant.pt) is another run than today's."""
+    out = tmp_path / "old"
+    out.mkdir()
+    old = {"maze": "u_chain_1", "agent": "ant", "method": "ours", "proposer": "geometric", "seed": 0, "rollouts": 8,
+           "episodes": 10, "policy": "shipped", "w": 1, "d": 1, "k": 1, "spec": None, "evaluation": "adaptive"}
+    (out / "run.json").write_text(json.dumps(old))  # refused before any Ant is built: the record is checked first
+    assert main(["refine", "u_chain_1", "--agent", "ant", *TINY, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "holds another run" in err and "goal_points" in err and "policy" in err
+    assert json.loads((out / "run.json").read_text()) == old
+
+
+def test_a_sweep_cell_is_a_maze_and_a_run_config():
+    parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "dirl", "--proposers", "geometric",
+                                        "--agent", "ant", "--seeds", "0", "-k", "5", "7"])
+    cells = sweep.cells_of(parsed)
+    assert all(isinstance(c.config, RunConfig) and c.config == c.config.resolved() for c in cells)
+    ours = [c for c in cells if c.method == "ours"]
+    assert [c.id for c in ours] == ["u_maze__ant__ours__geometric__s0__adaptive__centre",
+                                    "u_maze__ant__ours__geometric__s0__adaptive__k7__centre"]
+    assert {(c.config.goal_points, c.config.policy, c.k) for c in ours} == {("centre", "ant_stage5", 5),
+                                                                             ("centre", "ant_stage5", 7)}
+    (dirl,) = [c for c in cells if c.method == "dirl"]
+    assert dirl.proposer == "none" and dirl.row()["proposer"] == "none" and dirl.row()["cell"] == dirl.id
+    paper = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "dirl", "--seeds", "0",
+                                                      "--agent", "ant", "--preset", "paper"]))
+    assert [c.id for c in paper] == ["u_maze__ant__dirl__none__s0"]
+
+
+def test_search_settings_come_from_the_run_config_in_one_place():
+    config = RunConfig(agent="ant", w=4, d=1, k=9, seed=3).resolved()
+    search = SearchConfig.from_run(config, repair=True)
+    assert (search.w, search.d, search.k, search.seed, search.evaluation, search.repair) == (4, 1, 9, 3, "adaptive",
+                                                                                             True)
+
+
+def test_docs_choices_lists_every_departure_the_code_makes():
+    text = (ROOT / "docs" / "choices.md").read_text()
+    table = text.split("\n## Presets\n", 1)[1]
+    rows = [[c.strip() for c in line.split("|")[1:-1]] for line in table.splitlines()
+            if line.startswith("| ") and not line.startswith("| ---")][1:]  # the header row aside
+    listed = {(agent, re.search(r"`(--[a-z-]+)`", setting).group(1)): (best, paper)
+              for agent, setting, best, paper, _ in rows if agent != "point"}
+    flags = {"evaluation": "--evaluation", "goal_points": "--goal-points", "policy": "--policy"}
+    for name in AGENTS:
+        best, paper = RunConfig(agent=name).resolved(), RunConfig(agent=name, preset="paper").resolved()
+        for field, flag in flags.items():
+            if getattr(best, field) != getattr(paper, field) or getattr(best, field) not in (
+                    getattr(PAPER, field, None), "shipped"):  # a departure from the paper, or a non-default policy
+                assert (name, flag) in listed, (name, flag)
+                shown_best, shown_paper = listed[name, flag]
+                assert f"`{getattr(best, field)}`" in shown_best and f"`{getattr(paper, field)}`" in shown_paper
+    assert any(agent == "point" and "the paper's rules" in best for agent, _, best, _, _ in rows)
