@@ -12,7 +12,12 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install -q -e '.[dev,notebooks,vlm,ray]'  # the suite exercises every extra
 	touch $@
 
-venv: $(VENV)/.installed
+# the kernel the notebooks name ("specrefine"), registered inside the venv for papermill and JupyterLab
+KERNEL_SPEC := $(VENV)/share/jupyter/kernels/specrefine/kernel.json
+$(KERNEL_SPEC): $(VENV)/.installed
+	$(BIN)/python -m ipykernel install --sys-prefix --name specrefine --display-name "Python 3 (specrefine)"
+
+venv: $(VENV)/.installed $(KERNEL_SPEC)
 
 demo: $(VENV)/.installed
 	$(BIN)/specrefine refine $(MAZE) --agent point --method ours --proposer geometric --seed 0 --out runs/demo
@@ -37,9 +42,10 @@ executed: $(VENV)/.installed
 	$(BIN)/python -m specrefine.runs.notebook executed --tier full --out notebooks/executed
 
 LAB_PORT ?= 8888
-lab: $(VENV)/.installed
-	$(BIN)/python -m ipykernel install --sys-prefix --name specrefine --display-name "Python 3 (specrefine)"
+# extra arguments for jupyter lab; as root (a container) it refuses to start without --allow-root
+LAB_ARGS ?= $(if $(filter 0,$(shell id -u)),--allow-root)
+lab: $(KERNEL_SPEC)
 	$(BIN)/jupyter lab --notebook-dir=notebooks --ip=127.0.0.1 --port=$(LAB_PORT) \
-		--MappingKernelManager.default_kernel_name=specrefine
+		--MappingKernelManager.default_kernel_name=specrefine $(LAB_ARGS)
 
 .PHONY: venv demo test notebooks-full notebook-expected notebook-expected-full executed lab

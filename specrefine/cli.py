@@ -2,7 +2,7 @@
 
     specrefine [--plugin MODULE] COMMAND [options]        specrefine COMMAND --help: its options and defaults
 
-Commands: refine, official, sweep, grids, train, calibrate, failures, figures, bench, notebook (:data:`COMMANDS`;
+Commands: refine, official, sweep, grids, train, calibrate, failures, figures, bench, notebook, show (:data:`COMMANDS`;
 the machinery is :mod:`specrefine.core.commands`). Bad input exits 2 with one line on stderr, never a traceback.
 """
 

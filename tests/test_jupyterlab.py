@@ -2,8 +2,8 @@
 
 The test starts JupyterLab on 127.0.0.1 (a free port, token auth, config/runtime/workspace dirs and
 the root dir in a temporary directory holding a copy of ``notebooks/05_astar_refinement.ipynb``;
-its kernel ``python3`` is this interpreter with this checkout first on PYTHONPATH), opens the notebook
-in Debian's Chromium (``/usr/bin/chromium``) driven by playwright, runs all cells from the Run menu
+its kernel ``specrefine``, the notebooks' own, is this interpreter with this checkout first on PYTHONPATH), opens
+the notebook in Debian's Chromium (``/usr/bin/chromium``) driven by playwright, runs all cells from the Run menu
 (smoke parameters: ~30 s), moves the ipywidgets slider to step 0 and checks that the picture below
 it changes (the ``img`` src before and after) together with the slider's readout. The screenshot is
 saved to ``tests/artifacts/jupyterlab_05_slider.png`` (gitignored; its path is printed).
@@ -112,7 +112,7 @@ def test_slider_redraws_the_search_in_jupyterlab(lab):
             page.on("request", lambda r: r.url.startswith(("data:", "blob:", base)) or outside.append(r.url))
             page.goto(f"{base}/lab/tree/notebooks/{NOTEBOOK.name}?reset&token={token}")
             page.wait_for_selector(".jp-NotebookPanel .jp-Cell", timeout=120_000)
-            # the kernel (ours: a python3 spec at the front of JUPYTER_PATH) must be up before running
+            # the kernel (ours: a specrefine spec at the front of JUPYTER_PATH) must be up before running
             page.wait_for_function("""() => {
                 const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
                 const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;

@@ -12,7 +12,8 @@ parameters (each must exist in the notebook's ``parameters`` cell); lowercase ke
 settings: ``timeout_s`` (whole notebook, default 300 s) and ``note``. ``OUT_DIR`` is always set to a
 fresh temporary directory, so no evaluation cache from an earlier run changes the counts. The
 notebook runs in a subprocess (so the timeout is hard) with cwd ``notebooks/``, on a kernel named
-``python3`` that is this interpreter (PYTHONPATH passes through; the test checks that the kernel
+``specrefine`` (the notebooks' own, passed to papermill explicitly) that is this interpreter
+(PYTHONPATH passes through; the test checks that the kernel
 imported THIS checkout's ``specrefine``), with ``MPLBACKEND=Agg``.
 
 **Values under regression.** The last cell of every notebook calls ``specrefine.record(name,
@@ -62,7 +63,7 @@ def _parameter_names(nb: Path) -> set[str]:
 
 @pytest.fixture(scope="session")
 def venv_kernel_env(tmp_path_factory) -> dict:
-    """Environment whose kernel 'python3' is this interpreter (the venv), whatever else is installed."""
+    """Environment whose kernel 'specrefine' is this interpreter (the venv), whatever else is installed."""
     return kernel_env(tmp_path_factory.mktemp("jupyter"))
 
 
@@ -143,6 +144,13 @@ def test_notebook_has_uppercase_parameters(nb):
 
 
 @pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
+def test_notebook_names_the_projects_kernel(nb):
+    from specrefine.runs.notebook import KERNEL
+
+    assert json.loads(nb.read_text())["metadata"]["kernelspec"]["name"] == KERNEL == "specrefine"
+
+
+@pytest.mark.parametrize("nb", NOTEBOOKS, ids=IDS)
 def test_notebook_committed_without_outputs(nb):
     cells = nbformat.read(nb, as_version=4).cells
     dirty = [i for i, c in enumerate(cells) if c.cell_type == "code" and (c.outputs or c.execution_count)]
@@ -167,3 +175,20 @@ def test_notebook_values_smoke(nb, tmp_path_factory, venv_kernel_env, request):
 def test_notebook_values_full(nb, tmp_path_factory, venv_kernel_env, request):
     executed = _run(nb, "full", tmp_path_factory.getbasetemp() / "notebooks", venv_kernel_env)
     _check_values(nb, "full", executed, request.config.getoption("--update-notebook-expected"))
+
+
+def test_the_readmes_papermill_command_keeps_out_dir_in_the_checkout():
+    """Run from the checkout's root, README's papermill command runs the notebook from its own folder, so the
+    notebook's relative OUT_DIR lands inside the checkout (it once wrote ``../runs/nb05`` one folder above it)."""
+    import re
+    import shlex
+
+    readme = (REPO / "README.md").read_text()
+    (line,) = [line for line in readme.splitlines() if line.startswith(".venv/bin/papermill ")]
+    args = shlex.split(line)
+    nb_path = REPO / args[1]
+    cwd = REPO / args[args.index("--cwd") + 1]
+    assert cwd == nb_path.parent
+    params = "".join(_parameters_cells(nb_path)[0]["source"])
+    out_dir = re.search(r'^OUT_DIR = "([^"]+)"', params, re.M).group(1)
+    assert (cwd / out_dir).resolve().is_relative_to(REPO)

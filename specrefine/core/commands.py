@@ -47,6 +47,7 @@ COMMANDS: dict[str, Command] = {
     "figures": Command("specrefine.experiments.figures", "the paper's Figures 4-6 from a sweep table"),
     "bench": Command("specrefine.bench.__main__", "throughput benchmarks: evaluator, gymenv, train, refine"),
     "notebook": Command("specrefine.runs.notebook", "executed copies of the numbered notebooks"),
+    "show": Command("specrefine.runs.show", "a finished run at a glance: summary, path leg by leg, time, pictures"),
 }
 
 def _module(name: str):

@@ -143,6 +143,7 @@ class Evaluator:
         self.cache = ResultCache(cache_dir, self.MEMO_SIZE)
         self.evaluations = 0  # subtask evaluations actually simulated
         self.sim_steps = 0  # environment steps simulated (evaluate + run_compositional)
+        self.simulating: str | None = None  # what the simulator runs right now, for a live display (runs.progress)
         self.run_steps = 0  # the same, as a run in one go would have simulated them (cache_dir's earlier work too)
         self._act = policy.act if hasattr(policy, "act") else policy
         self.observation_frame = getattr(policy, "observation_frame", "world")
@@ -365,8 +366,13 @@ class Evaluator:
     def _rollout_many(self, tasks: list[tuple]) -> list[dict]:
         """Run several ``(start, legs, n, seed)`` tasks side by side in one batch; one result dict per task."""
         # small-batch inference is fastest on one torch thread; more threads only contend with MuJoCo's
-        with _torch_threads(1):
-            return self._rollout_batches(tasks)
+        episodes = sum(n for _, _, n, _ in tasks)
+        self.simulating = f"simulating {episodes} episodes" + (f" of {len(tasks)} subtasks" if len(tasks) > 1 else "")
+        try:
+            with _torch_threads(1):
+                return self._rollout_batches(tasks)
+        finally:
+            self.simulating = None
 
     def _start_rows(self, sim, rows: np.ndarray, start, n: int, rng: np.random.Generator) -> None:
         if isinstance(start, StartStates):

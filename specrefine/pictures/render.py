@@ -53,6 +53,7 @@ START = "#00c8e6"  # cyan
 GOAL = "#22b14c"  # green
 SUBGOAL = "#ff8c00"  # orange
 CANDIDATE = "#ff8c00"
+PROPOSED = "#5f6368"  # grey outline: a waypoint set as proposed, under the subset chosen in it
 SUCCESS = "#119933"
 FAILURE = "#dd2222"
 EDGE = "#333333"
@@ -80,7 +81,8 @@ def new_figure(bounds, size_px: int = 768, title: str | None = None, legend_row:
     fs = _font(size_px)
     # margins in pixels: left for y tick labels, bottom for x tick labels, top for title + legend
     left, right, bottom = 4.2 * fs, 1.2 * fs, 3.4 * fs
-    top = (2.2 * fs if title else 0.8 * fs) + (2.0 * fs if legend_row else 0.0)
+    title_lines = title.count("\n") + 1 if title else 0
+    top = 0.8 * fs + 1.4 * fs * title_lines + (2.0 * fs if legend_row else 0.0)
     aspect = (y1 - y0) / (x1 - x0)
     if aspect <= 1.0:
         w = size_px
@@ -278,7 +280,7 @@ def _legend(fig, ax, items) -> None:
 
 # --- the task picture ----------------------------------------------------------------------------
 def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=None, waypoints=None, path=None,
-                title=None, size_px=768, edge_labels=None, points=None, legend=True):
+                title=None, size_px=768, edge_labels=None, points=None, legend=True, proposed=None):
     """Top-down picture of a maze task (the image handed to the VLM).
 
     maze: a :class:`~specrefine.core.mazes.Maze` (metres follow its ``cell_size``).
@@ -286,6 +288,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
       without it the maze's own S / G / lettered subgoals are drawn.
     trajectories, success, lengths: rollouts (n, T, 2), success flags (n,), valid lengths (n,).
     waypoints: candidate waypoints (Regions or points) drawn orange, dashed and numbered x1, x2, ...
+    proposed: regions drawn as grey outlines only, under ``waypoints`` (the sets as proposed, before Algorithm 2
+      chose subsets of them: the paper's Figure 3 in one frame).
     path: a list of graph vertices to highlight; edge_labels: {(u, v): text}; points: extra (x, y) dots.
     size_px: the longer side of the picture in pixels (the other follows the maze's aspect ratio).
     """
@@ -299,6 +303,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
     else:
         draw_maze_regions(ax, maze, alpha=0.18, labels=False)
         draw_graph(ax, graph, path=path, edge_labels=edge_labels)
+    for region in proposed or ():
+        draw_region(ax, region, PROPOSED, alpha=0.0, edge=True, lw=1.6, ls="-", zorder=1.9)
     if waypoints:
         draw_waypoints(ax, waypoints)
     if trajectories is not None and len(trajectories):
@@ -311,6 +317,8 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
             items.insert(1, ("hazard", HAZARD, "patch"))
         if (graph is not None and len(graph.vertices()) > 2) or maze.subgoals or waypoints:
             items.append(("subgoal / waypoint", SUBGOAL, "patch"))
+        if proposed:
+            items.append(("as proposed", PROPOSED, "line"))
         if graph is not None and any(graph.is_shortcut(u, v) for u, v in graph.edges()):
             items.append(("shortcut edge", EDGE, "dashed"))
         if trajectories is not None and len(trajectories):

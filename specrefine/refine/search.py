@@ -269,7 +269,8 @@ class RefinementSearch:
         outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
                              w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
                              racing=self.racing, feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
-        self._log("split-generated", edge=[u, v], candidates=[
+        budget = [self.splits_generated, self.cfg.max_edge_splits]  # Algorithm 1 calls so far, of the budget
+        self._log("split-generated", edge=[u, v], splits=budget, candidates=[
             {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
              "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
         best = outcome.best
@@ -295,7 +296,8 @@ class RefinementSearch:
         after = dict(p_after=repaired.probabilities, legs_repaired=repaired.repaired,
                      waypoints=[x.to_dict() for x in repaired.waypoints]) if repaired else \
             dict(p_after=None, legs_repaired=0, waypoints=None)
-        self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities, **after)
+        self._log("split-repaired", edge=[u, v], p_before=candidate.probabilities,
+                  splits=[self.splits_generated, self.cfg.max_edge_splits], **after)
         if repaired is not None and self.cfg.repair_tuning and repaired.p > 0.0:
             repaired = self._tune_repaired(u, v, repaired)
         return repaired

@@ -211,17 +211,22 @@ def tier_settings(nb: Path, tier: str) -> tuple[dict, dict]:
     return params, harness
 
 
+KERNEL = "specrefine"  # the kernel the notebooks' metadata names (`make venv` / `make lab` register it in .venv)
+
+
 def kernel_env(root: Path, mpl_backend: str | None = "Agg") -> dict:
-    """Environment whose Jupyter kernel 'python3' is this interpreter; PYTHONPATH passes through.
+    """Environment whose Jupyter kernels ``specrefine`` (:data:`KERNEL`, the name in the notebooks' metadata) and
+    ``python3`` are this interpreter, whatever else is installed or not; PYTHONPATH passes through.
 
     ``mpl_backend="Agg"`` (the test runs: no figure is rendered to PNG unless a cell asks for one);
     ``None``: the kernel's own inline backend, as a reader gets it (``display(fig)`` shows a picture).
     """
-    spec_dir = Path(root) / "kernels" / "python3"
-    spec_dir.mkdir(parents=True, exist_ok=True)
     spec = {"argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
             "display_name": "Python 3 (specrefine)", "language": "python"}
-    (spec_dir / "kernel.json").write_text(json.dumps(spec))
+    for name in (KERNEL, "python3"):
+        spec_dir = Path(root) / "kernels" / name
+        spec_dir.mkdir(parents=True, exist_ok=True)
+        (spec_dir / "kernel.json").write_text(json.dumps(spec))
     env = dict(os.environ)
     env["JUPYTER_PATH"] = os.pathsep.join([str(root), *filter(None, [env.get("JUPYTER_PATH")])])
     env.pop("MPLBACKEND", None)
@@ -237,7 +242,7 @@ def execute(nb: Path, out: Path, params: dict, *, env: dict, timeout: int,
     out = Path(out)
     params_file = out.with_suffix(".params.json")  # JSON is YAML
     params_file.write_text(json.dumps(params))
-    cmd = [sys.executable, "-m", "papermill", str(nb), str(out), "-f", str(params_file), "-k", "python3",
+    cmd = [sys.executable, "-m", "papermill", str(nb), str(out), "-f", str(params_file), "-k", KERNEL,
            "--cwd", str(cwd), "--no-progress-bar", "--execution-timeout", str(timeout), "--start-timeout", "120"]
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)

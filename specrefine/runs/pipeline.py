@@ -39,18 +39,40 @@ class RunResult:
     out: Path
 
     def summary(self) -> str:
+        """What the run found, the input task beside the refined one ("input 0.000 -> refined 1.000")."""
         d = self.data
         lo, hi = d["success_ci"]
         return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
                 f"seed={d['seed']} preset={d.get('preset', '?')}\n"
-                f"  success on the original task: {d['success_rate']:.3f} (95% CI {lo:.3f}-{hi:.3f}, "
-                f"{d['episodes']} episodes); predicted {d['predicted_success']:.3f} (95% CI "
-                f"{d['predicted_ci'][0]:.3f}-{d['predicted_ci'][1]:.3f}; the search's own {d['search_estimate']:.3f})\n"
+                f"  success on the original task: {_before(d, 'success_rate')}{d['success_rate']:.3f} "
+                f"(95% CI {lo:.3f}-{hi:.3f}, {d['episodes']} episodes)\n"
+                f"  estimated: {_before(d, 'estimate')}{d['search_estimate']:.3f} (the search's own); "
+                f"predicted {d['predicted_success']:.3f} (95% CI {d['predicted_ci'][0]:.3f}-{d['predicted_ci'][1]:.3f},"
+                f" held-out episodes)\n"
                 f"  graph: {d['graph_vertices']} vertices, {d['graph_edges']} edges, path of {d['path_edges']} "
-                f"subtasks; refines input: {d['refines_input']}\n"
+                f"subtasks; {_refinement_text(d)}\n"
                 f"  {d['evaluations']} subtask evaluations, {d['sim_steps']} sim steps, "
                 f"{d['proposer_calls']} proposer calls ({'VLM' if d['proposer_is_vlm'] else 'offline, not a VLM'}), "
                 f"{d['wall_seconds']:.1f} s\n  -> {self.out / 'result.json'}")
+
+
+def _before(d: dict, key: str, form: str = ".3f") -> str:
+    """"input X -> refined " for a run that recorded its input task and refined it (else nothing)."""
+    before = None if _unrefined(d) else d.get("input_task")  # absent in runs written before it was recorded
+    return "" if before is None else f"input {before[key]:{form}} -> refined "
+
+
+def _unrefined(d: dict) -> bool:
+    return d.get("refinements", 0) == 0 and d.get("graph") == d.get("input_graph")
+
+
+def _refinement_text(d: dict) -> str:
+    """Whether the output graph is a refinement of the input, or the input itself (a method that refines nothing)."""
+    if _unrefined(d):
+        return f"the input graph itself ({d['method']} refined nothing)"
+    if d["refines_input"]:
+        return f"a refinement of the input (checked; refinements accepted: {d.get('refinements', 0)})"
+    return "NOT a refinement of the input (checked: the method's graph breaks Theorem 4.1)"
 
 
 def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/latest"), evaluator=None,
@@ -110,12 +132,12 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
         phases = {"search_seconds": time.time()}
         search = run_search(config, original, evaluator, exp.proposer, maze, on_step)
         phases["measure_seconds"] = time.time()
-        shown.phase("measurement")
+        shown.phase(f"measurement of {episodes} episodes")
         measured = measure(evaluator, original, search.graph, search.path, episodes, seed + MEASURE_SEED_OFFSET)
         phases["calibrate_seconds"] = time.time()
-        shown.phase("calibration")
+        shown.phase("calibration on held-out episodes")
         prediction = predict(evaluator, original, search.graph, search.path, seed, episodes)
-    data = _result_dict(exp, config, search, measured, t0)
+    data = _result_dict(exp, config, search, measured, t0)  # the counters and wall_seconds: the refinement's cost
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"], data["goal_points"] = config.evaluation, config.goal_points
@@ -124,11 +146,33 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])
     data["config"] = config.to_dict()  # everything this run was asked to do (what its preset decides resolved)
     data["preset"] = config.preset  # best (the best measured settings) or paper (the paper's rules)
-    data.update(_durations(phases, time.time()))  # where the wall time went: search, measurement, calibration
+    phases["input_seconds"] = time.time()
+    shown.phase(f"input task as it is: {episodes} episodes")
+    data["input_task"] = _input_task(exp, config, search, measured)
+    data.update(_durations(phases, time.time()))  # where the wall time went: search, measurement, calibration, input
     write_atomic(out / "result.json", json.dumps(data, indent=2, default=_jsonable))
     save_run_policy(out, maze, config.agent, search.graph, search.path, evaluator)  # out/policy.json: as an object
     _pictures(maze, search, measured, out, data)
     return RunResult(data, out)
+
+
+def _input_task(exp, config: RunConfig, search, measured) -> dict:
+    """The input task as it is, for the before-and-after: DiRL's shortest path on the input graph, its estimate
+    (the search's rollouts, mostly cached) and its success measured on the refined path's episode seeds.  Run after
+    the refinement's counters are taken: its evaluations and seconds (``input_seconds``) are apart from them."""
+    from ..core.results import wilson_ci
+    from ..refine import shortest_path
+
+    original, evaluator = exp.graph, exp.evaluator
+    if search.refinements == 0 and search.graph == original:  # the method's own path is the input's (dirl)
+        found, run = search, measured
+    else:
+        found = shortest_path(original, evaluator, seed=config.seed)
+        run = measure(evaluator, original, original, found.path, config.episodes, config.seed + MEASURE_SEED_OFFSET)
+    k, n = int(run.success.sum()), len(run.success)
+    return {"path": found.path, "estimate": found.predicted_success, "success_rate": run.rate,
+            "success_ci": list(wilson_ci(k, n)), "episodes": n,
+            "episode_outcomes": run.path_result.counts() if run.path_result else {}}
 
 
 def _durations(starts: dict, end: float) -> dict:
@@ -174,8 +218,9 @@ def _pictures(maze, search, measured, out, data) -> None:
 
     pr = measured.path_result
     lo, hi = data["success_ci"]
-    title = (f"{maze.name} [{data['method']}, {data['proposer']}]: {data['success_rate']:.0%} "
-             f"(95% CI {lo:.0%}-{hi:.0%}, {data['episodes']} episodes)")
+    title = (f"{maze.name} [{data['method']}, {data['proposer']}]\nmeasured: {_before(data, 'success_rate', '.0%')}"
+             f"{data['success_rate']:.0%} (95% CI {lo:.0%}-{hi:.0%}, {data['episodes']} episodes)\n"
+             f"estimated: {_before(data, 'estimate', '.0%')}{data['search_estimate']:.0%}")
     fig = render_task(maze, search.graph, trajectories=pr.trajectories if pr else None,
                       success=measured.success if pr else None, lengths=pr.lengths if pr else None,
                       path=search.path, title=title)

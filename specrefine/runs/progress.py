@@ -1,12 +1,15 @@
-"""One live line on stderr while a refinement run works, so that a long run (the Ant: minutes) is seen to work:
+"""One live line while a refinement run works, so that a long run (the Ant: minutes) is seen to work, and why:
 
-    00:12 search | best path 0.81 (to c) | 41 evaluations | 310,528 sim steps | 6 proposer calls
+    00:12 search | splits 3/30 | simulating 96 episodes of 3 subtasks | best path 0.81 (to c) | 41 evaluations | ...
 
-the elapsed time, the phase (search, measurement, calibration), the search's current estimate of its best path
-(to the vertex it last closed, then the found path's), the evaluator's counters and the proposer's calls,
-refreshed every second (what does not fit the terminal's width is cut from the end).  ``tqdm.auto``: a notebook
-gets a widget.  Shown when stderr is a terminal or in a notebook (``enabled=None``); never for ``enabled=False``
-(``specrefine refine --quiet``, sweep cells).
+the elapsed time, the phase (search, "measurement of 200 episodes", calibration, the input task), the edge splits
+used of the search's budget (once one is done), what the simulator runs right now (the evaluator's ``simulating``),
+the search's current estimate of its best path (to the vertex it last closed, then the found path's), the evaluator's
+counters and the proposer's calls, refreshed every second (what does not fit the terminal's width is cut from the
+end).  On a terminal: a tqdm line on stderr, cleared at the end.  In a notebook: one text output updated in place,
+which ends as the run's last line ("done"), so a saved notebook shows how the run ended, not how it began.  Shown
+when stderr is a terminal or in a notebook (``enabled=None``); never for ``enabled=False`` (``specrefine refine
+--quiet``, sweep cells).
 
 :func:`counted` is the bar of a loop over items (``official``'s episodes, a sweep's cells): tqdm's on a terminal or
 in a notebook; elsewhere (a log file, a pipe) one plain line per ``every`` items, as a log wants it, never the
@@ -21,7 +24,8 @@ import sys
 import threading
 import time
 
-from tqdm.auto import tqdm
+from tqdm import tqdm
+from tqdm.auto import tqdm as auto_tqdm
 
 
 def _in_notebook() -> bool:
@@ -44,7 +48,7 @@ def counted(items, total: int, desc: str, unit: str = "item", every: int | None 
     as ``official u_maze: 20/200 episodes (4 s)`` after every ``every`` items (default: a tenth of ``total``) and
     after the last."""
     if wanted(None):
-        return tqdm(items, total=total, desc=desc, unit=unit, file=sys.stderr, **tqdm_kw)
+        return auto_tqdm(items, total=total, desc=desc, unit=unit, file=sys.stderr, **tqdm_kw)
     return _lines(items, total, desc, unit, every or max(1, math.ceil(total / 10)))
 
 
@@ -64,27 +68,26 @@ class RunProgress:
 
     def __init__(self, evaluator, proposer=None, *, enabled: bool | None = None, every: float = 1.0):
         self.evaluator, self.proposer, self.every = evaluator, proposer, every
-        self.phase_name, self.estimate, self.towards = "search", None, None
+        self.phase_name, self.estimate, self.towards, self.splits = "search", None, None, None
         self.enabled = wanted(enabled)
-        self._bar = None
+        self._shown = None  # _TerminalLine or _NotebookLine
         self._stop = threading.Event()
         self._ticker = None
 
     def __enter__(self) -> RunProgress:
         if self.enabled:
-            columns, rows = shutil.get_terminal_size()  # a terminal that reports 0 x 0 (a bare pty) gets 80 x 24
-            self._bar = tqdm(total=None, file=sys.stderr, bar_format="{elapsed} {desc}", leave=False,
-                             desc=self.line(), ncols=columns, nrows=rows)
+            self._shown = _NotebookLine(self.line()) if _in_notebook() else _TerminalLine(self.line())
             self._ticker = threading.Thread(target=self._tick, daemon=True, name="run-progress")
             self._ticker.start()
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._bar is not None:
+        if self._shown is not None:
             self._stop.set()
             self._ticker.join()
-            self._bar.close()
-            self._bar = None
+            self.phase_name = "done" if exc[0] is None else "stopped"
+            self._shown.close(self.line())
+            self._shown = None
 
     def phase(self, name: str) -> None:
         self.phase_name = name
@@ -98,11 +101,17 @@ class RunProgress:
             self.estimate, self.towards = step["predicted_success"], None
         elif step.get("event") == "candidate" and "predicted_success" in step:  # the one-shot baseline's best so far
             self.estimate = max(self.estimate or 0.0, step["predicted_success"])
+        if "splits" in step:  # [used, budget] of the search's edge splits
+            self.splits = step["splits"]
         self.refresh()
 
     def line(self) -> str:
         ev, proposer = self.evaluator, self.proposer
         parts = [self.phase_name]
+        if self.splits is not None:
+            parts.append(f"splits {self.splits[0]}/{self.splits[1]}")
+        if getattr(ev, "simulating", None):
+            parts.append(ev.simulating)
         if self.estimate is not None:
             parts.append(f"best path {self.estimate:.2f}" + (f" (to {self.towards})" if self.towards else ""))
         parts += [f"{ev.evaluations + getattr(ev, 'disk_hits', 0)} evaluations", f"{int(ev.sim_steps):,} sim steps",
@@ -110,9 +119,44 @@ class RunProgress:
         return " | ".join(parts)
 
     def refresh(self) -> None:
-        if self._bar is not None:
-            self._bar.set_description_str(self.line(), refresh=True)
+        if self._shown is not None:
+            self._shown.show(self.line())
 
     def _tick(self) -> None:
         while not self._stop.wait(self.every):  # the elapsed time and counters move during a long evaluation too
             self.refresh()
+
+
+class _TerminalLine:
+    """The line on a terminal's stderr (tqdm: the elapsed time, cut to the width), cleared at the end."""
+
+    def __init__(self, text: str):
+        columns, rows = shutil.get_terminal_size()  # a terminal that reports 0 x 0 (a bare pty) gets 80 x 24
+        self._bar = tqdm(total=None, file=sys.stderr, bar_format="{elapsed} {desc}", leave=False, desc=text,
+                         ncols=columns, nrows=rows)
+
+    def show(self, text: str) -> None:
+        self._bar.set_description_str(text, refresh=True)
+
+    def close(self, text: str) -> None:
+        self._bar.close()
+
+
+class _NotebookLine:
+    """The line as one notebook output, replaced in place (``display_id``); its last text stays in the notebook."""
+
+    def __init__(self, text: str):
+        from IPython.display import display
+
+        self._t0 = time.monotonic()
+        self._handle = display(self._bundle(text), raw=True, display_id=True)
+
+    def _bundle(self, text: str) -> dict:
+        elapsed = int(time.monotonic() - self._t0)
+        return {"text/plain": f"{elapsed // 60:02d}:{elapsed % 60:02d} {text}"}
+
+    def show(self, text: str) -> None:
+        self._handle.update(self._bundle(text), raw=True)
+
+    def close(self, text: str) -> None:
+        self.show(text)

@@ -43,10 +43,11 @@ def _edge_graph(graph, u, v):
 
 
 def candidate_picture(maze):
-    """SplitCandidate -> PNG of its waypoints and the rollouts of each of its subtasks."""
+    """SplitCandidate -> PNG of its waypoints and the rollouts of each of its subtasks; ``picture(candidate,
+    proposed=regions, title=...)`` also outlines the sets as proposed under a tuned candidate's subsets (Figure 3)."""
     from ..pictures.render import render_task, to_png
 
-    def picture(candidate):
+    def picture(candidate, proposed=None, title=None):
         legs = [r for r in candidate.results if getattr(r, "trajectories", None) is not None and r.n]
         if not legs:
             return None
@@ -56,7 +57,8 @@ def candidate_picture(maze):
         traj = np.concatenate([pad_trajectories(r.trajectories, width) for r in legs])
         fig = render_task(maze, trajectories=traj, success=np.concatenate([r.success for r in legs]),
                           lengths=np.concatenate([r.lengths for r in legs]), waypoints=candidate.waypoints,
-                          title="subtask success: " + ", ".join(f"{p:.2f}" for p in candidate.probabilities))
+                          proposed=proposed, title=title or "subtask success: " + ", ".join(
+                              f"{p:.2f}" for p in candidate.probabilities))
         return to_png(fig)
 
     return picture

@@ -1,0 +1,121 @@
+"""``specrefine show RUN_DIR``: a finished run at a glance, from its files alone (nothing is simulated).
+
+    specrefine show runs/demo
+
+prints the run's summary (the input task beside the refined one), its path leg by leg (each subtask's estimate
+from the search's rollouts and its measured success among the episodes that started it), where the wall time
+went, the official environment's result if ``specrefine official`` has run, and the paths of its pictures and
+files.  A folder that is not a finished run is one line (exit 2).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..core.errors import SpecrefineError
+from .pipeline import RunResult
+
+PHASES = (("search_seconds", "search"), ("measure_seconds", "measurement"), ("calibrate_seconds", "calibration"),
+          ("input_seconds", "input task (after the run's counters)"))
+FILES = (("refined.png", "the refined task and the measured episodes"), ("graph.png", "the refined task graph"),
+         ("policy.json", "the compositional policy, docs/official_env.md"),
+         ("steps.jsonl", "the search, step by step"),
+         ("official.json", "the policy in the official Gymnasium-Robotics environment"),
+         ("result.json", "everything above, as data"))
+
+
+def load_run(run_dir) -> dict:
+    """``RUN_DIR/result.json`` checked by the records' schema (``core.records``: a FIFO, a folder or a device is
+    refused unopened), or one SpecrefineError line saying why it is not a finished run."""
+    from ..core.records import read_result
+
+    path = Path(run_dir) / "result.json"
+    if not path.exists() and not path.is_symlink():
+        raise SpecrefineError(f"{path}: not found: RUN_DIR must be a finished 'specrefine refine' run folder")
+    data = read_result(path)
+    missing = [key for key in ("success_rate", "success_ci", "episodes", "path") if key not in data]
+    if missing:
+        raise SpecrefineError(f"{path}: not a finished run's result (no {', '.join(missing)})")
+    return data
+
+
+def show(run_dir) -> str:
+    run_dir = Path(run_dir)
+    data = load_run(run_dir)
+    try:
+        parts = [RunResult(data, run_dir).summary(), path_text(data), time_text(data), official_text(run_dir),
+                 files_text(run_dir)]
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise SpecrefineError(f"{run_dir / 'result.json'}: malformed ({type(exc).__name__}: {exc})") from None
+    return "\n".join(part for part in parts if part)
+
+
+def path_text(data: dict) -> str:
+    """The chosen path, one subtask a line: the search's estimate and the measured success of that leg."""
+    path = data.get("path")
+    if not path:
+        return "path: none found (no compositional policy)"
+    estimates, measured = data.get("edge_probabilities", []), data.get("leg_success", [])
+    lines = [f"path, leg by leg (estimate: the search's rollouts; measured: the {data['episodes']} episodes, among "
+             "those that started the leg):"]
+    width = max(len(f"{u} -> {v}") for u, v in zip(path, path[1:]))
+    for i, (u, v) in enumerate(zip(path, path[1:])):
+        estimate = f"{estimates[i]:.3f}" if i < len(estimates) else "  -  "
+        leg = measured[i] if i < len(measured) else None
+        lines.append(f"  {i + 1:>2}. {f'{u} -> {v}':<{width}}  estimate {estimate}  measured "
+                     f"{'  -  ' if leg is None else f'{leg:.3f}'}")
+    outcomes = data.get("episode_outcomes")
+    if outcomes:
+        lines.append("  episodes ended: " + ", ".join(f"{name} {count}" for name, count in outcomes.items()))
+    before = data.get("input_task")
+    if before and before.get("path"):
+        lines.append(f"  the input task's path: {' -> '.join(before['path'])}, estimate {before['estimate']:.3f}, "
+                     f"measured {before['success_rate']:.3f} ({before['episodes']} episodes; ended: "
+                     + ", ".join(f"{name} {count}" for name, count in before.get("episode_outcomes", {}).items())
+                     + ")")
+    return "\n".join(lines)
+
+
+def time_text(data: dict) -> str:
+    """Where the wall time went: each phase's seconds and the rest (loading the policy, building the simulator)."""
+    wall = float(data.get("wall_seconds", 0.0))
+    phases = [(label, float(data[key])) for key, label in PHASES if key in data]
+    if not phases:
+        return f"time: {wall:.1f} s (no phase times recorded)"
+    inside = sum(seconds for label, seconds in phases if not label.startswith("input"))
+    shown = [f"{label} {seconds:.1f} s" for label, seconds in phases]
+    return (f"time: {wall:.1f} s = " + ", ".join(shown[:3]) + f", setup {max(wall - inside, 0.0):.1f} s"
+            + "".join(f"; then {part}" for part in shown[3:]))
+
+
+def official_text(run_dir: Path) -> str:
+    path = run_dir / "official.json"
+    if not path.exists():
+        return f"official environment: not run (specrefine official {run_dir})"
+    try:
+        from .official import summary
+
+        return summary(json.loads(path.read_text(encoding="utf-8")))
+    except (OSError, ValueError, KeyError, TypeError):
+        return f"official environment: {path} unreadable"
+
+
+def files_text(run_dir: Path) -> str:
+    lines = ["files:"]
+    for name, what in FILES:
+        if (run_dir / name).exists():
+            lines.append(f"  {run_dir / name}  ({what})")
+    return "\n".join(lines)
+
+
+# --- the command (specrefine show) ---------------------------------------------------------------------------
+def add_arguments(parser) -> None:
+    parser.description = ("A finished run at a glance: its summary (the input task beside the refined one), its path "
+                          "leg by leg with estimates and measured success, where the time went, and its pictures.")
+    parser.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a finished 'specrefine refine' output folder")
+
+
+def run(args, parser=None) -> int:
+    print(show(args.run_dir), flush=True)
+    return 0

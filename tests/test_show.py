@@ -1,0 +1,79 @@
+"""A run a person can judge at a glance: the input task beside the refined one, and `specrefine show RUN`."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from specrefine.cli import main
+
+TINY = ["--rollouts", "8", "--episodes", "16", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    root = tmp_path_factory.mktemp("show")
+    assert main(["refine", "split_doorway", "--method", "ours", "--proposer", "geometric", "--out",
+                 str(root / "ours"), *TINY]) == 0
+    assert main(["refine", "split_doorway", "--method", "dirl", "--out", str(root / "dirl"), *TINY]) == 0
+    return root
+
+
+def test_the_summary_puts_the_input_task_before_the_refined_one(runs, capsys):
+    data = json.loads((runs / "ours" / "result.json").read_text())
+    before = data["input_task"]
+    assert before["path"] == ["S", "G"] and before["episodes"] == 16
+    assert before["success_rate"] == 0.0 and before["estimate"] == 0.0  # straight through the doorway's wall
+    assert data["success_rate"] > before["success_rate"]
+    capsys.readouterr()
+    assert main(["show", str(runs / "ours")]) == 0
+    out = capsys.readouterr().out
+    assert f"success on the original task: input 0.000 -> refined {data['success_rate']:.3f}" in out
+    assert f"estimated: input 0.000 -> refined {data['search_estimate']:.3f}" in out
+    assert "a refinement of the input (checked" in out
+
+
+def test_dirl_is_not_called_a_refinement(runs, capsys):
+    data = json.loads((runs / "dirl" / "result.json").read_text())
+    assert data["input_task"]["success_rate"] == data["success_rate"]  # its path is the input's: measured once
+    capsys.readouterr()
+    assert main(["show", str(runs / "dirl")]) == 0
+    out = capsys.readouterr().out
+    assert "the input graph itself (dirl refined nothing)" in out
+    assert "refines input" not in out and "-> refined" not in out
+
+
+def test_show_gives_the_path_leg_by_leg_the_time_and_the_pictures(runs, capsys):
+    run = runs / "ours"
+    data = json.loads((run / "result.json").read_text())
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    out = capsys.readouterr().out
+    legs = [line for line in out.splitlines() if re.match(r"\s+\d+\. ", line)]
+    path = data["path"]
+    assert len(legs) == len(path) - 1
+    for line, u, v, p in zip(legs, path, path[1:], data["edge_probabilities"]):
+        assert f"{u} -> {v}" in line and f"estimate {p:.3f}" in line
+    assert "the input task's path: S -> G" in out
+    time_line = next(line for line in out.splitlines() if line.startswith("time: "))
+    for phase in ("search", "measurement", "calibration", "setup", "input task"):
+        assert phase in time_line
+    assert str(run / "refined.png") in out and str(run / "graph.png") in out
+    assert "official environment: not run" in out
+
+
+@pytest.mark.parametrize("content", [None, "{x", "[]", '{"maze": "u_maze", "agent": "point"}', "fifo", "folder"])
+def test_show_refuses_what_is_not_a_run_in_one_line(tmp_path, capsys, content):
+    import os
+
+    if content == "fifo":  # refused unopened: reading it would wait forever
+        os.mkfifo(tmp_path / "result.json")
+    elif content == "folder":
+        (tmp_path / "result.json").mkdir()
+    elif content is not None:
+        (tmp_path / "result.json").write_text(content)
+    assert main(["show", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "result.json" in err
