@@ -6,23 +6,41 @@
 # Environment: CODE (instead of the grid's commit; a grid without one runs the checkout's HEAD), OUT (the sweep
 # folder; parts with their own sit under it), SHIPPED (the table; grids with one table only), WORKERS, PYTHON,
 # TREE (scripts/pinned_sweep.sh), DRY_RUN=1 (print the pinned_sweep.sh commands, run nothing). Relative paths are
-# taken from the checkout's root.
+# taken from the checkout's root. Every value is passed as one argument, never run as shell code (no eval).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-name=${1:?usage: bash scripts/run_grid.sh NAME (python -m specrefine.experiments.grids list)}
+if [ -z "${1:-}" ]; then
+    echo "usage: bash scripts/run_grid.sh NAME (python -m specrefine.experiments.grids list)" >&2
+    exit 2
+fi
+name=$1
 py=${PYTHON:-$root/.venv/bin/python}
 grids() { PYTHONPATH=$root "$py" -m specrefine.experiments.grids "$@"; }
+split() { "$py" -c 'import shlex, sys; sys.stdout.write("".join(a + "\0" for a in shlex.split(sys.argv[1])))' "$1"; }
 
-plan=$(grids plan "$name" ${OUT:+--out "$OUT"} ${SHIPPED:+--shipped "$SHIPPED"})  # a bad name: its line, exit 2
-code=${CODE:-$(awk '$1 == "code" {print $2}' <<<"$plan")}
+options=()
+[ -z "${OUT:-}" ] || options+=(--out "$OUT")
+[ -z "${SHIPPED:-}" ] || options+=(--shipped "$SHIPPED")
+plan=$(grids plan "$name" ${options[@]+"${options[@]}"})  # a bad name: its line, exit 2
+code=${CODE:-}
+steps=()  # per step: OUT, TABLE and the sweep's arguments (shell-quoted, as grids args prints them)
+while IFS=$'\t' read -r kind part step out table; do
+    case $kind in
+        code) [ -n "$code" ] || code=$part ;;
+        step) steps+=("$out" "$table" "$(grids args "$name" --part "$part" --step "$step" \
+                                         ${WORKERS:+--workers "$WORKERS"})") ;;
+    esac
+done <<<"$plan"
 [ "$code" != - ] || code=$(git rev-parse --short HEAD)
-commands=()
-while read -r part step out table; do
-    args=$(grids args "$name" --part "$part" --step "$step" ${WORKERS:+--workers "$WORKERS"})
-    commands+=("CODE=$code OUT=$out SHIPPED=$table bash scripts/pinned_sweep.sh $args")
-done < <(awk '$1 == "step" {print $2, $3, $4, $5}' <<<"$plan")
 
-for command in "${commands[@]}"; do
-    if [ -n "${DRY_RUN:-}" ]; then echo "$command"; else eval "$command" </dev/null; fi
+for ((i = 0; i < ${#steps[@]}; i += 3)); do
+    out=${steps[i]} table=${steps[i + 1]} args=${steps[i + 2]}
+    if [ -n "${DRY_RUN:-}" ]; then
+        printf 'CODE=%q OUT=%q SHIPPED=%q bash scripts/pinned_sweep.sh %s\n' "$code" "$out" "$table" "$args"
+    else
+        mapfile -d '' -t argv < <(split "$args")
+        [ "${#argv[@]}" -gt 0 ] || { echo "run_grid.sh: no sweep arguments for step $((i / 3)) of $name" >&2; exit 2; }
+        CODE=$code OUT=$out SHIPPED=$table bash scripts/pinned_sweep.sh "${argv[@]}" </dev/null
+    fi
 done

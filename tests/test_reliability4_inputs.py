@@ -310,26 +310,12 @@ def _run_main(argv) -> tuple[int, str]:
         signal.signal(signal.SIGALRM, previous)
 
 
-#: cases that wait on issue 40's part A (another branch): (position, kind) -> (the item, whether it hangs)
-PART_A = {("official --out FILE", "fifo"): ("2", False), ("official --out FILE", "folder"): ("10", False),
-          ("official --out FILE", "device"): ("2", False), ("sweep OUT/sweep.json", "random bytes"): ("11", False),
-          ("sweep OUT/sweep.json", "symlink"): ("11", False), ("sweep OUT/sweep.json", "fifo"): ("7", True),
-          ("sweep OUT/sweep.json", "folder"): ("11", False), ("sweep OUT/sweep.json", "device"): ("7", False)}
+POSITIONS = ("refine MAZE_FILE", "refine --policy", "refine replay recording", "refine OUT/run.json",
+             "official RUN/result.json", "official RUN/policy.json", "official --out FILE", "failures RESULT",
+             "failures RUN/run.json", "sweep OUT/sweep.json", "sweep OUT/results.csv")
 
 
-def _cases():
-    cases = []
-    for position in ("refine MAZE_FILE", "refine --policy", "refine replay recording", "refine OUT/run.json",
-                     "official RUN/result.json", "official RUN/policy.json", "official --out FILE", "failures RESULT",
-                     "failures RUN/run.json", "sweep OUT/sweep.json", "sweep OUT/results.csv"):
-        for kind in KINDS:
-            item, hangs = PART_A.get((position, kind), (None, False))
-            marks = [pytest.mark.xfail(reason=f"issue 40 item {item}, part A (rel-io)", run=not hangs)] if item else []
-            cases.append(pytest.param(position, kind, marks=marks))
-    return cases
-
-
-@pytest.mark.parametrize("position,kind", _cases())
+@pytest.mark.parametrize("position,kind", [(p, k) for p in POSITIONS for k in KINDS])
 def test_every_input_in_every_form_is_exit_0_or_one_line_and_nothing_outside_out_changes(
         finished_run, tmp_path, monkeypatch, capsys, position, kind):
     where, valid, argv_of = _positions(finished_run)[position]

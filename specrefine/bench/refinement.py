@@ -19,6 +19,7 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from ..core.runfolder import open_append
 from ..runs.config import DEFAULTS
 
 COLUMNS = ["maze", "agent", "method", "proposer", "seed", "evaluation", "success_rate", "success_ci_low",
@@ -129,7 +130,7 @@ def _append(path, row: dict) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     new = not path.exists() or path.stat().st_size == 0
-    with path.open("a", newline="") as fh:
+    with open_append(path, "table") as fh:  # never through a link
         writer = csv.DictWriter(fh, fieldnames=COLUMNS)
         if new:
             writer.writeheader()

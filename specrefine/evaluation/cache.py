@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.results import EdgeResult, StartStates, wilson_ci
+from ..core.runfolder import fresh_opener
 
 log = logging.getLogger(__name__)
 
@@ -99,7 +100,8 @@ class ResultCache:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-            with open(tmp, "wb") as f:
+            tmp.unlink(missing_ok=True)  # a killed run's, or a planted link: removed, never followed
+            with open(tmp, "wb", opener=fresh_opener) as f:
                 np.savez_compressed(f, key=np.array(text), success=res.success, trajectories=res.trajectories,
                                     lengths=res.lengths, end_states=res.end_states.states, end_xy=res.end_states.xy,
                                     steps=np.array(res.steps), outcome=res.outcome)

@@ -16,7 +16,7 @@ import sys
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
-from ..core.runfolder import read_result, write_atomic
+from ..core.runfolder import output_file, read_result, write_atomic
 
 FIELDS = ("seed", "success_rate", "episodes", "path_edges", "evaluations", "sim_steps", "wall_seconds",
           "search_seconds", "measure_seconds", "calibrate_seconds")
@@ -43,6 +43,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", required=True, help="the JSON file to write (whole, or not at all)")
     args = ap.parse_args(argv)
     try:
+        output_file(args.out)  # before reading the runs
         report = dict(about_pair(a) for a in args.about)
         report["runs"] = [run_cost(read_result(path), str(path)) for path in args.results]
         write_atomic(args.out, json.dumps(report, indent=1) + "\n")

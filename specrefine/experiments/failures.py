@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import sys
 from collections import Counter
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -192,19 +193,20 @@ def main(argv=None) -> int:
 
 
 def run(args, p) -> int:
-    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic
+    from ..core.runfolder import read_result, recorded_maze, writable_parent, write_atomic, writing_into
 
     try:
-        if args.out is not None:
-            writable_parent(args.out)  # before the re-run, not after it
+        out = None if args.out is None else writable_parent(args.out)  # before the re-run, not after it
         result = read_result(args.result)
-        maze = recorded_maze(args.result, result["maze"])
-        if args.estimates:
-            report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
-        else:
-            report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy, args.goal_points)
-        if args.out is not None:
-            write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+        with nullcontext() if out is None else writing_into(out):  # into a run folder: under its lock
+            maze = recorded_maze(args.result, result["maze"])
+            if args.estimates:
+                report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
+            else:
+                report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy,
+                                       args.goal_points)
+            if args.out is not None:
+                write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:
         print(f"{p.prog}: error: {e}", file=sys.stderr)
         return 2

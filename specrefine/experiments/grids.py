@@ -368,14 +368,17 @@ def show(g: ExperimentGrid, root: Path = ROOT) -> list[str]:
 
 
 def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) -> list[str]:
-    """What run_grid.sh reads: 'code COMMIT' (or 'code -': the checkout's HEAD), then 'step PART STEP OUT TABLE'
-    per sweep, in order."""
+    """What run_grid.sh reads, fields separated by tabs (a path may hold spaces): 'code COMMIT' (or 'code -': the
+    checkout's HEAD), then 'step PART STEP OUT TABLE' per sweep, in order."""
     if shipped and len(g.tables) > 1:
         raise GridError(f"grid {g.name} writes {len(g.tables)} tables: SHIPPED names one table only")
-    lines = [f"code {g.code or '-'}"]
+    for name, path in (("OUT", out), ("SHIPPED", shipped)):
+        if path is not None and (not path.strip() or any(ch in path for ch in "\t\n\r")):
+            raise GridError(f"{name}={path!r}: name a path (not empty, no tab or line break)")
+    lines = [f"code\t{g.code or '-'}"]
     for i in range(len(g.parts)):
         for j in range(len(_steps(g, g.parts[i]))):
-            lines.append(f"step {i} {j} {g.part_out(i, out)} {shipped or g.part_table(i)}")
+            lines.append(f"step\t{i}\t{j}\t{g.part_out(i, out)}\t{shipped or g.part_table(i)}")
     return lines
 
 

@@ -20,7 +20,7 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
 from ..core.results import wilson_ci
-from ..core.runfolder import read_result, write_atomic
+from ..core.runfolder import output_file, read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
 
 HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | legs | legs per room | per-leg failure | "
@@ -157,6 +157,8 @@ def main(argv=None) -> int:
     if args.turns and not args.profiles:
         ap.error("--turns needs --profiles")
     try:
+        if args.out:
+            output_file(args.out)  # before reading the inputs
         if args.profiles:
             profiles = [leg_profile(read_result(path)) for path in args.tables]
             if args.out:

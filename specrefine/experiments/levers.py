@@ -18,7 +18,7 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
 from ..core.results import newcombe_ci, rate_text
-from ..core.runfolder import write_atomic
+from ..core.runfolder import output_file, write_atomic
 from ..core.tables import goal_points_of
 from ..runs.sweep import is_done, read_checked_table
 from .legs import pooled
@@ -86,6 +86,8 @@ def main(argv=None) -> int:
         p.error(f"--baseline-mazes names {len(baseline_mazes)} mazes for the {len(args.mazes)} of --mazes")
     pairs = dict(zip(args.mazes, baseline_mazes, strict=True))
     try:
+        if args.out is not None:
+            output_file(args.out)
         lever = _by_cell(args.table, args.method, args.proposer)
         by_maze = _by_cell(args.baseline, args.baseline_method, args.proposer)
     except SpecrefineError as exc:

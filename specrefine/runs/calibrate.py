@@ -249,6 +249,7 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     from tqdm.auto import tqdm
 
     from ..core.errors import SpecrefineError
+    from ..core.runfolder import open_append
 
     fields = ["cell", "success_rate", "predicted_success", "predicted_ci_low", "predicted_ci_high",
               "prediction_successes", "prediction_episodes", "prediction_sim_steps"]
@@ -266,7 +267,7 @@ def _predict_into(table, runs, maze_dir=None) -> int:
         except SpecrefineError as exc:
             raise SpecrefineError(f"{run}: {exc}" if not str(exc).startswith(str(run)) else str(exc)) from None
     new = not table.exists()
-    with table.open("a", newline="") as fh:
+    with open_append(table, "table") as fh:  # never through a link
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         if new:
             writer.writeheader()

@@ -42,16 +42,16 @@ from pathlib import Path
 
 import gymnasium
 import numpy as np
-from tqdm.auto import tqdm
 
 from ..core.agents import get_agent
 from ..core.errors import SpecrefineError
 from ..core.records import read_result
 from ..core.results import wilson_ci
-from ..core.runfolder import write_atomic
+from ..core.runfolder import output_file, write_atomic, writing_into
 from ..core.standard_maps import to_gymnasium
 from ..evaluation.compositional import CompositionalPolicy
 from ..evaluation.gym_wrapper import TaskJudge
+from .progress import counted
 
 OFFICIAL_JSON = "official.json"
 RESET_RULES = ("official", "package")  # whose start / reset noise an episode begins with (module docstring)
@@ -130,13 +130,21 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     """Run ``episodes`` official episodes of the run's policy; writes and returns ``RUN_DIR/official.json``
     (or ``out``).  ``start`` / ``reset_noise``: "official" (the environment's own) or "package" (this package's
     rule, module docstring)."""
-    from ..evaluation.evaluator import _torch_threads
-
     t0 = time.time()
     run_dir = Path(run_dir)
-    if out is not None and not Path(out).parent.is_dir():
-        raise SpecrefineError(f"--out {out}: its folder {Path(out).parent} does not exist")
     result = _read_result(run_dir)
+    target = run_dir / OFFICIAL_JSON if out is None else Path(out)
+    what = "--out" if out is not None else "the record"
+    with writing_into(target, what):  # checked before any episode; the run folder's lock held while writing into it
+        output_file(partial_path(target), what)
+        return _run(run_dir, result, episodes, seed, start, reset_noise, target, t0)
+
+
+def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, reset_noise: str, target: Path,
+         t0: float) -> dict:
+    """``run_official``'s episodes and record, once its outputs are checked (and its run folder's lock held)."""
+    from ..evaluation.evaluator import _torch_threads
+
     sim = {f"sim_{key}": result.get(key) for key in ("success_rate", "success_ci", "episodes")}  # the run's own
     sim = sim if None not in sim.values() else dict.fromkeys(sim)  # measurement, whole or not at all
     env = judged_env(run_dir, seed, start=start, reset_noise=reset_noise)
@@ -145,7 +153,7 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
     interrupted = False
     with _torch_threads(1):  # one observation per step: fastest on one thread, and no contention with MuJoCo
         try:
-            for episode in tqdm(range(episodes), desc=f"official {maze.name}", unit="episode", leave=False):
+            for episode in counted(range(episodes), episodes, f"official {maze.name}", "episode", leave=False):
                 ok, outcome = _episode(env, seed if episode == 0 else None)
                 success.append(ok)
                 outcomes[outcome] = outcomes.get(outcome, 0) + 1
@@ -161,7 +169,6 @@ def run_official(run_dir, episodes: int = 200, seed: int = 0, *, start: str = "o
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
                          "clearance": policy.clearance, "start": start, "reset_noise": reset_noise},
             "wall_seconds": time.time() - t0}
-    target = run_dir / OFFICIAL_JSON if out is None else Path(out)
     partial = partial_path(target)
     if interrupted:  # keep the finished episodes beside, never as, the complete record
         write_atomic(partial, json.dumps({**data, "interrupted": True, "episodes_asked": episodes}, indent=2))

@@ -7,6 +7,10 @@ the elapsed time, the phase (search, measurement, calibration), the search's cur
 refreshed every second (what does not fit the terminal's width is cut from the end).  ``tqdm.auto``: a notebook
 gets a widget.  Shown when stderr is a terminal or in a notebook (``enabled=None``); never for ``enabled=False``
 (``specrefine refine --quiet``, sweep cells).
+
+:func:`counted` is the bar of a loop over items (``official``'s episodes, a sweep's cells): tqdm's on a terminal or
+in a notebook; elsewhere (a log file, a pipe) one plain line per ``every`` items, as a log wants it, never the
+carriage-return redraws of a bar.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import math
 import shutil
 import sys
 import threading
+import time
 
 from tqdm.auto import tqdm
 
@@ -32,6 +37,25 @@ def wanted(enabled: bool | None) -> bool:
     if enabled is not None:
         return enabled
     return bool(getattr(sys.stderr, "isatty", lambda: False)()) or _in_notebook()
+
+
+def counted(items, total: int, desc: str, unit: str = "item", every: int | None = None, **tqdm_kw):
+    """``items``, counted on stderr as they go: a tqdm bar where one is shown (:func:`wanted`), else a line such
+    as ``official u_maze: 20/200 episodes (4 s)`` after every ``every`` items (default: a tenth of ``total``) and
+    after the last."""
+    if wanted(None):
+        return tqdm(items, total=total, desc=desc, unit=unit, file=sys.stderr, **tqdm_kw)
+    return _lines(items, total, desc, unit, every or max(1, math.ceil(total / 10)))
+
+
+def _lines(items, total: int, desc: str, unit: str, every: int):
+    t0 = time.time()
+    done = 0
+    for item in items:
+        yield item
+        done += 1
+        if done % every == 0 or done == total:
+            print(f"{desc}: {done}/{total} {unit}s ({time.time() - t0:.0f} s)", file=sys.stderr, flush=True)
 
 
 class RunProgress:

@@ -60,18 +60,17 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from tqdm.auto import tqdm
-
 from ..core.agents import AGENTS
 from ..core.argtypes import OneLineParser, bounded_int, out_path
 from ..core.errors import SpecrefineError, SweepError
 from ..core.paper import PAPER
-from ..core.paths import code_commit
+from ..core.paths import code_commit, regular_file
 from ..core.plugins import loaded
-from ..core.runfolder import replacing, write_atomic
+from ..core.runfolder import open_append, replacing, write_atomic
 from ..core.tables import _NUMBERS, KNOBS, _raw_rows, _typed, read_checked_table, read_table  # noqa: F401 (read here too)
 from .config import DEFAULTS, RunConfig, add_run_options, maze_problem, proposer_arg
 from .methods import METHODS, PROPOSER_METHODS
+from .progress import counted
 
 COLUMNS = [
     "cell", "maze", "agent", "method", "proposer", "proposer_is_vlm", "seed", "status", "error",
@@ -129,7 +128,8 @@ class Cell:
             name = f"{Path(name).stem}-{hashlib.sha256(name.encode()).hexdigest()[:8]}"
         # a standard map 'gr:NAME' -> 'gr-NAME', a shipped folder's 'held_out/x' -> 'held_out-x' (folder names)
         name = name.replace(":", "-").replace("/", "-")
-        task = f"{name}__{spec_slug(self.spec)}" if self.spec else name
+        name, prop = _bounded(name), _bounded(prop)
+        task = f"{name}__{_bounded(spec_slug(self.spec))}" if self.spec else name
         tail = "" if self.evaluation == PAPER.evaluation else f"__{self.evaluation}"  # older ids stay valid
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
                         if getattr(self, knob) != getattr(PAPER, knob))  # the paper's w, d, k: the id they had
@@ -145,6 +145,17 @@ _SETTINGS = frozenset(f.name for f in fields(RunConfig))
 #: the settings a results row records, in the order of the table's columns
 ROW_SETTINGS = ("agent", "method", "proposer", "seed", "rollouts", "episodes", "spec", "evaluation", "policy", "w",
                 "d", "k", "goal_points")
+
+
+ID_PART = 64  # characters of one part of a cell id (maze, spec, proposer): an id stays a file name (255 bytes)
+
+
+def _bounded(part: str) -> str:
+    """A part of a cell id as it is when short (every id so far); a longer one (an 80-branch spec, a long path)
+    cut, and ended with a hash of the whole so that different parts keep different ids."""
+    if len(part) <= ID_PART:
+        return part
+    return f"{part[:ID_PART - 13]}-{hashlib.sha256(part.encode()).hexdigest()[:12]}"
 
 
 def spec_slug(spec: str) -> str:
@@ -247,7 +258,7 @@ def cell_log(path: Path):
     adds to it), not printed."""
     path.parent.mkdir(parents=True, exist_ok=True)
     logger = logging.getLogger("specrefine")
-    handler = logging.FileHandler(path, encoding="utf-8")
+    handler = logging.StreamHandler(open_append(path, "cell's log"))
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     propagate = logger.propagate
     logger.addHandler(handler)
@@ -265,6 +276,7 @@ def cell_log(path: Path):
         logger.removeHandler(handler)
         logger.propagate = propagate
         handler.close()
+        handler.stream.close()
 
 
 def result_row(data: dict, row: dict | None = None) -> dict:
@@ -287,34 +299,21 @@ def is_done(row: dict) -> bool:
 def _drop_cut_row(path: Path) -> None:
     """A last row cut off by a kill (no newline at its end) is removed: it was not done, and ending it instead
     could leave an open quote that would swallow every row after it."""
-    with path.open("rb+") as fh:
+    with os.fdopen(os.open(path, os.O_RDWR | os.O_NOFOLLOW), "rb+") as fh:
         data = fh.read()
         if data and not data.endswith(b"\n"):
             fh.truncate(data.rfind(b"\n") + 1)
 
 
 def _append(path: Path, row: dict) -> None:
-    new = not path.exists() or path.stat().st_size == 0
-    columns = COLUMNS
-    if not new:  # an older table (without the later columns, e.g. spec) keeps its own header
-        with path.open(newline="") as fh:
-            columns = next(csv.reader(fh), None) or COLUMNS
-        if row.get("spec") and "spec" not in columns:
-            raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
-        if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
-            raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
-        if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
-            raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
-        if any(row.get(knob, getattr(PAPER, knob)) != getattr(PAPER, knob) for knob in KNOBS) \
-                and "w" not in columns:
-            raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
-        if row.get("goal_points", PAPER.goal_points) != PAPER.goal_points and "goal_points" not in columns:
-            raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
+    new = not os.path.lexists(path) or os.lstat(path).st_size == 0
+    columns = COLUMNS if new else _header(path)  # an older table (without later columns) keeps its own header
     if not new:
+        _check_fits(path, columns, row)
         _drop_cut_row(path)
         if missing := [c for c in PROVENANCE if c not in columns]:
             columns = _add_columns(path, columns, missing)
-    with path.open("a", newline="") as fh:
+    with open_append(path, "results table") as fh:  # a link or a FIFO is refused, never written through
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new:
             writer.writeheader()
@@ -322,6 +321,42 @@ def _append(path: Path, row: dict) -> None:
                          for k in columns})  # one line per row: a cut row is then always the last line
         fh.flush()
         os.fsync(fh.fileno())
+
+
+def _header(path: Path) -> list[str]:
+    with regular_file(path, "results table").open(newline="") as fh:
+        return next(csv.reader(fh), None) or COLUMNS
+
+
+def _check_fits(path: Path, columns: list[str], row: dict) -> None:
+    """A row whose values an older table has no column for is refused (it would be read back as another cell)."""
+    if row.get("spec") and "spec" not in columns:
+        raise ValueError(f"{path} has no 'spec' column: write cells with a spec to another table")
+    if row.get("evaluation", "fixed") != "fixed" and "evaluation" not in columns:
+        raise ValueError(f"{path} has no 'evaluation' column: write adaptive cells to another table")
+    if row.get("policy", "shipped") != "shipped" and "policy" not in columns:
+        raise ValueError(f"{path} has no 'policy' column: write cells with another policy to another table")
+    if any(row.get(knob, getattr(PAPER, knob)) != getattr(PAPER, knob) for knob in KNOBS) and "w" not in columns:
+        raise ValueError(f"{path} has no 'w', 'd', 'k' columns: write cells with other w, d or k to another table")
+    if row.get("goal_points", PAPER.goal_points) != PAPER.goal_points and "goal_points" not in columns:
+        raise ValueError(f"{path} has no 'goal_points' column: write cells aiming at centres to another table")
+
+
+def check_table(table: Path, cells: list[Cell]) -> None:
+    """Before any cell runs: a table the sweep can append ``cells``' rows to (a regular file it can write, with the
+    sweep's header and the columns those rows need), or none yet; else a one-line SweepError."""
+    if not os.path.lexists(table):
+        return
+    open_append(table, "results table").close()  # a link, read-only: refused now, not after the first cell
+    columns = _raw_rows(table)[0]  # a FIFO, a folder, a device, bytes that are not a table: one line
+    if columns and not {"cell", "status"} <= set(columns):
+        raise SweepError(f"{table}: not a sweep's results table (its header has no 'cell' and 'status' columns): "
+                         f"use another --out")
+    for cell in cells if columns else []:
+        try:
+            _check_fits(table, columns, cell.row())
+        except ValueError as exc:
+            raise SweepError(str(exc)) from None
 
 
 def _add_columns(path: Path, columns: list[str], missing: list[str]) -> list[str]:
@@ -368,7 +403,7 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
     """Refuse cells whose id ``OUT`` already holds with other ``PARAMS`` (``OUT/sweep.json``, or for older
     tables the rows' ``rollouts_per_evaluation``); record the new cells' parameters."""
     record = out_root / "sweep.json"
-    known = json.loads(record.read_text())["cells"] if record.exists() else {}
+    known = _recorded_cells(record) if os.path.lexists(record) else {}
     for row in read_table(out_root / "results.csv"):
         if row.get("cell") not in known and isinstance(row.get("rollouts_per_evaluation"), float):
             known[row["cell"]] = {"rollouts": int(row["rollouts_per_evaluation"])}
@@ -382,16 +417,33 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
     write_atomic(record, json.dumps({"cells": known}, indent=1, sort_keys=True))
 
 
+def _recorded_cells(record: Path) -> dict:
+    """``sweep.json``'s cells ({cell id: {param: value}}), or a one-line SweepError."""
+    try:
+        cells = json.loads(regular_file(record, "sweep record").read_text(encoding="utf-8")).get("cells")
+    except SpecrefineError as exc:
+        raise SweepError(str(exc)) from None
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as exc:
+        raise SweepError(f"{record}: not a sweep record ({type(exc).__name__}): remove it to start over, or use "
+                         f"another --out") from None
+    if not isinstance(cells, dict) or not all(isinstance(v, dict) for v in cells.values()):
+        raise SweepError(f"{record}: not a sweep record ('cells' is not a mapping of cell ids to their settings): "
+                         f"remove it to start over, or use another --out")
+    return cells
+
+
 def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: int | None = None,
               address: str | None = None, retries: int = 1) -> Path:
     """Run every pending cell, appending rows to OUT/results.csv; returns the table's path.
 
-    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters.
+    Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters, or its
+    ``sweep.json`` or ``results.csv`` cannot be read back or written (``check_table``).
     """
     from ..core.runfolder import ensure_dir
 
     out_root = ensure_dir(out_root)
     table = out_root / "results.csv"
+    check_table(table, cells)
     check_params(cells, out_root)
     try:
         for attempt in range(retries + 1):
@@ -400,8 +452,8 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
                 break
             runner = _run_ray if backend == "ray" else _run_local
             where = (str(out_root), *([tuple(loaded())] if loaded() else []))  # run_cell's arguments after the cell
-            for row in tqdm(runner(todo, where, workers, address), total=len(todo),
-                            desc=f"sweep ({backend}, try {attempt + 1})"):
+            for row in counted(runner(todo, where, workers, address), len(todo),
+                               f"sweep ({backend}, try {attempt + 1})", "cell", every=1):
                 _append(table, row)
     finally:
         compact(table)

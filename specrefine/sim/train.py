@@ -34,6 +34,7 @@ from tqdm.auto import tqdm
 from ..core.agents import AGENTS, get_agent
 from ..core.argtypes import bounded_int, out_path
 from ..core.errors import SpecrefineError
+from ..core.runfolder import open_append
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
@@ -260,11 +261,12 @@ class Trainer:
                 from None
 
     def save_checkpoint(self) -> None:
-        tmp = self.out / "checkpoint.pt.tmp"
-        torch.save({"config": asdict(self.cfg), "loss": self.loss.state_dict(), "optim": self.optim.state_dict(),
-                    "frames": self.frames, "iteration": self.iteration, "wall": self.wall,
-                    "torch_rng": torch.get_rng_state()}, tmp)
-        tmp.replace(self.out / "checkpoint.pt")
+        from ..core.runfolder import replacing
+
+        with replacing(self.out / "checkpoint.pt", "wb") as fh:  # whole, and never through a link
+            torch.save({"config": asdict(self.cfg), "loss": self.loss.state_dict(), "optim": self.optim.state_dict(),
+                        "frames": self.frames, "iteration": self.iteration, "wall": self.wall,
+                        "torch_rng": torch.get_rng_state()}, fh)
         save_policy(self.policy, self.out / "policy.pt", {"frames": self.frames, "config": asdict(self.cfg)})
         plot_curve(self.out / "log.jsonl", self.out / "curve.png")
 
@@ -319,7 +321,7 @@ class Trainer:
         bar = tqdm(total=cfg.frames, initial=min(self.frames, cfg.frames), unit="frames",
                    disable=not self.progress, dynamic_ncols=True)
         last_ck = time.time()
-        log = (self.out / "log.jsonl").open("a")
+        log = open_append(self.out / "log.jsonl", "training log")  # never through a link
         t_batch = time.time()
         for batch in self.collector:
             if self.frames >= cfg.frames:

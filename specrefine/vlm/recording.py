@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ..core.errors import ReplayMiss, SpecrefineError, VLMConfigError
 from ..core.paths import data_dir, regular_file
+from ..core.runfolder import open_append, write_atomic, write_error
 from .messages import (
     MAX_REPLY_CHARS,
     TOO_LONG,
@@ -63,8 +64,8 @@ class Recorder:
             return url
         self.image_dir.mkdir(parents=True, exist_ok=True)
         target = self.image_dir / f"{digest.split(':', 1)[1]}.png"
-        if not target.exists():
-            target.write_bytes(base64.b64decode(url.split(";base64,", 1)[1]))
+        if not target.is_file() or target.is_symlink():  # a link is replaced, never written through
+            write_atomic(target, base64.b64decode(url.split(";base64,", 1)[1]))
         return digest
 
     def write(self, record: dict, messages: list[dict]) -> None:
@@ -75,8 +76,12 @@ class Recorder:
         # belt and braces: no long secret survives, whatever field it hid in (short ones could match JSON syntax)
         line = scrub_text(line, secrets, long_only=True)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        with self.path.open("a", encoding="utf-8") as fh:
-            fh.write(line + "\n")
+        with open_append(self.path, "recording") as fh:  # a link or a FIFO is refused, never written through
+            try:
+                fh.write(line + "\n")
+                fh.flush()
+            except OSError as exc:  # a full disk: one line, not a traceback
+                raise write_error(self.path, exc) from None
 
 
 def _parse_record(line: bytes) -> dict | None:
