@@ -18,7 +18,7 @@ from specrefine.runs.methods import METHODS
 
 ROOT = Path(__file__).resolve().parent.parent
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
-EXTRAS = ("litellm", "ray", "papermill", "jupyterlab", "ipywidgets", "nbformat", "playwright")
+EXTRAS = ("litellm", "ray", "papermill", "jupyterlab", "ipywidgets", "ipykernel", "nbformat", "playwright")
 TINY = ["--rollouts", "8", "--episodes", "10", "-w", "1", "-d", "1", "-k", "1"]
 
 
@@ -97,6 +97,12 @@ def test_a_base_install_refines_and_a_missing_extra_is_one_line(tmp_path):
                   "--proposer", "litellm:gpt-4o", "--out", str(tmp_path / "vlm"))
     lines = vlm.stderr.strip().splitlines()
     assert vlm.returncode == 2 and len(lines) == 1 and "pip install 'specrefine[vlm]'" in lines[0], vlm.stderr
+    for extra, argv in (("ray", ["sweep", "--mazes", "u_maze", "--methods", "dirl", "--seeds", "0", "--backend",
+                                 "ray", "--out", str(tmp_path / "sweep")]),
+                        ("notebooks", ["notebook", "executed", "05", "--out", str(tmp_path / "nb")])):
+        done = _python("-c", block + "sys.exit(main(sys.argv[1:]))", *argv)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2 and len(lines) == 1 and f"'specrefine[{extra}]'" in lines[0], done.stderr
 
 
 def test_py_typed_ships_with_the_package():

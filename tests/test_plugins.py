@@ -131,3 +131,16 @@ def test_the_base_class_counts_queries_and_make_proposer_names_them():
         assert proposer.queries == 2 and proposer.describe()["proposer_calls"] == 2
     finally:
         del PROPOSERS["quiet-example"]
+
+
+def test_a_fresh_worker_loads_the_sweeps_plugins_before_its_cell(tmp_path):
+    """A Ray worker is a fresh process: run_cell gets the sweep's --plugin modules and loads them itself."""
+    code = ("import sys; from specrefine.runs.sweep import Cell, run_cell; "
+            "cell = Cell.of('split_doorway', 'point', 'ours-greedy', 'straight', 0, rollouts=8, episodes=10, w=1, d=1,"
+            " k=1); "
+            f"row = run_cell(cell, {str(tmp_path)!r}, ({str(PLUGIN)!r},)); "
+            "print(row['status'], row['method'], row['proposer'], row.get('error', ''))")
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split()[:3] == ["ok", "ours-greedy", "straight"], done.stdout

@@ -8,8 +8,7 @@ run through it (:func:`run_command`) without importing a layer above its own; co
 :data:`COMMANDS` names each command's module, which has ``add_arguments(parser)`` and ``run(args, parser) -> int``:
 a new command is one entry there. Only the chosen command's module is imported (``train`` imports PyTorch, the
 others need not), and plugins (:mod:`specrefine.core.plugins`: entry points and ``--plugin MODULE``) are loaded before
-any parser is built, so ``--method`` and ``--proposer`` accept the names they register. The older
-``python -m specrefine.<module>`` paths run the same code (:func:`run_command`).
+any parser is built, so ``--method`` and ``--proposer`` accept the names they register.
 
 Bad input exits 2 with one line on stderr; never a traceback. Ctrl-C exits 130.
 """
@@ -49,6 +48,7 @@ COMMANDS: dict[str, Command] = {
     "notebook": Command("specrefine.runs.notebook", "executed copies of the numbered notebooks"),
     "show": Command("specrefine.runs.show", "a finished run at a glance: summary, path leg by leg, time, pictures"),
 }
+
 
 def _module(name: str):
     return importlib.import_module(COMMANDS[name].module)

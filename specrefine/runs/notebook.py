@@ -343,7 +343,7 @@ def main(argv=None) -> int:
 def run(args, p) -> int:
     from ..core.extras import require
 
-    for module in ("papermill", "nbformat", "jupyterlab"):
+    for module in ("papermill", "nbformat", "ipykernel"):  # what executing a notebook needs
         require(module, "notebooks", "specrefine notebook")
     return write_executed(args.notebooks, args.tier, args.out)
 

@@ -242,10 +242,13 @@ def run_cell(cell: Cell, out_root: str, plugins: tuple[str, ...] = ()) -> dict:
     from ..core.plugins import load_plugins
     from .pipeline import refine_maze
 
+    try:
+        load_plugins(plugins)  # before the row: a plugin's method names its proposer only once registered
+    except SpecrefineError as exc:
+        return {**cell.row(), "commit": code_commit(), "status": "error", "error": str(exc)[:300]}
     row = {**cell.row(), "commit": code_commit()}  # a failed cell's row names its code too
     out = Path(out_root) / "cells" / cell.id
     try:
-        load_plugins(plugins)
         with cell_log(out / "log.txt"):
             result = refine_maze(cell.maze, cell.config, out=out, progress=False)  # the sweep has its own bar
     except Exception as exc:  # noqa: BLE001 - a sweep records every failure and goes on
@@ -692,6 +695,10 @@ def run(args, parser) -> int:
                                   f"maze ({len(cells_of(args))} cells with these options)", 2)
     if args.mazes is not None and args.all:
         return _fail(parser.prog, "--mazes and --all: give one of them", 2)
+    if args.backend == "ray":  # before any work: a missing extra is one line, not a failed sweep
+        from ..core.extras import require
+
+        require("ray", "ray", "--backend ray")
     cells = cells_of(args)
     bad = maze_problem(args.mazes or []) or _check_specs(cells) or _check_policy(cells)
     if bad:
