@@ -357,7 +357,7 @@ GRIDS = {g.name: g for g in (
         "point", parts=(Part(("ours-deeprepair", "ours-feasible", "ours-checked"),
                              ("imperfect:mild", "imperfect:moderate"), split="proposers"),),
         seeds=(0, 1, 2, 3), mazes=("u_chain_3", "u_chain_3_subgoals", "u_chain_5", "u_chain_5_subgoals"), workers=1,
-        code="LEVERS", table="data/results/corrector/levers.csv", out="runs/corrector_levers"),
+        code="722e118", table="data/results/corrector/levers.csv", out="runs/corrector_levers"),
     ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
