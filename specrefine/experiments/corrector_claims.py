@@ -317,7 +317,8 @@ def run(args, p) -> int:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
         args.out.mkdir(parents=True, exist_ok=True)
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out))
-        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant)}
+        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant),
+                  "front": front(point, held_out)}
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
@@ -325,6 +326,40 @@ def run(args, p) -> int:
         return 2
     print(f"-> {args.out}/claims.md")
     return 0
+
+
+def front(point: dict, held_out: dict | None) -> dict[str, str]:
+    """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
+    out = {}
+    for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
+        level = proposer.split(":")[1]
+        mazes = [e for e in point["per_maze"] + point["severe"] if e["proposer"] == proposer]
+        within = sum(1 for e in mazes if e["success"] >= e["reference_success"] - TOLERANCE)
+        rooms = next((e for e in point["rooms"] if e["proposer"] == proposer and e["method"] == METHOD), None)
+        zero = next(z for z in point["zero"] if z["proposer"] == proposer)
+        curve = [f"{k / n:.3f}" for k, n, _ in point["curves"][proposer]["/".join((METHOD, "*"))] if n]
+        text = (f"1-5 rooms {', '.join(curve)}; within {TOLERANCE} of the oracle on {within} of {len(mazes)} "
+                f"U-chains")
+        if rooms is not None:
+            text += f", {cmp._interval_text(rooms)} ({rooms['verdict']})"
+        text += (f"; runs at 0: {zero[METHOD][0]} of {zero[METHOD][1]} (ours {zero['ours'][0]} of "
+                 f"{zero['ours'][1]}, ours-repair {zero['ours-repair'][0]} of {zero['ours-repair'][1]})")
+        out[level] = text
+    ratios = [e for e in point["ratio"] if e["method"].startswith(METHOD)]
+    out["ratio"] = "; ".join(f"{e['proposer'].split(':')[1]} {cmp._interval_text(e)} ({e['verdict']})"
+                             for e in ratios)
+    out["cost"] = "; ".join(f"{c['proposer'].split(':')[1]} {_num(c['evaluations_ratio'], '{:.1f}x')} the "
+                            f"evaluations, {_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls, "
+                            f"{_num(c['sim_steps_ratio'], '{:.1f}x')} the simulator steps" for c in point["costs"])
+    if held_out:
+        done = [e for e in held_out["per_maze"] if e["runs"]]
+        lo = min(e["success"] for e in done)
+        hi = max(e["success"] for e in done)
+        lo_o, hi_o = min(e["reference_success"] for e in done), max(e["reference_success"] for e in done)
+        out["held-out"] = (f"ours-corrector {lo:.3f}-{hi:.3f} per layout and mix where ours gives {lo_o:.3f}-"
+                           f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
+                           f"{held_out['zero']['ours']} of {held_out['runs']}")
+    return out
 
 
 def rooms_figure(point: dict):
