@@ -109,3 +109,13 @@ def test_docs_choices_lists_every_departure_the_code_makes():
                 shown_best, shown_paper = listed[name, flag]
                 assert f"`{getattr(best, field)}`" in shown_best and f"`{getattr(paper, field)}`" in shown_paper
     assert any(agent == "point" and "the paper's rules" in best for agent, _, best, _, _ in rows)
+
+
+def test_every_run_setting_reaches_a_sweep_cell():
+    """Each RunConfig field is a sweep option (or axis), so a new setting needs no sweep code to reach its cells."""
+    from dataclasses import fields
+
+    dests = {action.dest for action in sweep.parser()._actions}
+    axes = {"method": "methods", "proposer": "proposers", "seed": "seeds", "spec": "specs"}
+    assert [f.name for f in fields(RunConfig) if axes.get(f.name, f.name) not in dests] == []
+    assert sweep.OTHER_SETTINGS == ()  # today every setting has its place in the id, or is checked by sweep.json
