@@ -105,3 +105,29 @@ def test_the_held_out_grid_is_described_per_maze_and_mix(tmp_path):
     first = study["per_maze"][0]
     assert first["mix"] == "A" and first["difference"] == pytest.approx(0.95) and first["oracle"] == 0.99
     assert study["costs"][0]["evaluations_ratio"] == pytest.approx(1.0)
+
+
+def test_readme_corrector_sentences_are_the_shipped_tables():
+    """README's '<!-- front corrector NAME -->' texts, recomputed from the shipped tables; the success curves once
+    more with the csv module alone (pooled successes over pooled episodes)."""
+    import csv
+    import re
+
+    from specrefine.experiments.grids import ROOT
+
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
+    assert {"mild", "moderate", "ratio", "held-out", "cost"} <= set(marked)
+    expected = cc.front(cc.point_study(), cc.held_out_study())
+    for name, text in marked.items():
+        assert " ".join(text.split()) == " ".join(expected[name].split()), name
+    rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
+    for level in ("mild", "moderate"):
+        curve = []
+        for n in range(1, 6):
+            mine = [r for r in rows if r["maze"] == f"u_chain_{n}" and r["method"] == cc.METHOD
+                    and r["proposer"] == f"imperfect:{level}" and r["status"] == "ok"]
+            if mine:
+                k = sum(round(float(r["success_rate"]) * int(r["episodes"])) for r in mine)
+                curve.append(f"{k / sum(int(r['episodes']) for r in mine):.3f}")
+        assert marked[level].startswith(f"1-5 rooms {', '.join(curve)};")

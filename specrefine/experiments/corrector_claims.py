@@ -317,7 +317,8 @@ def run(args, p) -> int:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
         args.out.mkdir(parents=True, exist_ok=True)
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out))
-        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant)}
+        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant),
+                  "front": front(point, held_out)}
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
@@ -325,6 +326,62 @@ def run(args, p) -> int:
         return 2
     print(f"-> {args.out}/claims.md")
     return 0
+
+
+def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
+    """(cells done in the shipped tables, cells) of grid ``name``."""
+    from .grids import status
+
+    done = [(d, total) for _, d, total, _ in status(GRIDS[name], root)]
+    return sum(d for d, _ in done), sum(t for _, t in done)
+
+
+def front(point: dict, held_out: dict | None, root: Path = ROOT) -> dict[str, str]:
+    """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
+    counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector")}
+    out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
+                     + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
+    for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
+        level = proposer.split(":")[1]
+        mazes = [e for e in point["per_maze"] + point["severe"] if e["proposer"] == proposer]
+        ran = [e for e in mazes if e["runs"]]
+        if not ran:
+            out[level] = "not run yet"
+            continue
+        within = sum(1 for e in ran if e["success"] >= e["reference_success"] - TOLERANCE)
+        rooms = next((e for e in point["rooms"] if e["proposer"] == proposer and e["method"] == METHOD), None)
+        zero = next(z for z in point["zero"] if z["proposer"] == proposer)
+        curve = [f"{k / n:.3f}" for k, n, _ in point["curves"][proposer]["/".join((METHOD, "*"))] if n]
+        text = (f"1-5 rooms {', '.join(curve)}; within {TOLERANCE} of the oracle on {within} of {len(ran)} "
+                f"U-chains" + ("" if len(ran) == len(mazes) else f" run so far (of {len(mazes)})"))
+        if rooms is not None:
+            text += f", {cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)})"
+        text += (f"; runs at 0: {zero[METHOD][0]} of {zero[METHOD][1]} (ours {zero['ours'][0]} of "
+                 f"{zero['ours'][1]}, ours-repair {zero['ours-repair'][0]} of {zero['ours-repair'][1]})")
+        out[level] = text
+    ratios = [e for e in point["ratio"] if e["method"].startswith(METHOD)]
+    out["ratio"] = "; ".join(f"{e['proposer'].split(':')[1]} {cmp._interval_text(e)} ({e['verdict']}{_partial(e)})"
+                             for e in ratios)
+    out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
+    if held_out:
+        done = [e for e in held_out["per_maze"] if e["runs"]]
+        lo = min(e["success"] for e in done)
+        hi = max(e["success"] for e in done)
+        lo_o, hi_o = min(e["reference_success"] for e in done), max(e["reference_success"] for e in done)
+        out["held-out"] = (f"ours-corrector {lo:.3f}-{hi:.3f} per layout and mix where ours gives {lo_o:.3f}-"
+                           f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
+                           f"{held_out['zero']['ours']} of {held_out['runs']}")
+    return out
+
+
+def _cost_text(c: dict) -> str:
+    return (f"{c['proposer'].split(':')[1]} ({c['pairs']} pairs) {_num(c['evaluations_ratio'], '{:.1f}x')} the "
+            f"evaluations, {_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls, "
+            f"{_num(c['sim_steps_ratio'], '{:.1f}x')} the simulator steps")
+
+
+def _partial(entry: dict) -> str:
+    return "" if entry["complete"] else f", partial: {entry['n_cells']} of {entry['n_expected']} cells"
 
 
 def rooms_figure(point: dict):

@@ -353,6 +353,12 @@ GRIDS = {g.name: g for g in (
         seeds=(0, 1), mazes=HELD_OUT_MAZES, workers=1, code="5356175",
         table="data/results/corrector/held_out.csv", out="runs/corrector_held_out"),
     ExperimentGrid(
+        "corrector-levers", "docs/corrector.md, 'Each lever alone' (issue 39; fixed 2026-11-27 before it ran)",
+        "point", parts=(Part(("ours-deeprepair", "ours-feasible", "ours-checked"),
+                             ("imperfect:mild", "imperfect:moderate"), split="proposers"),),
+        seeds=(0, 1, 2, 3), mazes=("u_chain_3", "u_chain_3_subgoals", "u_chain_5", "u_chain_5_subgoals"), workers=1,
+        code="722e118", table="data/results/corrector/levers.csv", out="runs/corrector_levers"),
+    ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
         mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",

@@ -201,6 +201,16 @@ register_method("ours-corrector", ours_variant(repair=True, repair_depth=3, dead
                 "edge, then the found path's legs estimated again on 4x fresh rollouts and its weak legs split, "
                 "split over or bypassed while the path gains (refine/correct.py)",
                 colour="#c62828")
+register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
+                "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
+                "three levels", colour="#8e24aa")
+register_method("ours-feasible", ours_variant(dead_weight=100.0),
+                "lever of ours-corrector alone: ours with a never-succeeding leg weighing 100, so that any chain that "
+                "succeeds at all beats a dead edge", colour="#d81b60")
+register_method("ours-checked", ours_variant(correct_rollouts=4, correct_reach="policy"),
+                "lever of ours-corrector alone: ours, then the found path checked on 4x fresh rollouts per leg and "
+                "its weak legs split, split over or bypassed while the path gains (refine/correct.py)",
+                colour="#ef5350")
 register_method("vlm-oneshot", vlm_oneshot,
                 "baseline: whole-graph refinement in one query + one feedback round, best of 2 x w",
                 colour="#ef6c00", knobs=("w", "d"))
