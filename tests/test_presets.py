@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -31,7 +32,7 @@ def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules(
     assert (paper.evaluation, paper.goal_points, paper.policy) == ("fixed", "sampled", "ant_stage5")
     assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
     point = resolved()
-    assert point == resolved("--preset", "paper").__class__(**{**point.to_dict(), "preset": "best"})
+    assert replace(resolved("--preset", "paper"), preset="best") == point  # the point mass: the same settings
     assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "sampled", "shipped")
     explicit = resolved("--agent", "ant", "--preset", "paper", "--goal-points", "centre", "--policy", "shipped")
     assert (explicit.goal_points, explicit.policy, explicit.evaluation) == ("centre", "shipped", "fixed")
@@ -109,3 +110,13 @@ def test_docs_choices_lists_every_departure_the_code_makes():
                 shown_best, shown_paper = listed[name, flag]
                 assert f"`{getattr(best, field)}`" in shown_best and f"`{getattr(paper, field)}`" in shown_paper
     assert any(agent == "point" and "the paper's rules" in best for agent, _, best, _, _ in rows)
+
+
+def test_every_run_setting_reaches_a_sweep_cell():
+    """Each RunConfig field is a sweep option (or axis), so a new setting needs no sweep code to reach its cells."""
+    from dataclasses import fields
+
+    dests = {action.dest for action in sweep.parser()._actions}
+    axes = {"method": "methods", "proposer": "proposers", "seed": "seeds", "spec": "specs"}
+    assert [f.name for f in fields(RunConfig) if axes.get(f.name, f.name) not in dests] == []
+    assert sweep.OTHER_SETTINGS == ()  # today every setting has its place in the id, or is checked by sweep.json

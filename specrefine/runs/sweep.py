@@ -132,6 +132,8 @@ class Cell:
         tail += "".join(f"__{knob}{getattr(self, knob)}" for knob in KNOBS
                         if getattr(self, knob) != getattr(PAPER, knob))  # the paper's w, d, k: the id they had
         tail += "" if self.goal_points == PAPER.goal_points else f"__{self.goal_points}"
+        tail += "".join(f"__{name}-{getattr(self, name)}" for name in OTHER_SETTINGS  # a later setting, when set
+                        if getattr(self, name) != getattr(DEFAULTS_RESOLVED[self.agent], name))
         whole = self._id(name, spec_slug(self.spec), prop, tail)
         if len(whole.encode()) <= ID_LIMIT:  # every id a shipped table holds
             return whole
@@ -147,6 +149,12 @@ class Cell:
 
 
 _SETTINGS = frozenset(f.name for f in fields(RunConfig))
+#: in the cell id: the agent, method, proposer, seed and spec, then evaluation, w, d, k, goal_points as they always
+#: were; not in it: what OUT/sweep.json checks (PARAMS) and the preset (what it decides is); any other setting a
+#: RunConfig gains is named in the id whenever it differs from its default, with no change here
+OTHER_SETTINGS = tuple(sorted(_SETTINGS - {"agent", "method", "proposer", "seed", "spec", "evaluation", *KNOBS,
+                                          "goal_points", "rollouts", "episodes", "policy", "preset"}))
+DEFAULTS_RESOLVED = {name: RunConfig(agent=name).resolved() for name in AGENTS}
 #: the settings a results row records, in the order of the table's columns
 ROW_SETTINGS = ("agent", "method", "proposer", "seed", "rollouts", "episodes", "spec", "evaluation", "policy", "w",
                 "d", "k", "goal_points")
@@ -199,7 +207,7 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
          agent: str = "point", rollouts: int = DEFAULTS.rollouts, episodes: int = DEFAULTS.episodes,
          specs: Iterable[str | None] = (None,), evaluation: str | None = None, policy: str | None = None,
          w: Iterable[int] = (DEFAULTS.w,), d: Iterable[int] = (DEFAULTS.d,), k: Iterable[int] = (DEFAULTS.k,),
-         goal_points: str | None = None, preset: str = DEFAULTS.preset) -> list[Cell]:
+         goal_points: str | None = None, preset: str = DEFAULTS.preset, **settings) -> list[Cell]:
     """All cells; methods without a proposer (dirl, symbolic) appear once per seed, not once per proposer.
 
     ``w``, ``d``, ``k``: the values of each search setting; a method gets one cell per combination of the settings
@@ -209,11 +217,11 @@ def grid(mazes: Iterable[str], methods: Iterable[str], proposers: Iterable[str],
     (:meth:`RunConfig.resolved`).
 
     ``specs``: task expressions run on every maze (None or "" = the maze's own task); a maze given as
-    ``MAZE=SPEC`` runs that spec only.
+    ``MAZE=SPEC`` runs that spec only. ``settings``: any other RunConfig field, for every cell.
     """
     axes = {"w": list(w), "d": list(d), "k": list(k)}
     common = dict(rollouts=rollouts, episodes=episodes, evaluation=evaluation, policy=policy, goal_points=goal_points,
-                  preset=preset)
+                  preset=preset, **settings)
     cells = []
     for arg in mazes:
         maze, own = split_maze_arg(str(arg))
@@ -647,7 +655,7 @@ def add_arguments(p) -> None:
     p.add_argument("--agent", default="point", choices=list(AGENTS), help="the agent of every cell")
     add_run_options(p, ["rollouts", "episodes"], suffix=" of every cell")
     add_run_options(p, ["goal_points"], suffix=" (every cell; named in the cell id when not sampled)")
-    add_run_options(p, ["preset"], suffix=" (every cell)")
+    add_run_options(p, ["preset", *OTHER_SETTINGS], suffix=" (every cell)")
     add_run_options(p, KNOBS, many=KNOBS, suffix="; several values: one cell each (a method gets the values of those "
                                                "of w, d, k it reads)")
     p.add_argument("--evaluation", choices=["fixed", "adaptive"], default=None,
@@ -673,7 +681,8 @@ def cells_of(args) -> list[Cell]:
     mazes = args.mazes if args.mazes is not None else sorted(benchmark_mazes())
     return grid(mazes, args.methods, args.proposers, args.seeds, agent=args.agent, rollouts=args.rollouts,
                 episodes=args.episodes, specs=args.specs, evaluation=args.evaluation, w=args.w, d=args.d, k=args.k,
-                goal_points=args.goal_points, preset=args.preset, policy=_policy_ref(args.policy))
+                goal_points=args.goal_points, preset=args.preset, policy=_policy_ref(args.policy),
+                **{name: getattr(args, name) for name in OTHER_SETTINGS})
 
 
 def _policy_ref(policy: str | None) -> str | None:
