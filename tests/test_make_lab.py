@@ -20,7 +20,8 @@ pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="no make")
 
 def lab_command(*assignments: str) -> list[str]:
     """The `jupyter lab` command line `make lab` runs (a dry run: nothing is started or installed)."""
-    dry = subprocess.run(["make", "-n", "lab", *assignments], cwd=ROOT, capture_output=True, text=True, check=True)
+    dry = subprocess.run(["make", "--no-print-directory", "-n", "lab", *assignments], cwd=ROOT, capture_output=True,
+                         text=True, check=True)  # a sub-make (the suite run by `make test`) prints no directory lines
     line = dry.stdout.replace("\\\n", " ").splitlines()[-1]
     assert "jupyter lab" in line, dry.stdout
     return shlex.split(line)
