@@ -223,9 +223,11 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                     "verdict": _cost_verdict(c)})
     if ant:
         complete = all(e["runs"] == len(ANT_SEEDS) for e in ant["per_maze"])
-        low = [e["maze"] for e in ant["per_maze"] if not e["success"] >= ANT_FLOOR]
+        ran = [e for e in ant["per_maze"] if e["runs"]]
+        low = [e["maze"] for e in ran if e["success"] < ANT_FLOOR]
         out.append({"rule": f"Ant, imperfect:moderate: at least {ANT_FLOOR} on every maze",
-                    "value": f"below on {len(low)} of {len(ant['per_maze'])}", "verdict": _verdict(not low, complete)})
+                    "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of {len(ant['per_maze'])})"
+                    + (f": {', '.join(low)}" if low else ""), "verdict": _verdict(not low, complete)})
         ratio = ant["ratio"][0]
         out.append({"rule": f"Ant: {METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                     "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
