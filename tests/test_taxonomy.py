@@ -38,6 +38,8 @@ def sweep(tmp_path):
               steps=[{"event": "split-generated", "edge": ["S", "G"], "candidates": []}, done()])
     write_run(cells / "lucky", success=0.80, estimates=[1.0, 1.0], measured=[1.0, 0.80], steps=[done()])
     write_run(cells / "weak", success=0.80, estimates=[0.9, 0.9], measured=[0.9, 0.89], steps=[done()])
+    write_run(cells / "unstarted", success=0.0, estimates=[1.0, 1.0, 1.0], measured=[1.0, 0.0, None],
+              steps=[done()])  # no episode started the last leg: its measured success is null
     write_run(cells / "fine", success=0.99, estimates=[1.0], measured=[0.99], steps=[done()])
     (cells / "unfinished").mkdir()
     (tmp_path / "oracle.csv").write_text("maze,method,proposer,status,success_rate\n"
@@ -47,12 +49,13 @@ def sweep(tmp_path):
 
 def test_each_run_below_the_oracle_gets_its_first_cause(sweep):
     runs = read_runs([sweep / "sweep"])
-    assert len(runs) == 7  # the unfinished folder is not a run
+    assert len(runs) == 8  # the unfinished folder is not a run
     rows = {r["cell"]: r for r in classify(runs, {"u_chain_3": 0.995})}
     assert "fine" not in rows  # within 0.05 of the oracle
     assert {cell: r["cause"] for cell, r in rows.items()} == {
         "declined": "split-declined-dead-legs", "gave_up": "repair-gave-up", "budget": "budget-spent",
-        "nothing": "no-split-offered", "lucky": "estimate-refuted", "weak": "weak-legs-accepted"}
+        "nothing": "no-split-offered", "lucky": "estimate-refuted", "weak": "weak-legs-accepted",
+        "unstarted": "estimate-refuted"}
     assert rows["budget"]["flags"] == "budget-spent split-declined-dead-legs"
     assert rows["lucky"]["refuted_legs"] == 1 and rows["weak"]["refuted_legs"] == 0
     assert set(r["cause"] for r in rows.values()) == set(CAUSES)
@@ -64,9 +67,9 @@ def test_the_command_writes_the_table_and_the_summary(sweep):
                            "--oracle", str(sweep / "oracle.csv"), "--out", str(out)], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     rows = list(csv.DictReader((out / "taxonomy.csv").open()))
-    assert len(rows) == 6 and {r["cause"] for r in rows} == set(CAUSES)
+    assert len(rows) == 7 and {r["cause"] for r in rows} == set(CAUSES)
     md = (out / "taxonomy.md").read_text()
-    assert "| ours | imperfect:mild | 6 | 5 | 1 | 0 | 1 | 1 | 1 | 1 |" in md
+    assert "| ours | imperfect:mild | 7 | 6 | 1 | 0 | 1 | 1 | 2 | 1 |" in md
 
 
 def test_a_missing_oracle_is_one_line(sweep, tmp_path):

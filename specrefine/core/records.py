@@ -252,7 +252,8 @@ RESULT_FIELDS: dict[str, Check] = {
     "maze": text, "agent": agent, "method": text, "proposer": optional(text), "seed": count, "episodes": count,
     "success_rate": probability, "success_ci": interval, "path_success_rate": probability,
     "predicted_success": probability, "search_estimate": probability, "predicted_ci": interval,
-    "predicted_p_ci": interval, "edge_probabilities": list_of(probability), "leg_success": list_of(probability),
+    "predicted_p_ci": interval, "edge_probabilities": list_of(probability),
+    "leg_success": list_of(optional(probability)),  # null: a leg no episode started
     "episode_outcomes": counts, "rollouts_per_evaluation": number(1, whole=True), "path": list_of(text),
     "graph": task_graph, "input_graph": task_graph, "config": mapping, "refines_input": flag,
     "proposer_is_vlm": flag, "policy": optional(text), "policy_fingerprint": optional(text), "spec": optional(text),

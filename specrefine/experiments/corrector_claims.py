@@ -213,7 +213,7 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                     + ("" if ratio["complete"] else " (partial)")})
     severe = point["severe_vs_repair"]
     out.append({"rule": "imperfect:severe: no worse than ours-repair (paired, U-chains)",
-                "value": cmp._interval_text(severe), "verdict": ("no worse" if severe["verdict"] != "lower"
+                "value": _paired_text(severe), "verdict": ("no worse" if severe["verdict"] != "lower"
                                                                   else "worse") + ("" if severe["complete"]
                                                                                    else " (partial)")})
     for c in point["costs"]:
@@ -232,6 +232,12 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
         out.append({"rule": f"Ant: {METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                     "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
     return out
+
+
+def _paired_text(e: dict) -> str:
+    if math.isnan(e["estimate"]):
+        return "—"
+    return f"difference {e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}] over {e['n_cells']} cells"
 
 
 def _cost_verdict(c: dict) -> str:
