@@ -67,14 +67,16 @@ class LegEstimates:
         return sum(weight(r.p, n) for r in self.results)
 
 
-def estimate_legs(evaluator: SubtaskEvaluator, start, legs: list[Leg]) -> LegEstimates:
-    """Estimate legs in order; a leg with no successes ends the estimation (the rest has p = 0)."""
+def estimate_legs(evaluator: SubtaskEvaluator, start, legs: list[Leg], *, seed=None, n=None) -> LegEstimates:
+    """Estimate legs in order; a leg with no successes ends the estimation (the rest has p = 0). ``seed``, ``n``:
+    the rollouts' seed and number instead of the evaluator's own (passed on only when given)."""
+    own = {name: value for name, value in (("seed", seed), ("n", n)) if value is not None}
     out = LegEstimates()
     for leg in legs:
         if start is None:
             result = UNREACHED
         else:
-            result = evaluator.evaluate(start, leg.goal, leg.avoid, goal_point=leg.goal_point)
+            result = evaluator.evaluate(start, leg.goal, leg.avoid, goal_point=leg.goal_point, **own)
         out.results.append(result)
         start = start_of(result)
     return out

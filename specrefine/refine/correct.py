@@ -24,29 +24,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..core.graph import TaskGraph
-from .common import UNREACHED, Leg, SubtaskEvaluator, start_of
+from .common import Leg, LegEstimates, SubtaskEvaluator, estimate_legs, start_of
 from .shortcut import Shortcut, add_shortcuts, shortcuts
 
 CHECK_SEED_OFFSET = 104_729  # the correction's fresh rollouts: apart from the search's, polish's and the measurement's
 
 
 @dataclass
-class Check:
+class Check(LegEstimates):
     """Fresh estimates of a path's legs: one EdgeResult per leg, each leg started from the previous one's successes."""
 
-    path: list[str]
-    results: list
-
-    @property
-    def probabilities(self) -> list[float]:
-        return [r.p for r in self.results]
-
-    @property
-    def p(self) -> float:
-        return math.prod(self.probabilities) if self.results else 0.0
+    path: list[str] = field(default_factory=list)
 
 
 def path_legs(graph: TaskGraph, path: list[str]) -> list[Leg]:
@@ -54,16 +45,11 @@ def path_legs(graph: TaskGraph, path: list[str]) -> list[Leg]:
 
 
 def check_path(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
-               start=None) -> Check:
-    """The legs of ``path`` estimated on ``rollouts`` fresh rollouts each (seed ``seed``), from ``start`` (default
-    I(path[0]))."""
-    start, results = graph.region(path[0]) if start is None else start, []
-    for leg in path_legs(graph, path):
-        result = UNREACHED if start is None else evaluator.evaluate(start, leg.goal, leg.avoid,
-                                                                    goal_point=leg.goal_point, seed=seed, n=rollouts)
-        results.append(result)
-        start = start_of(result)
-    return Check(list(path), results)
+               start) -> Check:
+    """The legs of ``path`` estimated on ``rollouts`` fresh rollouts each (seed ``seed``), from ``start`` (None:
+    nothing reached path[0], every leg unreached)."""
+    estimates = estimate_legs(evaluator, start, path_legs(graph, path), seed=seed, n=rollouts)
+    return Check(results=estimates.results, path=list(path))
 
 
 def weakest_untried(check: Check, tried: set) -> int | None:
@@ -115,7 +101,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     An alternative is judged on the legs it changes and the leg after them (the window), from the same fresh start
     states as the current path's legs there; it replaces the path when it gains at least one rollout's worth
     (1 / rollouts) over the window, and the path's legs from the window on are then checked again."""
-    check = check_path(graph, path, evaluator, rollouts=rollouts, seed=seed)
+    check = check_path(graph, path, evaluator, rollouts=rollouts, seed=seed, start=graph.region(path[0]))
     log("correct-check", path=path, p=check.p, probabilities=check.probabilities)
     tried: set = set()
     while (leg := weakest_untried(check, tried)) is not None:
@@ -148,7 +134,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
         if accepted:
             graph, path = best[1], best[2]
             rest = check_path(graph, path[s:], evaluator, rollouts=rollouts, seed=seed, start=start)
-            check = Check(list(path), check.results[:s] + rest.results)
+            check = Check(results=check.results[:s] + rest.results, path=list(path))
     log("correct-done", path=path, p=check.p, probabilities=check.probabilities)
     return graph, path, check
 
