@@ -31,7 +31,7 @@ import numpy as np
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
-from .correct import CHECK_SEED_OFFSET, correct
+from .correct import CHECK_SEED_OFFSET, correct, path_legs
 from .edge_split import SplitCandidate, edge_split
 from .polish import polish
 from .racing import Racing
@@ -364,9 +364,13 @@ class RefinementSearch:
             self._log("path-polished", vertex=step.vertex, p_before=step.p_before, p_after=step.p_after,
                       changed=step.changed, region=g.region(step.vertex).to_dict())
         assert_refines(g, self.original)
-        # the path's estimates again on the search's own rollouts, so that its prediction is made as before
-        legs = [Leg(g.region(b), g.avoid(a, b), g.goal_point(b)) for a, b in zip(path, path[1:])]
-        for edge, result in zip(zip(path, path[1:]), estimate_legs(self.evaluator, g.region(path[0]), legs).results):
+        self._estimate_again(path)
+
+    def _estimate_again(self, path: list[str]) -> None:
+        """The path's estimates again on the search's own rollouts, so that its prediction is made as before."""
+        g = self.graph
+        estimates = estimate_legs(self.evaluator, g.region(path[0]), path_legs(g, path)).results
+        for edge, result in zip(zip(path, path[1:]), estimates):
             self.results[edge] = result
 
     # --- beyond the paper: correcting the found path on fresh rollouts (correct.py) ------
@@ -389,12 +393,7 @@ class RefinementSearch:
                                       may_split=lambda: self.splits_generated < budget, reach=reach,
                                       clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log)
         assert_refines(self.graph, self.original)
-        # the corrected path's estimates on the search's own rollouts, so that its prediction is made as before
-        legs = [Leg(self.graph.region(b), self.graph.avoid(a, b), self.graph.goal_point(b))
-                for a, b in zip(path, path[1:])]
-        estimates = estimate_legs(self.evaluator, self.graph.region(path[0]), legs).results
-        for edge, result in zip(zip(path, path[1:]), estimates):
-            self.results[edge] = result
+        self._estimate_again(path)
         return path
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
