@@ -10,7 +10,7 @@ goal-switching rule of :meth:`specrefine.evaluation.evaluator.Evaluator.run_comp
 * at every decision the agent's position is checked first: while it lies in the current leg's goal
   region the policy moves on to the next leg (several at once if the regions overlap); then the goal
   policy is fed the current leg's goal point (the last leg's once all are done);
-* ``switching`` names when it is fed that point (:mod:`specrefine.evaluation.switching`): ``at-region`` (the
+* ``switching`` names when it is fed that point (:mod:`specrefine.sim.switching`): ``at-region`` (the
   paper's, the default) at once; ``slow-turn`` first holds a leg that starts with the torso moving fast and away
   from its goal point, feeding the agent's own position until the rule lets go (the evaluator's rule and code).
 
@@ -44,7 +44,7 @@ from ..core.agents import get_agent
 from ..core.errors import PolicyError, SpecrefineError
 from ..core.mazes import Maze
 from ..core.regions import CompiledRegion, Region, from_dict
-from .switching import AT_REGION, SWITCHING, switching_rule
+from ..sim.switching import AT_REGION, SWITCHING, switching_rule
 
 FORMAT, VERSION = "specrefine-compositional-policy", 1
 POLICY_JSON = "policy.json"

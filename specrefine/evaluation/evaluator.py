@@ -12,7 +12,7 @@ region allows (the paper's "representative waypoint randomly sampled from the in
 subtask's goal vertex"; ``goal_points="sampled"``), or with ``goal_points="centre"`` the goal region's centre in
 every rollout (beyond the paper: the policy's legs between sampled points are longer and more varied than the
 legs it then runs; :meth:`Evaluator.aim`).  ``switching`` names when the policy is fed a leg's goal point
-(:mod:`specrefine.evaluation.switching`): ``at-region`` (the paper's: as soon as the leg starts) or ``slow-turn``
+(:mod:`specrefine.sim.switching`): ``at-region`` (the paper's: as soon as the leg starts) or ``slow-turn``
 (beyond the paper: a leg that starts with the torso moving fast and away from its goal first brakes).
 :class:`EvaluationFacts` says the rule in words for the VLM.
 
@@ -61,9 +61,9 @@ from ..core.results import (
     unreached,
     wilson_ci,
 )
+from ..sim.switching import AT_REGION, switching_rule
 from .cache import ResultCache
 from .rollouts import Controls, Plan, RolloutLoop, rows_stepped
-from .switching import AT_REGION, switching_rule
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 

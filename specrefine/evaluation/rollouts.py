@@ -7,8 +7,8 @@ of control steps. It fails on touching the leg's avoid set (``avoid.below(xy, cl
 out of the leg's horizon. A finished episode is frozen (zero action, no more checks, its trajectory padded with
 its last point). When at most half of the rows still run, the running ones are moved (full physics states,
 bit-exact) into a smaller BatchedSim (a power of two, at least ``min_batch``), so finished rollouts stop costing
-physics. With a switching rule that holds (``Controls.hold``, :mod:`.switching`'s ``slow-turn``), an episode at the
-start of a leg aims at its own position while the rule holds it, then at the leg's goal point.
+physics. With a switching rule that holds (``Controls.hold``: :mod:`specrefine.sim.switching`'s ``slow-turn``), an
+episode at the start of a leg aims at its own position while the rule holds it, then at the leg's goal point.
 """
 
 from __future__ import annotations
@@ -48,7 +48,8 @@ class Plan:
 class Controls:
     """How it runs: ``act(obs)`` the policy, ``frame`` its observation frame, ``sim_of(size)`` the BatchedSim of
     that many rows (for compaction), ``horizon`` control steps per leg, ``clearance`` the avoid test's distance,
-    ``hold`` the switching rule's hold at a leg's start (:func:`.switching.switching_rule`; None: ``at-region``)."""
+    ``hold`` the switching rule's hold at a leg's start (:func:`specrefine.sim.switching.switching_rule`; None:
+    ``at-region``)."""
 
     act: object
     frame: str

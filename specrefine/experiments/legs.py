@@ -11,6 +11,12 @@ Leg profiles (``--profiles RUN/result.json ... --out FILE.json``): each run's me
 episodes that started the leg) beside the search's estimate of that leg, small enough to ship, and
 ``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few, and ``turn_table``:
 the legs that turn against the straight ones, lost episodes pooled over the runs.
+
+Re-runs of a path (``--failures REPORT.json ...``, reports of :mod:`specrefine.experiments.failures`):
+``outcome_turn_table``, per setting (policy, goal points, switching rule) and kind of leg, the episodes that started
+such legs and how the ones lost there were lost (flipped, wall contacts, timeouts), pooled over the reports::
+
+    python -m specrefine.experiments.legs --failures data/results/ant/switching_checks/u_chain_2_*.json
 """
 import json
 import re
@@ -19,6 +25,7 @@ import sys
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
+from ..core.paper import PAPER
 from ..core.results import wilson_ci
 from ..core.runfolder import output_file, read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
@@ -118,6 +125,37 @@ def turn_table(profiles) -> str:
     return "\n".join(lines)
 
 
+OUTCOME_HEADER = ("| policy | goal points | switching | legs | paths | count | episodes started | flipped | "
+                  "wall contacts | timeouts | lost | failure per leg [95 % CI] |\n"
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+
+def outcome_turn_table(reports, variant: str = "walls") -> str:
+    """Lost episodes by kind of leg and how they were lost, per setting, pooled over failures reports (``variant``:
+    their run with the walls, or ``no_inner_walls``)."""
+    pooled_by: dict[tuple, dict] = {}
+    for r in reports:
+        if variant not in r or "legs" not in r:
+            raise SpecrefineError(f"report of {r.get('maze')} has no {variant!r} re-run: not a failures report")
+        setting = (str(r.get("policy", "?")).rsplit(" ", 1)[-1],  # reports older than the rules ran the paper's
+                   r.get("goal_points") or PAPER.goal_points, r.get("switching") or "at-region")
+        for leg, row in zip(r["legs"], r[variant]["per_leg"], strict=True):
+            acc = pooled_by.setdefault((*setting, turn_kind(leg["turn_deg"])), {"paths": set(), "count": 0})
+            acc["paths"].add((r.get("maze"), r.get("seed"), id(r)))
+            acc["count"] += 1
+            for key in ("started", "flipped", "avoid", "timeout"):
+                acc[key] = acc.get(key, 0) + row[key]
+    kinds = ("first leg", "straight", "turning")
+    lines = [OUTCOME_HEADER]
+    for key in sorted(pooled_by, key=lambda k: (k[:3], kinds.index(k[3]))):
+        a = pooled_by[key]
+        lost = a["flipped"] + a["avoid"] + a["timeout"]
+        lo, hi = wilson_ci(lost, a["started"])
+        lines.append(f"| {' | '.join(key)} | {len(a['paths'])} | {a['count']} | {a['started']:,} | {a['flipped']} | "
+                     f"{a['avoid']} | {a['timeout']} | {lost} | {lost / a['started']:.4f} [{lo:.4f}, {hi:.4f}] |")
+    return "\n".join(lines)
+
+
 def worst_share(failures, share: float = 0.2) -> float:
     """The part of the summed per-leg failure that the worst ``share`` of the legs carry."""
     ordered = sorted(failures, reverse=True)
@@ -143,6 +181,17 @@ def profile_table(profiles) -> str:
     return "\n".join(lines)
 
 
+def _read_report(path) -> dict:
+    try:
+        with open(path) as f:
+            report = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise SpecrefineError(f"{path}: not a readable failures report ({type(exc).__name__})") from None
+    if not isinstance(report, dict):
+        raise SpecrefineError(f"{path}: not a failures report")
+    return report
+
+
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
     ap.add_argument("tables", nargs="+", help="sweep tables (with --profiles: runs' result.json files)")
@@ -151,6 +200,8 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles", action="store_true", help="the inputs are result.json files: write their leg "
                                                             "profiles to --out and print profile_table")
     ap.add_argument("--out", help="with --profiles: the JSON file to write")
+    ap.add_argument("--failures", action="store_true",
+                    help="the inputs are failures reports (experiments.failures --out): print outcome_turn_table")
     ap.add_argument("--turns", action="store_true", help="with --profiles: also print the lost episodes pooled by "
                                                          "straight and turning legs")
     args = ap.parse_args(argv)
@@ -159,6 +210,9 @@ def main(argv=None) -> int:
     try:
         if args.out:
             output_file(args.out)  # before reading the inputs
+        if args.failures:
+            print(outcome_turn_table([_read_report(path) for path in args.tables]))
+            return 0
         if args.profiles:
             profiles = [leg_profile(read_result(path)) for path in args.tables]
             if args.out:

@@ -78,7 +78,7 @@ def _goal_points() -> tuple[str, ...]:
 
 
 def _switching() -> tuple[str, ...]:
-    from ..evaluation.switching import SWITCHING
+    from ..sim.switching import SWITCHING
 
     return SWITCHING
 

@@ -76,7 +76,7 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     None = the maze's own task (its ``; spec:`` line, else its chain); goal_points: where a leg's policy aims,
     "sampled" (a point drawn in the goal region per rollout, the paper's rule) or "centre" (``Evaluator.aim``);
     switching: when a leg's policy is fed its goal point, "at-region" (the paper's) or "slow-turn"
-    (:mod:`specrefine.evaluation.switching`).
+    (:mod:`specrefine.sim.switching`).
     """
     from ..core.spec import maze_task
     from ..evaluation.evaluator import Evaluator

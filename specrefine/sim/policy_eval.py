@@ -17,6 +17,7 @@ from ..core.agents import get_agent
 from ..core.results import wilson_ci
 from .policy import GoalPolicy
 from .simulator import BatchedSim, sample_goals
+from .switching import AT_REGION, switching_rule
 
 
 def _frame(policy) -> str:
@@ -67,19 +68,23 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
 
 
 def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
-                   hi: float | None = None, seed: int = 0, horizon: int | None = None) -> dict:
+                   hi: float | None = None, seed: int = 0, horizon: int | None = None,
+                   switching: str = AT_REGION) -> dict:
     """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
 
     This is how a compositional policy uses the goal policy (the next subtask starts from a moving
-    state); per goal it reports how many episodes got there and how many flipped on the way.
+    state); per goal it reports how many episodes got there and how many flipped on the way.  ``switching``: when
+    the policy is fed a new goal (:mod:`specrefine.sim.switching`, as a compositional policy's legs).
     """
+    hold = switching_rule(switching)
     task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
     index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
-    alive = np.ones(episodes, dtype=bool)
+    alive, holding = np.ones(episodes, dtype=bool), np.full(episodes, hold is not None)
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
     with torch.inference_mode():
         while alive.any():
-            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal, _frame(policy))), 0.0))
+            aim = goal if hold is None else _held_aim(hold, sim, goal, t, holding)
+            sim.step(np.where(alive[:, None], policy.act(sim.observe(aim, _frame(policy))), 0.0))
             t += 1
             flip = alive & sim.flipped
             np.add.at(flips, index[flip], 1)
@@ -88,6 +93,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             np.add.at(reached, index[hit], 1)
             index[hit] += 1
             t[hit] = 0
+            holding[hit] = hold is not None
             goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
             alive &= index < goals
             late = alive & (t >= horizon)
@@ -96,9 +102,17 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     sim.close()
     k = int(reached[-1])
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
-            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
-            "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
+            "horizon": horizon, **({} if hold is None else {"switching": switching}),
+            "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes), "reached": reached.tolist(),
+            "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
             "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
+
+
+def _held_aim(hold, sim: BatchedSim, goal: np.ndarray, t: np.ndarray, holding: np.ndarray) -> np.ndarray:
+    """The goals fed this step: each row's own position while the switching rule holds its new goal's start."""
+    xy, rows = sim.xy, np.flatnonzero(holding)
+    holding[rows] = hold.holding(sim.qvel[rows, :2], goal[rows] - xy[rows], t[rows])
+    return np.where(holding[:, None], xy, goal)
 
 
 def success_by_distance(result: dict, bins: int = 8) -> list[dict]:

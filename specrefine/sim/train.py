@@ -39,6 +39,7 @@ from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_lo
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
 from .reach_env import GoalReachEnv
+from .switching import AT_REGION, SWITCHING
 
 __all__ = ["PPO_DIAGNOSTICS", "Config", "Trainer", "config_arguments", "explained_variance", "make_config", "main",
            "make_modules", "train",
@@ -372,6 +373,10 @@ def add_arguments(ap) -> None:
     ap.add_argument("--chain", type=bounded_int("chain"), default=None, metavar="K",
                     help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain) "
                          "(default: one goal per episode)")
+    ap.add_argument("--switching", choices=SWITCHING, default=AT_REGION,
+                    help="with --evaluate --chain: when the policy is fed the next goal: at-region (at once) or "
+                         "slow-turn (a fast, turned start brakes first; specrefine.sim.switching) (default: "
+                         "at-region)")
     config_arguments(ap)
 
 
@@ -386,7 +391,8 @@ def run(args, ap) -> int:
     try:
         if args.evaluate and args.chain:
             lo, hi = args.goal_range or (None, None)
-            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed)
+            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed,
+                                 switching=args.switching)
             print(json.dumps(res))
             return 0
         if args.evaluate:
