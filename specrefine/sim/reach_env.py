@@ -13,9 +13,10 @@ from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
 from ..core.agents import ReachTask, get_agent
+from ..core.errors import SpecrefineError
 from ..core.mazes import Maze
 from ..core.regions import CompiledRegion
-from .simulator import BatchedSim, contact_margin, sample_goals
+from .simulator import BatchedSim, contact_margin, direction_of_travel, sample_goals, sample_turn_goals
 
 
 class GoalReachEnv(EnvBase):
@@ -34,11 +35,18 @@ class GoalReachEnv(EnvBase):
     going back unless it ends; touching a wall (closer than the evaluator's clearance, the body radius plus MuJoCo's
     contact margin) ends the episode with ``task.wall_penalty``. The policy's observation stays as it is: the walls
     are in the physics only.
+
+    ``turn`` = (lo, hi) degrees (open floor only): every chained goal after the first turns by lo-hi degrees from the
+    direction the agent travels when it switches (``simulator.sample_turn_goals``), at whatever speed it has: the
+    goal switches where the U-chain paths lose most episodes (issue 42).  The first goal of an episode stays uniform.
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None,
-                 frame: str = "world", maze: Maze | None = None):
+                 frame: str = "world", maze: Maze | None = None, turn: tuple[float, float] | None = None):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
+        if turn is not None and maze is not None:
+            raise SpecrefineError("turning goals (--turn-goals) are drawn on the open floor: not with --train-maze")
+        self.turn = turn
         self.maze = None if maze is None else maze.for_agent(agent)
         self.sim = BatchedSim(agent, self.maze, n, nthread=nthread)
         if self.maze is not None:
@@ -85,7 +93,7 @@ class GoalReachEnv(EnvBase):
             self.cell[idx] = self.came_from[idx] = self._free[self.rng.integers(len(self._free), size=len(idx))]
             self.sim.reset(xy=self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2),
                            rng=self.rng, idx=idx)
-        self._new_goals(idx)
+        self._new_goals(idx, chained=False)
         self.t[idx] = 0
         self.goal_index[idx] = 0
         zeros = np.zeros(self.sim.n, dtype=bool)
@@ -93,10 +101,15 @@ class GoalReachEnv(EnvBase):
         out.update(self._dones(zeros, zeros))
         return out
 
-    def _new_goals(self, idx: np.ndarray) -> None:
-        """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are."""
+    def _new_goals(self, idx: np.ndarray, chained: bool = True) -> None:
+        """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are;
+        ``chained``: a switch within the episode (turning with ``turn``), not its first goal."""
         task = self.task
-        if self.maze is None:
+        if self.maze is None and chained and self.turn is not None:
+            xy = self.sim.xy[idx]
+            travel = direction_of_travel(self.sim.qvel[idx, :2], self.goals[idx] - xy)
+            self.goals[idx] = sample_turn_goals(xy, travel, task.goal_min, task.goal_max, self.turn, self.rng)
+        elif self.maze is None:
             self.goals[idx] = sample_goals(self.sim.xy[idx], task.goal_min, task.goal_max, self.rng)
         else:
             for i in idx:
