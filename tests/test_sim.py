@@ -346,3 +346,22 @@ def test_chained_goals_turn_from_the_direction_of_travel_with_turn():
     assert turn.min() >= 90.0 - 1e-6 and (env.sim.xy[:, 0] > before[:, 0]).all()  # turned from where it moved
     with pytest.raises(SpecrefineError, match="open floor"):
         GoalReachEnv("point", 2, seed=0, nthread=1, maze=CORRIDOR, turn=(45.0, 180.0))
+
+
+def test_sampled_training_goals_spread_over_the_cell_and_keep_off_its_walls():
+    from dataclasses import replace
+
+    from specrefine.core.agents import AGENTS
+    from specrefine.core.mazes import random_maze
+
+    task = replace(AGENTS["point"].reach_task, goals_per_episode=50)
+    env = GoalReachEnv("point", 64, seed=0, nthread=1, task=task, maze=random_maze((3, 3), seed=1),
+                       goal_points="sampled")
+    env.reset()
+    centres = env.maze.cell_to_xy(env.cell[:, 0], env.cell[:, 1]).reshape(64, 2)
+    offset = np.abs(env.goals - centres)
+    assert offset.max() <= env.maze.cell_size / 2 - env.clearance + 1e-9 and offset.max() > 0.1
+    assert not env.touching(env.goals).any()
+    for bad in ({"goal_points": "sampled"}, {"goal_points": "corner", "maze": random_maze((3, 3), seed=1)}):
+        with pytest.raises(SpecrefineError, match="goal points"):
+            GoalReachEnv("point", 2, seed=0, nthread=1, **bad)

@@ -240,3 +240,12 @@ def test_turn_goals_reach_the_training_env_and_refuse_a_maze(tmp_path):
     assert Trainer(make_config("point", frames=2048, seed=0), tmp_path / "plain", progress=False).env.turn is None
     with pytest.raises(SpecrefineError, match="open floor"):
         make_config("point", turn_goals=(45, 180), train_maze="random:3x3:0")
+
+
+def test_sampled_training_goal_points_need_a_training_maze(tmp_path, capsys):
+    out = tmp_path / "open"
+    assert main(["--agent", "point", "--out", str(out), "--train-goal-points", "sampled"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "needs --train-maze" in err and not out.exists()
+    cfg = make_config("point", train_maze="random:3x3:0", train_goal_points="sampled", goals_per_episode=4)
+    assert Trainer(cfg, tmp_path / "walls", progress=False).env.goal_points == "sampled"

@@ -92,6 +92,9 @@ class Config:
                                         "are neighbouring cells' centres (default: the open floor)")
     wall_penalty: float | None = knob(None, "with --train-maze: touching a wall ends the episode with this "
                                             "penalty (default: the agent's task)")
+    train_goal_points: str = knob("centre", "with --train-maze: each goal at the neighbouring cell's 'centre' or "
+                                            "'sampled', a uniform point of it at least the body's clearance from "
+                                            "its walls (as the sampled goal-point rule aims: some by a wall)")
     turn_goals: tuple[float, float] | None = knob(None, "open floor, chained goals: every goal after an episode's "
                                                         "first turns by LO-HI degrees (either side) from the "
                                                         "direction of travel at the switch; with --evaluate --chain: "
@@ -150,6 +153,10 @@ def make_config(agent: str, **overrides) -> Config:
     cfg = replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
     if cfg.wall_penalty is not None and cfg.train_maze is None:
         raise SpecrefineError("--wall-penalty needs --train-maze (on the open floor there is no wall to touch)")
+    if cfg.train_goal_points not in ("centre", "sampled"):
+        raise SpecrefineError(f"--train-goal-points {cfg.train_goal_points}: 'centre' or 'sampled'")
+    if cfg.train_goal_points == "sampled" and cfg.train_maze is None:
+        raise SpecrefineError("--train-goal-points sampled needs --train-maze (on the open floor a goal is any point)")
     if cfg.turn_goals is not None:
         cfg = replace(cfg, turn_goals=turn_range(cfg.turn_goals))
         if cfg.train_maze is not None:
@@ -224,7 +231,8 @@ class Trainer:
         # the policy first: a bad --observation-frame is one line before the simulator is built
         self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
-                                frame=cfg.observation_frame, maze=training_maze(cfg.train_maze), turn=cfg.turn_goals)
+                                frame=cfg.observation_frame, maze=training_maze(cfg.train_maze), turn=cfg.turn_goals,
+                                goal_points=cfg.train_goal_points)
         self.actor, self.critic = make_modules(self.policy, self.env)
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
                                 entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,
