@@ -12,11 +12,9 @@ episodes that started the leg) beside the search's estimate of that leg, small e
 ``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few, and ``turn_table``:
 the legs that turn against the straight ones, lost episodes pooled over the runs.
 
-Re-runs of a path (``--failures REPORT.json ...``, reports of :mod:`specrefine.experiments.failures`):
-``outcome_turn_table``, per setting (policy, goal points, switching rule) and kind of leg, the episodes that started
-such legs and how the ones lost there were lost (flipped, wall contacts, timeouts), pooled over the reports::
-
-    python -m specrefine.experiments.legs --failures data/results/ant/switching_checks/u_chain_2_*.json
+Leg kinds of re-run paths (``--failures FILE.json ...``, the reports of ``python -m specrefine.experiments.failures``):
+flips, wall contacts (avoid) and timeouts per kind of leg (first, straight, turning at 45 degrees or more), pooled over
+the files, with the walls (``kind_table``).
 """
 import json
 import re
@@ -25,7 +23,6 @@ import sys
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
-from ..core.paper import PAPER
 from ..core.results import wilson_ci
 from ..core.runfolder import output_file, read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
@@ -125,34 +122,32 @@ def turn_table(profiles) -> str:
     return "\n".join(lines)
 
 
-OUTCOME_HEADER = ("| policy | goal points | switching | legs | paths | count | episodes started | flipped | "
-                  "wall contacts | timeouts | lost | failure per leg [95 % CI] |\n"
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|")
+KIND_HEADER = ("| legs | count | episodes started | flipped | avoid | timeout | failure per leg [95 % CI] |\n"
+               "|---|---|---|---|---|---|---|")
 
 
-def outcome_turn_table(reports, variant: str = "walls") -> str:
-    """Lost episodes by kind of leg and how they were lost, per setting, pooled over failures reports (``variant``:
-    their run with the walls, or ``no_inner_walls``)."""
-    pooled_by: dict[tuple, dict] = {}
-    for r in reports:
-        if variant not in r or "legs" not in r:
-            raise SpecrefineError(f"report of {r.get('maze')} has no {variant!r} re-run: not a failures report")
-        setting = (str(r.get("policy", "?")).rsplit(" ", 1)[-1],  # reports older than the rules ran the paper's
-                   r.get("goal_points") or PAPER.goal_points, r.get("switching") or "at-region")
-        for leg, row in zip(r["legs"], r[variant]["per_leg"], strict=True):
-            acc = pooled_by.setdefault((*setting, turn_kind(leg["turn_deg"])), {"paths": set(), "count": 0})
-            acc["paths"].add((r.get("maze"), r.get("seed"), id(r)))
-            acc["count"] += 1
-            for key in ("started", "flipped", "avoid", "timeout"):
-                acc[key] = acc.get(key, 0) + row[key]
-    kinds = ("first leg", "straight", "turning")
-    lines = [OUTCOME_HEADER]
-    for key in sorted(pooled_by, key=lambda k: (k[:3], kinds.index(k[3]))):
-        a = pooled_by[key]
-        lost = a["flipped"] + a["avoid"] + a["timeout"]
-        lo, hi = wilson_ci(lost, a["started"])
-        lines.append(f"| {' | '.join(key)} | {len(a['paths'])} | {a['count']} | {a['started']:,} | {a['flipped']} | "
-                     f"{a['avoid']} | {a['timeout']} | {lost} | {lost / a['started']:.4f} [{lo:.4f}, {hi:.4f}] |")
+def kind_table(reports, variant: str = "walls") -> str:
+    """Lost episodes of re-run paths (``failures`` reports) pooled by the kind of leg, split by how they ended."""
+    pooled_by: dict[str, dict[str, int]] = {}
+    for report in reports:
+        try:
+            rows = zip(report["legs"], report[variant]["per_leg"], strict=True)
+            for leg, row in rows:
+                acc = pooled_by.setdefault(turn_kind(leg["turn_deg"]), dict.fromkeys(
+                    ("count", "started", "flipped", "avoid", "timeout"), 0))
+                acc["count"] += 1
+                for key in ("started", "flipped", "avoid", "timeout"):
+                    acc[key] += int(row[key])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise SpecrefineError(f"not a failures report with per-leg counts ({type(exc).__name__}: {exc})") from None
+    lines = [KIND_HEADER]
+    for kind in ("first leg", "straight", "turning"):
+        if kind in pooled_by:
+            acc = pooled_by[kind]
+            lost = acc["flipped"] + acc["avoid"] + acc["timeout"]
+            lo, hi = wilson_ci(lost, acc["started"])
+            lines.append(f"| {kind} | {acc['count']} | {acc['started']:,} | {acc['flipped']} | {acc['avoid']} | "
+                         f"{acc['timeout']} | {lost / acc['started']:.4f} [{lo:.4f}, {hi:.4f}] |")
     return "\n".join(lines)
 
 
@@ -181,17 +176,6 @@ def profile_table(profiles) -> str:
     return "\n".join(lines)
 
 
-def _read_report(path) -> dict:
-    try:
-        with open(path) as f:
-            report = json.load(f)
-    except (OSError, ValueError) as exc:
-        raise SpecrefineError(f"{path}: not a readable failures report ({type(exc).__name__})") from None
-    if not isinstance(report, dict):
-        raise SpecrefineError(f"{path}: not a failures report")
-    return report
-
-
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.experiments.legs", description=__doc__.splitlines()[0])
     ap.add_argument("tables", nargs="+", help="sweep tables (with --profiles: runs' result.json files)")
@@ -200,8 +184,8 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles", action="store_true", help="the inputs are result.json files: write their leg "
                                                             "profiles to --out and print profile_table")
     ap.add_argument("--out", help="with --profiles: the JSON file to write")
-    ap.add_argument("--failures", action="store_true",
-                    help="the inputs are failures reports (experiments.failures --out): print outcome_turn_table")
+    ap.add_argument("--failures", action="store_true", help="the inputs are reports of experiments.failures: print "
+                                                            "their lost episodes by kind of leg (kind_table)")
     ap.add_argument("--turns", action="store_true", help="with --profiles: also print the lost episodes pooled by "
                                                          "straight and turning legs")
     args = ap.parse_args(argv)
@@ -211,7 +195,14 @@ def main(argv=None) -> int:
         if args.out:
             output_file(args.out)  # before reading the inputs
         if args.failures:
-            print(outcome_turn_table([_read_report(path) for path in args.tables]))
+            reports = []
+            for path in args.tables:
+                try:
+                    with open(path) as fh:
+                        reports.append(json.load(fh))
+                except (OSError, ValueError) as exc:
+                    raise SpecrefineError(f"{path}: not a readable JSON report ({type(exc).__name__})") from None
+            print(kind_table(reports))
             return 0
         if args.profiles:
             profiles = [leg_profile(read_result(path)) for path in args.tables]

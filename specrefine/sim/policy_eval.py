@@ -16,7 +16,7 @@ import torch
 from ..core.agents import get_agent
 from ..core.results import wilson_ci
 from .policy import GoalPolicy
-from .simulator import BatchedSim, sample_goals
+from .simulator import BatchedSim, direction_of_travel, sample_goals, sample_turn_goals
 from .switching import AT_REGION, switching_rule
 
 
@@ -69,11 +69,13 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
 
 def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
                    hi: float | None = None, seed: int = 0, horizon: int | None = None,
-                   switching: str = AT_REGION) -> dict:
+                   turn: tuple[float, float] | None = None, switching: str = AT_REGION) -> dict:
     """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
 
     This is how a compositional policy uses the goal policy (the next subtask starts from a moving
-    state); per goal it reports how many episodes got there and how many flipped on the way.  ``switching``: when
+    state); per goal it reports how many episodes got there and how many flipped on the way, and the mean planar
+    speed at the switches.  ``turn`` = (lo, hi) degrees: every goal after the first turns by that much from the
+    direction of travel at the switch (``simulator.sample_turn_goals``); None: any direction.  ``switching``: when
     the policy is fed a new goal (:mod:`specrefine.sim.switching`, as a compositional policy's legs).
     """
     hold = switching_rule(switching)
@@ -81,6 +83,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
     alive, holding = np.ones(episodes, dtype=bool), np.full(episodes, hold is not None)
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
+    switch_speeds = []
     with torch.inference_mode():
         while alive.any():
             aim = goal if hold is None else _held_aim(hold, sim, goal, t, holding)
@@ -94,7 +97,14 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             index[hit] += 1
             t[hit] = 0
             holding[hit] = hold is not None
-            goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
+            switch = hit & (index < goals)
+            velocity = sim.qvel[switch, :2]
+            switch_speeds.extend(np.linalg.norm(velocity, axis=1))
+            if turn is None:
+                goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
+            else:
+                travel = direction_of_travel(velocity, goal[switch] - sim.xy[switch])
+                goal[switch] = sample_turn_goals(sim.xy[switch], travel, lo, hi, turn, rng)
             alive &= index < goals
             late = alive & (t >= horizon)
             np.add.at(timeouts, index[late], 1)
@@ -102,10 +112,12 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     sim.close()
     k = int(reached[-1])
     return {"agent": policy.agent, "episodes": episodes, "seed": seed, "goals": goals, "goal_range_m": [lo, hi],
-            "horizon": horizon, **({} if hold is None else {"switching": switching}),
-            "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes), "reached": reached.tolist(),
-            "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
-            "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum()))}
+            "horizon": horizon, "success_rate": k / episodes, "success_ci95": wilson_ci(k, episodes),
+            "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
+            "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum())),
+            **({} if turn is None else {"turn_degrees": list(turn)}),
+            "mean_switch_speed_mps": float(np.mean(switch_speeds)) if switch_speeds else None,
+            **({} if hold is None else {"switching": switching})}
 
 
 def _held_aim(hold, sim: BatchedSim, goal: np.ndarray, t: np.ndarray, holding: np.ndarray) -> np.ndarray:
