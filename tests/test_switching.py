@@ -12,9 +12,9 @@ from specrefine.core.mazes import load_maze
 from specrefine.core.regions import Box, Disc
 from specrefine.evaluation.compositional import CompositionalPolicy, Leg
 from specrefine.evaluation.evaluator import Evaluator
-from specrefine.evaluation.switching import SlowTurn, switching_rule
 from specrefine.runs.config import RunConfig
 from specrefine.sim.policy import PointController
+from specrefine.sim.switching import SlowTurn, switching_rule
 
 
 class Recorder:
@@ -120,3 +120,13 @@ def test_at_region_keeps_its_outcomes_and_cache_keys_and_slow_turn_has_its_own()
 def test_a_run_records_its_switching_rule():
     assert RunConfig().switching == "at-region" and "switching" not in RunConfig().resolved().record()
     assert RunConfig(switching="slow-turn").resolved().record()["switching"] == "slow-turn"
+
+
+def test_the_eight_goal_check_takes_the_rule():
+    from specrefine.sim.policy_eval import evaluate_chain
+
+    plain = evaluate_chain(PointController(), episodes=8, goals=3, lo=1.0, hi=2.0, seed=0)
+    named = evaluate_chain(PointController(), episodes=8, goals=3, lo=1.0, hi=2.0, seed=0, switching="at-region")
+    slow = evaluate_chain(PointController(), episodes=8, goals=3, lo=1.0, hi=2.0, seed=0, switching="slow-turn")
+    assert plain == named and "switching" not in plain and slow["switching"] == "slow-turn"
+    assert slow["mean_switch_speed_mps"] != plain["mean_switch_speed_mps"]  # the holds changed the episodes
