@@ -138,10 +138,12 @@ def test_each_lever_alone_is_compared_with_ours_ours_repair_and_the_corrector_on
     checked = by[("imperfect:moderate", "ours-checked")]
     assert checked["versus"][cc.METHOD]["estimate"] == pytest.approx(0.0)
     assert checked["costs"]["proposer_calls_ratio"] == pytest.approx(1.0)  # 3 calls each, as ours
+    assert checked["same"] == {"ours": 0, cc.METHOD: 16} and feasible["same"]["ours"] == 16
     text = cc.front(cc.point_study(tmp_path), None, tmp_path, levers=lv)["levers"]
     assert text.startswith("mild: ours-deeprepair 0.800 (+0.200 [+0.200, +0.200] over ours, helps;")
     md = "\n".join(cc.levers_markdown(lv))
     assert "| imperfect:mild | ours-feasible | 16 | 0.600 | +0.000 [+0.000, +0.000] undecided | — |" in md
+    assert md.count("| 1.00x | 16 / 0 |") == 2  # ours-feasible at both presets: ours's success on every cell
 
 
 def test_a_lever_grid_cut_short_is_marked_partial(tmp_path):

@@ -196,9 +196,17 @@ def levers_study(root: Path = ROOT) -> dict | None:
             entries.append({"proposer": proposer, "lever": lever, "runs": runs, "success": k / n if n else math.nan,
                             "versus": {ref: cmp.paired_difference(cells, failed, proposer, lever, ref, grid.seeds,
                                                                   grid.mazes) for ref in references},
+                            "same": {ref: same_cells(cells, proposer, lever, ref, grid.mazes, grid.seeds)
+                                     for ref in references},
                             "costs": costs(rows, proposer, grid.mazes, grid.seeds, first=lever)})
     return {"mazes": list(grid.mazes), "seeds": list(grid.seeds), "entries": entries,
             "n_expected": len(grid.mazes) * len(grid.seeds)}
+
+
+def same_cells(cells, proposer, first, second, mazes, seeds) -> int:
+    """Cells where both ran with the same success (the lever never acted: its code path is the reference's)."""
+    pairs = [(cells.get((m, first, proposer, s)), cells.get((m, second, proposer, s))) for m in mazes for s in seeds]
+    return sum(1 for a, b in pairs if a is not None and a == b)
 
 
 def pooled(rows, mazes, method, proposer, seeds) -> tuple[int, int, int]:
@@ -398,14 +406,15 @@ def levers_markdown(lv: dict) -> list[str]:
              "success, and the paired difference lever - reference over the same cells (95 % bootstrap over cells); "
              "against the method without the lever: helps above 0, hurts below, else undecided.", "",
              "| proposer | lever | runs | success | - ours | - ours-repair | - ours-corrector | proposer calls / ours "
-             "|",
-             "|---|---|---|---|---|---|---|---|"]
+             "| cells with the same success as ours / ours-corrector |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for e in lv["entries"]:
         v = e["versus"]
         repair = f"{_signed(v['ours-repair'])} {_helps(v['ours-repair'])}" if "ours-repair" in v else "—"
         lines.append(f"| {e['proposer']} | {e['lever']} | {e['runs']} | {_num(e['success'])} | "
                      f"{_signed(v['ours'])} {_helps(v['ours'])} | {repair} | {_signed(v[METHOD])} {_sided(v[METHOD])}"
-                     f" | {_num(e['costs']['proposer_calls_ratio'], '{:.2f}x')} |")
+                     f" | {_num(e['costs']['proposer_calls_ratio'], '{:.2f}x')} | {e['same']['ours']} / "
+                     f"{e['same'][METHOD]} |")
     return lines
 
 
