@@ -74,3 +74,27 @@ def test_a_profile_without_turns_is_refused_in_one_line(tmp_path, capsys):
     assert "| turning | 1 | 198 | 10 |" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         legs.main([str(path), "--turns"])  # --turns alone: argparse's usage line, exit 2
+
+
+def _report(turns, per_leg):
+    return {"legs": [{"leg": k, "turn_deg": t} for k, t in enumerate(turns)],
+            "walls": {"per_leg": [{"leg": k, "started": s, "flipped": f, "avoid": a, "timeout": t}
+                                  for k, (s, f, a, t) in enumerate(per_leg)]}}
+
+
+def test_failure_reports_pool_flips_contacts_and_timeouts_by_kind_of_leg(tmp_path, capsys):
+    import json
+
+    one = _report([None, 10.0, 90.0], [(100, 0, 1, 0), (99, 2, 0, 0), (97, 3, 1, 1)])
+    two = _report([None, 120.0], [(100, 0, 0, 0), (100, 1, 0, 0)])
+    rows = {r.split("|")[1].strip(): [c.strip() for c in r.strip("|").split("|")]
+            for r in legs.kind_table([one, two]).splitlines()[2:]}
+    assert rows["first leg"][1:6] == ["2", "200", "0", "1", "0"]
+    assert rows["straight"][1:6] == ["1", "99", "2", "0", "0"]
+    assert rows["turning"][1:6] == ["2", "197", "4", "1", "1"] and rows["turning"][6].startswith("0.0305 [")
+    (tmp_path / "a.json").write_text(json.dumps(one))
+    (tmp_path / "bad.json").write_text(json.dumps({"legs": []}))
+    assert legs.main(["--failures", str(tmp_path / "a.json")]) == 0
+    assert "| turning | 1 | 97 |" in capsys.readouterr().out
+    assert legs.main(["--failures", str(tmp_path / "bad.json")]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

@@ -284,3 +284,84 @@ def test_training_among_walls_walks_goals_along_the_corridors_and_ends_on_a_wall
     assert bool(out["next", "wall"][0]) and bool(out["next", "terminated"][0]) and not bool(out["next", "flipped"][0])
     assert not bool(out["next", "success"][0]) and out["next", "reward"][0].item() < out["next", "reward"][1].item() - 1
     assert not out["next", "wall"][1:].any() and not out["next", "done"][1:].any()
+
+
+def _turn_degrees(travel: np.ndarray, step: np.ndarray) -> np.ndarray:
+    cos = (travel * step).sum(1) / (np.linalg.norm(travel, axis=1) * np.linalg.norm(step, axis=1))
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def test_turn_goals_turn_within_their_range_either_side_at_the_distances_asked():
+    from specrefine.sim.simulator import sample_turn_goals
+
+    rng = np.random.default_rng(0)
+    xy = rng.normal(size=(2000, 2))
+    travel = rng.normal(size=(2000, 2)) * rng.uniform(0.1, 5.0, size=(2000, 1))  # any direction, any speed
+    goals = sample_turn_goals(xy, travel, 3.0, 5.0, (45.0, 180.0), rng)
+    dist = np.linalg.norm(goals - xy, axis=1)
+    assert dist.min() >= 3.0 - 1e-9 and dist.max() <= 5.0 + 1e-9
+    turn = _turn_degrees(travel, goals - xy)
+    assert turn.min() >= 45.0 - 1e-6 and turn.max() <= 180.0 + 1e-6
+    assert turn.min() < 50 and turn.max() > 175  # the whole range is drawn
+    side = np.sign(travel[:, 0] * (goals - xy)[:, 1] - travel[:, 1] * (goals - xy)[:, 0])
+    assert 0.45 < (side > 0).mean() < 0.55  # left and right alike
+    still = sample_turn_goals(np.zeros((500, 2)), np.zeros((500, 2)), 1.0, 1.0, (90.0, 90.0), rng)
+    np.testing.assert_allclose(np.abs(still[:, 1]), 1.0, atol=1e-9)  # no travel: turns from east, to north or south
+
+
+def test_turn_goals_are_the_same_for_the_same_seed():
+    from specrefine.sim.simulator import sample_turn_goals
+
+    xy, travel = np.zeros((50, 2)), np.ones((50, 2))
+    draw = lambda seed: sample_turn_goals(xy, travel, 1.0, 8.0, (45.0, 180.0), np.random.default_rng(seed))  # noqa: E731
+    np.testing.assert_array_equal(draw(3), draw(3))
+    assert not np.allclose(draw(3), draw(4))
+
+
+def test_direction_of_travel_is_the_velocity_unless_nearly_still():
+    from specrefine.sim.simulator import direction_of_travel
+
+    velocity = np.array([[1.0, 0.0], [0.05, 0.0]])
+    fallback = np.array([[0.0, 1.0], [0.0, 1.0]])
+    np.testing.assert_array_equal(direction_of_travel(velocity, fallback), [[1.0, 0.0], [0.0, 1.0]])
+
+
+def test_chained_goals_turn_from_the_direction_of_travel_with_turn():
+    from dataclasses import replace
+
+    from specrefine.core.agents import AGENTS
+
+    task = replace(AGENTS["point"].reach_task, goals_per_episode=3)
+    env = GoalReachEnv("point", 64, seed=0, nthread=1, task=task, turn=(90.0, 180.0))
+    td = env.reset()
+    state = env.sim.get_state()
+    state[:, 1 + env.sim.model.nq:1 + env.sim.model.nq + 2] = [0.6, 0.0]  # east, below arrive_speed
+    env.sim.reset(states=state)
+    env.goals[:] = env.sim.xy  # every goal 1 reached on the next step
+    td["action"] = torch.zeros(64, 2)
+    before = env.sim.xy.copy()
+    env.step_and_maybe_reset(td)
+    assert (env.goal_index == 1).all()
+    turn = _turn_degrees(env.sim.qvel[:, :2], env.goals - env.sim.xy)
+    assert turn.min() >= 90.0 - 1e-6 and (env.sim.xy[:, 0] > before[:, 0]).all()  # turned from where it moved
+    with pytest.raises(SpecrefineError, match="open floor"):
+        GoalReachEnv("point", 2, seed=0, nthread=1, maze=CORRIDOR, turn=(45.0, 180.0))
+
+
+def test_sampled_training_goals_spread_over_the_cell_and_keep_off_its_walls():
+    from dataclasses import replace
+
+    from specrefine.core.agents import AGENTS
+    from specrefine.core.mazes import random_maze
+
+    task = replace(AGENTS["point"].reach_task, goals_per_episode=50)
+    env = GoalReachEnv("point", 64, seed=0, nthread=1, task=task, maze=random_maze((3, 3), seed=1),
+                       goal_points="sampled")
+    env.reset()
+    centres = env.maze.cell_to_xy(env.cell[:, 0], env.cell[:, 1]).reshape(64, 2)
+    offset = np.abs(env.goals - centres)
+    assert offset.max() <= env.maze.cell_size / 2 - env.clearance + 1e-9 and offset.max() > 0.1
+    assert not env.touching(env.goals).any()
+    for bad in ({"goal_points": "sampled"}, {"goal_points": "corner", "maze": random_maze((3, 3), seed=1)}):
+        with pytest.raises(SpecrefineError, match="goal points"):
+            GoalReachEnv("point", 2, seed=0, nthread=1, **bad)

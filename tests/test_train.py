@@ -275,3 +275,37 @@ def test_the_ppo_update_computes_torchrl_s_gae_and_clipped_loss(tmp_path, entrop
     assert ours == pytest.approx(theirs, rel=1e-5, abs=1e-6)
     for a, b in zip(their_grads, our_grads, strict=True):
         torch.testing.assert_close(b, a, rtol=1e-4, atol=1e-6)
+
+
+def test_turning_chain_evaluation_and_a_bad_turn_range(capsys):
+    from specrefine.sim.policy_eval import evaluate_chain
+
+    plain = evaluate_chain(load_policy("point"), episodes=32, goals=3, seed=3)
+    turning = evaluate_chain(load_policy("point"), episodes=32, goals=3, seed=3, turn=(90.0, 180.0))
+    assert turning["turn_degrees"] == [90.0, 180.0] and "turn_degrees" not in plain
+    assert turning["reached"][0] == plain["reached"][0]  # the first goal is the same, only the later ones turn
+    assert turning["mean_switch_speed_mps"] >= 0.0
+    for args in (["--turn-goals", "90", "200"], ["--turn-goals", "-1", "10"]):
+        assert main(["--agent", "point", "--evaluate", "point", "--chain", "3", *args]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "--turn-goals" in err
+    assert main(["--agent", "point", "--evaluate", "point", "--turn-goals", "45", "180"]) == 2
+    assert "needs --chain" in capsys.readouterr().err
+
+
+def test_turn_goals_reach_the_training_env_and_refuse_a_maze(tmp_path):
+    trainer = Trainer(make_config("point", frames=2048, seed=0, goals_per_episode=3, turn_goals=(45, 180)),
+                      tmp_path / "turn", progress=False)
+    assert trainer.env.turn == (45.0, 180.0)
+    assert Trainer(make_config("point", frames=2048, seed=0), tmp_path / "plain", progress=False).env.turn is None
+    with pytest.raises(SpecrefineError, match="open floor"):
+        make_config("point", turn_goals=(45, 180), train_maze="random:3x3:0")
+
+
+def test_sampled_training_goal_points_need_a_training_maze(tmp_path, capsys):
+    out = tmp_path / "open"
+    assert main(["--agent", "point", "--out", str(out), "--train-goal-points", "sampled"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "needs --train-maze" in err and not out.exists()
+    cfg = make_config("point", train_maze="random:3x3:0", train_goal_points="sampled", goals_per_episode=4)
+    assert Trainer(cfg, tmp_path / "walls", progress=False).env.goal_points == "sampled"

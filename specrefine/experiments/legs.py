@@ -11,6 +11,10 @@ Leg profiles (``--profiles RUN/result.json ... --out FILE.json``): each run's me
 episodes that started the leg) beside the search's estimate of that leg, small enough to ship, and
 ``profile_table`` on them: whether the lost episodes spread over every leg or gather on a few, and ``turn_table``:
 the legs that turn against the straight ones, lost episodes pooled over the runs.
+
+Leg kinds of re-run paths (``--failures FILE.json ...``, the reports of ``python -m specrefine.experiments.failures``):
+flips, wall contacts (avoid) and timeouts per kind of leg (first, straight, turning at 45 degrees or more), pooled over
+the files, with the walls (``kind_table``).
 """
 import json
 import re
@@ -118,6 +122,35 @@ def turn_table(profiles) -> str:
     return "\n".join(lines)
 
 
+KIND_HEADER = ("| legs | count | episodes started | flipped | avoid | timeout | failure per leg [95 % CI] |\n"
+               "|---|---|---|---|---|---|---|")
+
+
+def kind_table(reports, variant: str = "walls") -> str:
+    """Lost episodes of re-run paths (``failures`` reports) pooled by the kind of leg, split by how they ended."""
+    pooled_by: dict[str, dict[str, int]] = {}
+    for report in reports:
+        try:
+            rows = zip(report["legs"], report[variant]["per_leg"], strict=True)
+            for leg, row in rows:
+                acc = pooled_by.setdefault(turn_kind(leg["turn_deg"]), dict.fromkeys(
+                    ("count", "started", "flipped", "avoid", "timeout"), 0))
+                acc["count"] += 1
+                for key in ("started", "flipped", "avoid", "timeout"):
+                    acc[key] += int(row[key])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise SpecrefineError(f"not a failures report with per-leg counts ({type(exc).__name__}: {exc})") from None
+    lines = [KIND_HEADER]
+    for kind in ("first leg", "straight", "turning"):
+        if kind in pooled_by:
+            acc = pooled_by[kind]
+            lost = acc["flipped"] + acc["avoid"] + acc["timeout"]
+            lo, hi = wilson_ci(lost, acc["started"])
+            lines.append(f"| {kind} | {acc['count']} | {acc['started']:,} | {acc['flipped']} | {acc['avoid']} | "
+                         f"{acc['timeout']} | {lost / acc['started']:.4f} [{lo:.4f}, {hi:.4f}] |")
+    return "\n".join(lines)
+
+
 def worst_share(failures, share: float = 0.2) -> float:
     """The part of the summed per-leg failure that the worst ``share`` of the legs carry."""
     ordered = sorted(failures, reverse=True)
@@ -151,6 +184,8 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles", action="store_true", help="the inputs are result.json files: write their leg "
                                                             "profiles to --out and print profile_table")
     ap.add_argument("--out", help="with --profiles: the JSON file to write")
+    ap.add_argument("--failures", action="store_true", help="the inputs are reports of experiments.failures: print "
+                                                            "their lost episodes by kind of leg (kind_table)")
     ap.add_argument("--turns", action="store_true", help="with --profiles: also print the lost episodes pooled by "
                                                          "straight and turning legs")
     args = ap.parse_args(argv)
@@ -159,6 +194,16 @@ def main(argv=None) -> int:
     try:
         if args.out:
             output_file(args.out)  # before reading the inputs
+        if args.failures:
+            reports = []
+            for path in args.tables:
+                try:
+                    with open(path) as fh:
+                        reports.append(json.load(fh))
+                except (OSError, ValueError) as exc:
+                    raise SpecrefineError(f"{path}: not a readable JSON report ({type(exc).__name__})") from None
+            print(kind_table(reports))
+            return 0
         if args.profiles:
             profiles = [leg_profile(read_result(path)) for path in args.tables]
             if args.out:

@@ -15,9 +15,10 @@ from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
 from ..core.agents import ReachTask, get_agent
+from ..core.errors import SpecrefineError
 from ..core.mazes import Maze
 from ..core.regions import CompiledRegion
-from .simulator import BatchedSim, contact_margin, sample_goals
+from .simulator import BatchedSim, contact_margin, direction_of_travel, sample_goals, sample_turn_goals
 
 
 class GoalReachEnv(EnvBase):
@@ -36,11 +37,24 @@ class GoalReachEnv(EnvBase):
     going back unless it ends; touching a wall (closer than the evaluator's clearance, the body radius plus MuJoCo's
     contact margin) ends the episode with ``task.wall_penalty``. The policy's observation stays as it is: the walls
     are in the physics only.
+
+    ``goal_points`` = "sampled" (with ``maze``): each goal is a uniform point of the neighbouring cell at least the
+    clearance from its walls instead of its centre, as the sampled goal-point rule aims, some of them by a wall.
+
+    ``turn`` = (lo, hi) degrees (open floor only): every chained goal after the first turns by lo-hi degrees from the
+    direction the agent travels when it switches (``simulator.sample_turn_goals``), at whatever speed it has: the
+    goal switches where the U-chain paths lose most episodes (issue 42).  The first goal of an episode stays uniform.
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None,
-                 frame: str = "world", maze: Maze | None = None):
+                 frame: str = "world", maze: Maze | None = None, turn: tuple[float, float] | None = None,
+                 goal_points: str = "centre"):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
+        if turn is not None and maze is not None:
+            raise SpecrefineError("turning goals (--turn-goals) are drawn on the open floor: not with --train-maze")
+        if goal_points not in ("centre", "sampled") or (goal_points == "sampled" and maze is None):
+            raise SpecrefineError(f"training goal points {goal_points!r}: 'centre', or 'sampled' with --train-maze")
+        self.turn, self.goal_points = turn, goal_points
         self.maze = None if maze is None else maze.for_agent(agent)
         self.sim = BatchedSim(agent, self.maze, n, nthread=nthread)
         if self.maze is not None:
@@ -93,20 +107,28 @@ class GoalReachEnv(EnvBase):
             self.cell[idx] = self.came_from[idx] = self._free[self.rng.integers(len(self._free), size=len(idx))]
             self.sim.reset(xy=self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2),
                            rng=self.rng, idx=idx)
-        self._new_goals(idx)
+        self._new_goals(idx, chained=False)
         self.t[idx] = 0
         self.goal_index[idx] = 0
         return self.sim.observe(self.goals, self.frame)
 
-    def _new_goals(self, idx: np.ndarray) -> None:
-        """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are."""
+    def _new_goals(self, idx: np.ndarray, chained: bool = True) -> None:
+        """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are;
+        ``chained``: a switch within the episode (turning with ``turn``), not its first goal."""
         task = self.task
-        if self.maze is None:
+        if self.maze is None and chained and self.turn is not None:
+            xy = self.sim.xy[idx]
+            travel = direction_of_travel(self.sim.qvel[idx, :2], self.goals[idx] - xy)
+            self.goals[idx] = sample_turn_goals(xy, travel, task.goal_min, task.goal_max, self.turn, self.rng)
+        elif self.maze is None:
             self.goals[idx] = sample_goals(self.sim.xy[idx], task.goal_min, task.goal_max, self.rng)
         else:
             for i in idx:
                 self.came_from[i], self.cell[i] = self.cell[i].copy(), self._next_cell(self.cell[i], self.came_from[i])
             self.goals[idx] = self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2)
+            if self.goal_points == "sampled":  # within the cell, never closer to a wall than the clearance
+                half = self.maze.cell_size / 2 - self.clearance
+                self.goals[idx] += self.rng.uniform(-half, half, size=(len(idx), 2))
         self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
         if task.goal_radius is not None:
             self.radius[idx] = self.rng.uniform(*task.goal_radius, size=len(idx))

@@ -280,3 +280,21 @@ def sample_goals(xy: np.ndarray, lo: float, hi: float, rng: np.random.Generator)
     r = rng.uniform(lo, hi, size=len(xy))
     a = rng.uniform(-np.pi, np.pi, size=len(xy))
     return xy + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
+def sample_turn_goals(xy: np.ndarray, travel: np.ndarray, lo: float, hi: float, turn_deg: tuple[float, float],
+                      rng: np.random.Generator) -> np.ndarray:
+    """Goals at a uniform distance in [lo, hi] from each row of ``xy``, in a direction that turns by a uniform
+    angle in ``turn_deg`` (degrees, either side at random) from that row's ``travel`` direction (any nonzero
+    vector; a zero row counts as heading east): the goal switches of a path that turns."""
+    r = rng.uniform(lo, hi, size=len(xy))
+    turn = np.radians(rng.uniform(*turn_deg, size=len(xy))) * rng.choice((-1.0, 1.0), size=len(xy))
+    a = np.arctan2(travel[:, 1], travel[:, 0]) + turn  # arctan2(0, 0) = 0: east
+    return xy + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
+def direction_of_travel(velocity: np.ndarray, fallback: np.ndarray, min_speed: float = 0.2) -> np.ndarray:
+    """Each row's planar ``velocity``, or ``fallback`` (e.g. towards the goal just reached) where the agent moves
+    slower than ``min_speed`` m/s, whose velocity says little about where it is going."""
+    slow = np.linalg.norm(velocity, axis=1) < min_speed
+    return np.where(slow[:, None], fallback, velocity)

@@ -41,6 +41,7 @@ from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
 from .ppo import ClipPPO, add_advantages
 from .reach_env import GoalReachEnv
+from .switching import AT_REGION, SWITCHING
 
 __all__ = ["PPO_DIAGNOSTICS", "Config", "Trainer", "config_arguments", "explained_variance", "make_config", "main",
            "make_modules", "train",
@@ -94,6 +95,13 @@ class Config:
                                         "are neighbouring cells' centres (default: the open floor)")
     wall_penalty: float | None = knob(None, "with --train-maze: touching a wall ends the episode with this "
                                             "penalty (default: the agent's task)")
+    train_goal_points: str = knob("centre", "with --train-maze: each goal at the neighbouring cell's 'centre' or "
+                                            "'sampled', a uniform point of it at least the body's clearance from "
+                                            "its walls (as the sampled goal-point rule aims: some by a wall)")
+    turn_goals: tuple[float, float] | None = knob(None, "open floor, chained goals: every goal after an episode's "
+                                                        "first turns by LO-HI degrees (either side) from the "
+                                                        "direction of travel at the switch; with --evaluate --chain: "
+                                                        "the same for the evaluated goals (default: any direction)")
 
     @property
     def frames_per_batch(self) -> int:
@@ -119,6 +127,14 @@ def _radius_range(pair) -> tuple[float, float]:
     return lo, hi
 
 
+def turn_range(pair) -> tuple[float, float]:
+    """``--turn-goals LO HI``: degrees, 0 <= LO <= HI <= 180, else a one-line error."""
+    lo, hi = (float(x) for x in pair)
+    if not 0 <= lo <= hi <= 180:
+        raise SpecrefineError(f"--turn-goals {lo:g} {hi:g}: needs 0 <= LO <= HI <= 180 (degrees)")
+    return lo, hi
+
+
 def config_arguments(parser: argparse.ArgumentParser) -> None:
     """One ``--field-name`` option per :class:`Config` field (except ``agent``), default None = the agent's."""
     types = {"int": int, "float": float, "str": str, "str | None": str, "float | None": float, "int | None": int}
@@ -140,6 +156,14 @@ def make_config(agent: str, **overrides) -> Config:
     cfg = replace(Config(agent=agent), **{**get_agent(agent).train, **overrides})
     if cfg.wall_penalty is not None and cfg.train_maze is None:
         raise SpecrefineError("--wall-penalty needs --train-maze (on the open floor there is no wall to touch)")
+    if cfg.train_goal_points not in ("centre", "sampled"):
+        raise SpecrefineError(f"--train-goal-points {cfg.train_goal_points}: 'centre' or 'sampled'")
+    if cfg.train_goal_points == "sampled" and cfg.train_maze is None:
+        raise SpecrefineError("--train-goal-points sampled needs --train-maze (on the open floor a goal is any point)")
+    if cfg.turn_goals is not None:
+        cfg = replace(cfg, turn_goals=turn_range(cfg.turn_goals))
+        if cfg.train_maze is not None:
+            raise SpecrefineError("--turn-goals draws goals on the open floor: not with --train-maze")
     return cfg
 
 
@@ -208,7 +232,8 @@ class Trainer:
         # the policy first: a bad --observation-frame is one line before the simulator is built
         self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
-                                frame=cfg.observation_frame, maze=training_maze(cfg.train_maze))
+                                frame=cfg.observation_frame, maze=training_maze(cfg.train_maze), turn=cfg.turn_goals,
+                                goal_points=cfg.train_goal_points)
         self.actor, self.critic = make_modules(self.policy, self.env)
         # TorchRL's loss holds the actor's and critic's parameters: its state_dict is a checkpoint's "loss" (every
         # checkpoint so far); the update computes the same loss with ppo.ClipPPO, without its per-call machinery
@@ -371,6 +396,10 @@ def add_arguments(ap) -> None:
     ap.add_argument("--chain", type=bounded_int("chain"), default=None, metavar="K",
                     help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain) "
                          "(default: one goal per episode)")
+    ap.add_argument("--switching", choices=SWITCHING, default=AT_REGION,
+                    help="with --evaluate --chain: when the policy is fed the next goal: at-region (at once) or "
+                         "slow-turn (a fast, turned start brakes first; specrefine.sim.switching) (default: "
+                         "at-region)")
     config_arguments(ap)
 
 
@@ -385,10 +414,14 @@ def run(args, ap) -> int:
     try:
         if args.evaluate and args.chain:
             lo, hi = args.goal_range or (None, None)
-            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed)
+            turn = None if args.turn_goals is None else turn_range(args.turn_goals)
+            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed, turn=turn,
+                                 switching=args.switching)
             print(json.dumps(res))
             return 0
         if args.evaluate:
+            if args.turn_goals is not None:
+                raise SpecrefineError("--turn-goals with --evaluate needs --chain K (a turn needs a goal before it)")
             lo, hi = args.goal_range or (None, None)
             res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=seed)
             print(json.dumps(summary(res)))
