@@ -74,16 +74,19 @@ def test_hold_keeps_the_control_period():
     assert all(np.linalg.norm(a) <= 1.0 + 1e-12 for a in actions)  # the point's unit disc
 
 
-def test_the_object_reproduces_run_compositional_in_this_simulator():
-    """Driven step by step, the object gives the evaluator's own trajectory (scripted policy: bit-exact)."""
+@pytest.mark.parametrize("switching", ["at-region", "slow-turn"])
+def test_the_object_reproduces_run_compositional_in_this_simulator(switching):
+    """Driven step by step, the object gives the evaluator's own trajectory (scripted policy: bit-exact), under
+    either switching rule (slow-turn holds the turn towards the goal at the end of the first leg)."""
     maze = load_maze("u_maze").for_agent("point")
     legs = [(Box(0.0, -1.5, 1.5, 0.5), maze.obstacles, np.array([0.9, -0.6])), (maze.goal, maze.obstacles, None)]
-    ev = Evaluator(maze, "point", PointController(), n=1, seed=3)
+    ev = Evaluator(maze, "point", PointController(), n=1, seed=3, switching=switching)
     run = ev.run_compositional(maze.start, legs, n=1, seed=3)
     rng = np.random.default_rng(3)
     start = ev.spawn_points(maze.start, 1, rng)
     policy = CompositionalPolicy("point", maze, [Leg(str(i), g, a, None if p is None else tuple(p))
-                                                 for i, (g, a, p) in enumerate(legs)], PointController(), ev.horizon)
+                                                 for i, (g, a, p) in enumerate(legs)], PointController(), ev.horizon,
+                                    switching=switching)
     policy.reset(seed=None)
     policy.goal_points[1] = ev.sample_free(maze.goal, 1, rng)[0]  # the evaluator's draw, in its order
     sim = BatchedSim("point", maze, 1)
@@ -116,3 +119,23 @@ def test_refine_writes_a_policy_that_loads(tmp_path, capsys):
         CompositionalPolicy.load(out)
     with pytest.raises(PolicyError, match="no compositional policy"):
         CompositionalPolicy.load(tmp_path)
+
+
+def test_a_run_saves_its_switching_rule_and_official_runs_it(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["refine", "u_maze", "--method", "dirl", "--out", str(out), "--rollouts", "8", "--episodes", "8",
+                 "--switching", "slow-turn"]) == 0
+    assert json.loads((out / "run.json").read_text())["switching"] == "slow-turn"
+    assert json.loads((out / "result.json").read_text())["config"]["switching"] == "slow-turn"
+    data = json.loads((out / POLICY_JSON).read_text())
+    assert data["switching_rule"] == "slow-turn" and CompositionalPolicy.load(out).switching == "slow-turn"
+    capsys.readouterr()
+    assert main(["official", str(out), "--episodes", "2"]) == 0
+    assert "; switching: slow-turn)" in capsys.readouterr().out
+    assert json.loads((out / "official.json").read_text())["settings"]["switching"] == "slow-turn"
+    (out / POLICY_JSON).write_text(json.dumps({**data, "switching_rule": "blend"}))
+    with pytest.raises(PolicyError, match="switching_rule"):
+        CompositionalPolicy.load(out)
+    del data["switching_rule"]  # a policy saved before the rules were named: the paper's
+    (out / POLICY_JSON).write_text(json.dumps(data))
+    assert CompositionalPolicy.load(out).switching == "at-region"

@@ -143,3 +143,42 @@ def test_ours_corrector_runs_end_to_end_and_logs_its_correction(tmp_path):
     assert len(check["probabilities"]) == len(check["path"]) - 1
     assert result.data["method"] == "ours-corrector" and result.data["proposer_calls"] >= 1
     assert result.data["refines_input"] is True
+
+
+# --- the gate (method ours-corrector-gated): the proposer is asked about a leg only with enough fresh failures -----
+ONE_FAILURE = {(3.0, 6.0): 127 / 128}  # the middle leg fails 1 of the 128 fresh rollouts
+THREE_FAILURES = {(3.0, 6.0): 125 / 128}
+
+
+def test_the_gate_asks_nothing_about_a_leg_with_fewer_fresh_failures_than_it_needs():
+    book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
+    _, result = run(LegTable(LUCKY, ONE_FAILURE), book, correct_rollouts=4, correct_min_failures=3)
+    assert book.queries == [(0.0, 10.0)]  # the search's split only
+    assert xs(result) == [0.0, 3.0, 6.0, 10.0]
+    leg = next(s for s in result.steps if s["event"] == "correct-leg")
+    assert leg["tried"] == [] and leg["accepted"] is None
+
+
+def test_the_gate_still_offers_the_bypass_which_asks_nothing():
+    # within reach, S -> 6 and 3 -> G never fail: the bypass over 3 (the first of the two) drops the weak leg
+    book = AnswerBook({(0.0, 10.0): [3, 6]})
+    _, result = run(LegTable(LUCKY, ONE_FAILURE), book, correct_rollouts=4, correct_min_failures=3,
+                    correct_reach=10.0)
+    assert book.queries == [(0.0, 10.0)]
+    assert xs(result) == [0.0, 6.0, 10.0]
+    leg = next(s for s in result.steps if s["event"] == "correct-leg")
+    assert [t["kind"] for t in leg["tried"]] == ["bypass", "bypass"] and leg["accepted"] == "bypass"
+
+
+def test_the_gate_splits_a_leg_with_enough_fresh_failures_as_the_corrector_does():
+    for gate in (1, 3):
+        book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
+        _, result = run(LegTable(LUCKY, THREE_FAILURES), book, correct_rollouts=4, correct_min_failures=gate)
+        assert (3.0, 6.0) in book.queries
+        assert xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]
+
+
+def test_without_the_gate_a_single_fresh_failure_is_split():
+    book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
+    _, result = run(LegTable(LUCKY, ONE_FAILURE), book, correct_rollouts=4)
+    assert (3.0, 6.0) in book.queries and xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]

@@ -107,6 +107,77 @@ def test_the_held_out_grid_is_described_per_maze_and_mix(tmp_path):
     assert study["costs"][0]["evaluations_ratio"] == pytest.approx(1.0)
 
 
+def lay_grid(root, name, rate_of, calls_of=lambda m: 3, seeds=None, part=0, drop=0):
+    """A grid's part table under ``root``: rate_of(maze, method, proposer) per cell (the last ``drop`` rows left
+    out)."""
+    g = GRIDS[name]
+    p = g.parts[part]
+    rows = [row(maze, m, rate_of(maze, m, pr), s, pr) | {"proposer_calls": calls_of(m), "evaluations": 10,
+                                                          "sim_steps": 1000}
+            for maze in (p.mazes or g.mazes) for m in p.methods for pr in p.proposers for s in (p.seeds or g.seeds)]
+    path = root / g.part_table(part)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(path, rows[:len(rows) - drop])
+
+
+LEVER_RATES = {"ours-deeprepair": 0.8, "ours-feasible": 0.6, "ours-checked": 0.97}
+
+
+def test_each_lever_alone_is_compared_with_ours_ours_repair_and_the_corrector_on_its_cells(tmp_path):
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, "corrector-levers", lambda maze, m, p: LEVER_RATES[m])
+    lv = cc.levers_study(tmp_path)
+    by = {(e["proposer"], e["lever"]): e for e in lv["entries"]}
+    deep = by[("imperfect:mild", "ours-deeprepair")]
+    assert deep["runs"] == 16 and deep["success"] == pytest.approx(0.8)
+    assert deep["versus"]["ours"]["estimate"] == pytest.approx(0.2) and cc._helps(deep["versus"]["ours"]) == "helps"
+    assert deep["versus"]["ours-repair"]["estimate"] == pytest.approx(0.1)
+    assert deep["versus"][cc.METHOD]["verdict"] == "lower"
+    feasible = by[("imperfect:moderate", "ours-feasible")]
+    assert "ours-repair" not in feasible["versus"] and cc._helps(feasible["versus"]["ours"]) == "undecided"
+    checked = by[("imperfect:moderate", "ours-checked")]
+    assert checked["versus"][cc.METHOD]["estimate"] == pytest.approx(0.0)
+    assert checked["costs"]["proposer_calls_ratio"] == pytest.approx(1.0)  # 3 calls each, as ours
+    assert checked["same"] == {"ours": 0, cc.METHOD: 16} and feasible["same"]["ours"] == 16
+    text = cc.front(cc.point_study(tmp_path), None, tmp_path, levers=lv)["levers"]
+    assert text.startswith("mild: ours-deeprepair 0.800 (+0.200 [+0.200, +0.200] over ours, helps;")
+    md = "\n".join(cc.levers_markdown(lv))
+    assert "| imperfect:mild | ours-feasible | 16 | 0.600 | +0.000 [+0.000, +0.000] undecided | — |" in md
+    assert md.count("| 1.00x | 16 / 0 |") == 2  # ours-feasible at both presets: ours's success on every cell
+
+
+def test_a_lever_grid_cut_short_is_marked_partial(tmp_path):
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, "corrector-levers", lambda maze, m, p: LEVER_RATES[m], drop=5)
+    lv = cc.levers_study(tmp_path)
+    last = lv["entries"][-1]
+    assert last["versus"]["ours"]["complete"] is False and "partial" in cc._helps(last["versus"]["ours"])
+
+
+@pytest.mark.parametrize("gated, verdict", [(0.96, "holds"), (0.9, "does not hold")])
+def test_the_gated_corrector_is_judged_against_the_corrector_by_its_margin(tmp_path, gated, verdict):
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, "corrector-gated", lambda maze, m, p: gated, calls_of=lambda m: 5)
+    gs = cc.gated_study(tmp_path)
+    v = {e["rule"]: e for e in cc.gated_verdicts(gs)}
+    paired = v[f"{cc.GATED} - {cc.METHOD} (paired, U-chains, mild and moderate): lower end >= -0.02"]
+    assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
+    cost = v[f"{cc.GATED}, imperfect:moderate: cost at most 3.0x ours (proposer calls, evaluations)"]
+    assert cost["value"].startswith("1.67x, 1.00x over 36 pairs") and cost["verdict"] == "holds"
+    assert v[f"{cc.GATED}, imperfect:mild: no run at 0"]["verdict"] == "holds"
+    within = v[f"{cc.GATED}, imperfect:mild: within 0.05 of the oracle on every U-chain"]
+    assert within["verdict"] == ("holds" if gated >= 0.94 else "does not hold")
+    assert gs["held_out"] and not any(e["runs"] for e in gs["held_out"])  # its held-out part has not run
+    assert cc._gated_text(gs).startswith("proposer calls over ours: mild 1.7x (36 pairs); moderate 1.7x (36 pairs)")
+
+
+def test_without_their_tables_the_levers_and_the_gate_are_not_run_yet(tmp_path):
+    lay(tmp_path, rates)
+    assert cc.levers_study(tmp_path) is None and cc.gated_study(tmp_path) is None
+    text = cc.front(cc.point_study(tmp_path), None, tmp_path)
+    assert text["levers"] == text["gated"] == "not run yet"
+
+
 def test_readme_corrector_sentences_are_the_shipped_tables():
     """README's '<!-- front corrector NAME -->' texts, recomputed from the shipped tables; the success curves once
     more with the csv module alone (pooled successes over pooled episodes)."""
@@ -117,8 +188,8 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
 
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
-    assert {"mild", "moderate", "ratio", "held-out", "cost"} <= set(marked)
-    expected = cc.front(cc.point_study(), cc.held_out_study())
+    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated"} <= set(marked)
+    expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))

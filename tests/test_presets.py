@@ -119,4 +119,8 @@ def test_every_run_setting_reaches_a_sweep_cell():
     dests = {action.dest for action in sweep.parser()._actions}
     axes = {"method": "methods", "proposer": "proposers", "seed": "seeds", "spec": "specs"}
     assert [f.name for f in fields(RunConfig) if axes.get(f.name, f.name) not in dests] == []
-    assert sweep.OTHER_SETTINGS == ()  # today every setting has its place in the id, or is checked by sweep.json
+    assert sweep.OTHER_SETTINGS == ("switching",)  # named in the id when not its default; the rest have a place
+    parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers", "geometric",
+                                        "--agent", "ant", "--seeds", "0", "--switching", "slow-turn"])
+    [cell] = sweep.cells_of(parsed)
+    assert cell.config.switching == "slow-turn" and cell.id.endswith("__centre__switching-slow-turn")

@@ -23,10 +23,12 @@ def test_every_field_is_an_option(capsys):
     args = build_parser().parse_args(["refine", "u_maze", "--agent", "point", "--method", "symbolic", "--proposer",
                                       "random", "--spec", "a -> G", "--seed", "4", "--rollouts", "8", "--episodes",
                                       "9", "--policy", "scripted", "-w", "4", "-d", "1", "-k", "6", "--evaluation",
-                                      "adaptive", "--goal-points", "centre", "--preset", "paper"])
+                                      "adaptive", "--goal-points", "centre", "--switching", "slow-turn", "--preset",
+                                      "paper"])
     assert asdict(RunConfig.from_namespace(args)) == dict(
         agent="point", method="symbolic", proposer="random", spec="a -> G", seed=4, rollouts=8, episodes=9,
-        policy="scripted", w=4, d=1, k=6, evaluation="adaptive", goal_points="centre", preset="paper")
+        policy="scripted", w=4, d=1, k=6, evaluation="adaptive", goal_points="centre", switching="slow-turn",
+        preset="paper")
 
 
 def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_path, capsys):

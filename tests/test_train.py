@@ -166,15 +166,14 @@ def test_init_from_a_policy_file_trains_the_fresh_critic_alone_first(tiny_run, t
     assert trainer.env.task.lateral_cost == 0.3 and trainer.env.task.goal_radius == (0.3, 0.6)
     actor = {k: v.clone() for k, v in trainer.policy.net.state_dict().items()}
     critic = [p.detach().clone() for p in trainer.critic.parameters()]
-    batch = next(iter(trainer.collector))
+    batch = trainer.collector.collect()
     trainer.update(batch)  # inside the warm-up: the critic moves, the actor does not
     for k, v in trainer.policy.net.state_dict().items():
         torch.testing.assert_close(v, actor[k], rtol=0, atol=0)
     assert any(not torch.equal(a, b.detach()) for a, b in zip(critic, trainer.critic.parameters()))
     trainer.frames = 2048
-    trainer.update(next(iter(trainer.collector)))  # after it: both
+    trainer.update(trainer.collector.collect())  # after it: both
     assert any(not torch.equal(v, actor[k]) for k, v in trainer.policy.net.state_dict().items())
-    trainer.collector.shutdown()
     with pytest.raises(SpecrefineError, match="a point policy, not one for the ant"):
         Trainer(make_config("ant", frames=2048, init=str(path)), tmp_path / "ft3", progress=False)
 
@@ -215,6 +214,67 @@ def test_a_wall_penalty_without_walls_is_one_line_and_writes_nothing(tmp_path, c
     assert main(["--agent", "point", "--out", str(out), "--wall-penalty", "5"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--wall-penalty needs --train-maze" in err and not out.exists()
+
+
+def test_the_batch_collector_collects_what_torchrl_s_collector_did(tmp_path):
+    """Same seed, same batches (resets included): the lean collector only drops TorchRL's per-step machinery."""
+    from torchrl.collectors import Collector
+
+    from specrefine.sim.collect import BatchCollector
+
+    def trainer():
+        return Trainer(make_config("point", seed=3, num_envs=8, steps_per_env=70, checkpoint_every_s=1e9),
+                       tmp_path / "run", progress=False)
+
+    ref = trainer()  # the old way: TorchRL's Collector on the trainer's env and actor, from the env's first state
+    ref.env.rng = np.random.default_rng(3)
+    torch.manual_seed(11)
+    col = Collector(ref.env, ref.actor, frames_per_batch=8 * 70, total_frames=-1, auto_register_policy_transforms=False)
+    it = iter(col)
+    theirs = [next(it), next(it)]
+    col.shutdown()
+    ours_trainer = trainer()
+    torch.manual_seed(11)
+    ours = [ours_trainer.collector.collect() for _ in range(2)]
+    assert isinstance(ours_trainer.collector, BatchCollector)
+    assert sum(int(b["next", "done"].sum()) for b in ours) > 0  # episodes ended and were reset within the batches
+    for a, b in zip(theirs, ours, strict=True):
+        for key in b.keys(True, True):
+            torch.testing.assert_close(b[key], a[key], rtol=0, atol=0, msg=str(key))
+
+
+@pytest.mark.parametrize("entropy_coef", [0.0, 0.01])
+def test_the_ppo_update_computes_torchrl_s_gae_and_clipped_loss(tmp_path, entropy_coef):
+    from torchrl.objectives.value import GAE
+
+    cfg = make_config("point", seed=4, num_envs=8, steps_per_env=70, entropy_coef=entropy_coef,
+                      checkpoint_every_s=1e9)
+    tr = Trainer(cfg, tmp_path / "run", progress=False)
+    batch = tr.collector.collect()
+    tr.policy.norm.update(batch["observation"])  # a normaliser away from identity, as during training
+    ref = batch.clone()
+    with torch.no_grad():
+        GAE(gamma=cfg.gamma, lmbda=cfg.gae_lambda, value_network=tr.critic, average_gae=False)(ref)
+    from specrefine.sim.ppo import add_advantages
+
+    add_advantages(batch, tr.value, cfg.gamma, cfg.gae_lambda)
+    for key in ("state_value", "advantage", "value_target"):
+        torch.testing.assert_close(batch[key], ref[key], rtol=1e-5, atol=1e-5, msg=key)
+    mb = batch.reshape(-1)[torch.randperm(8 * 70)[:256]]
+    results = []
+    for loss in (tr.loss, tr.ppo):  # TorchRL's, then ours, from the same random state
+        torch.manual_seed(7)
+        out = loss(mb)
+        total = out["loss_objective"] + out["loss_critic"] + out["loss_entropy"]
+        tr.optim.zero_grad()
+        total.backward()
+        grads = [p.grad.clone() for p in tr.loss.parameters()]
+        keys = ("loss_objective", "loss_critic", "loss_entropy", "kl_approx", "clip_fraction", "entropy")
+        results.append(({k: float(out[k].detach()) for k in keys}, grads))
+    (theirs, their_grads), (ours, our_grads) = results
+    assert ours == pytest.approx(theirs, rel=1e-5, abs=1e-6)
+    for a, b in zip(their_grads, our_grads, strict=True):
+        torch.testing.assert_close(b, a, rtol=1e-4, atol=1e-6)
 
 
 def test_turning_chain_evaluation_and_a_bad_turn_range(capsys):

@@ -43,6 +43,8 @@ COMMANDS: dict[str, Command] = {
     "taxonomy": Command("specrefine.experiments.taxonomy", "why runs ended below the oracle: one cause per run"),
     "corrector-claims": Command("specrefine.experiments.corrector_claims",
                                 "the corrector grids' rules decided from their shipped tables"),
+    "corrector-diagnosis": Command("specrefine.experiments.corrector_diagnosis",
+                                   "where ours-corrector still loses and where its proposer calls go"),
     "figures": Command("specrefine.experiments.figures", "the paper's Figures 4-6 from a sweep table"),
     "bench": Command("specrefine.bench.__main__", "throughput benchmarks: evaluator, gymenv, train, refine"),
     "notebook": Command("specrefine.runs.notebook", "executed copies of the numbered notebooks"),

@@ -9,7 +9,10 @@ goal-switching rule of :meth:`specrefine.evaluation.evaluator.Evaluator.run_comp
   ``clearance`` from walls and hazards (``Evaluator.sample_free``, the evaluator's own rule and code);
 * at every decision the agent's position is checked first: while it lies in the current leg's goal
   region the policy moves on to the next leg (several at once if the regions overlap); then the goal
-  policy is fed the current leg's goal point (the last leg's once all are done).
+  policy is fed the current leg's goal point (the last leg's once all are done);
+* ``switching`` names when it is fed that point (:mod:`specrefine.sim.switching`): ``at-region`` (the
+  paper's, the default) at once; ``slow-turn`` first holds a leg that starts with the torso moving fast and away
+  from its goal point, feeding the agent's own position until the rule lets go (the evaluator's rule and code).
 
 ``act`` takes a Gymnasium-Robotics maze observation (the dict of ``PointMaze_*-v3`` /
 ``AntMaze_*-v5``): the agent's xy is ``achieved_goal``; ``observation`` is qpos and qvel of the
@@ -41,6 +44,7 @@ from ..core.agents import get_agent
 from ..core.errors import PolicyError, SpecrefineError
 from ..core.mazes import Maze
 from ..core.regions import CompiledRegion, Region, from_dict
+from ..sim.switching import AT_REGION, SWITCHING, switching_rule
 
 FORMAT, VERSION = "specrefine-compositional-policy", 1
 POLICY_JSON = "policy.json"
@@ -61,7 +65,7 @@ class CompositionalPolicy:
     """``reset(observation)`` / ``act(observation) -> action`` along a run's refined path (module docstring)."""
 
     def __init__(self, agent: str, maze: Maze, legs: list[Leg], goal_policy, horizon: int,
-                 env_dt: float | None = None):
+                 env_dt: float | None = None, switching: str = AT_REGION):
         from .evaluator import Evaluator
 
         if not legs:
@@ -69,6 +73,7 @@ class CompositionalPolicy:
         if isinstance(horizon, bool) or not isinstance(horizon, int | np.integer) or horizon < 1:
             raise SpecrefineError(f"horizon {horizon!r:.40}: the decisions per leg must be a whole number >= 1")
         spec = get_agent(agent)
+        self.switching, self._hold = switching, switching_rule(switching)
         self.agent, self.maze, self.legs, self.goal_policy, self.horizon = agent, maze, list(legs), goal_policy, horizon
         self.control_period = spec.timestep * spec.frame_skip
         self.match_env_dt(env_dt)
@@ -99,6 +104,7 @@ class CompositionalPolicy:
         self.goal_points = np.array([leg.point if leg.point is not None else sample(leg.goal, 1, rng)[0]
                                      for leg in self.legs], dtype=float)
         self.leg, self.decisions_in_leg, self._calls, self._action = 0, 0, 0, None
+        self.holding = self._hold is not None  # the switching rule may hold the leg's start (slow-turn)
         if observation is not None:
             self.update(observation)
 
@@ -106,7 +112,7 @@ class CompositionalPolicy:
         """The control for this environment step (a new decision every ``hold`` calls)."""
         if self._calls % self.hold == 0 or self._action is None:
             self.update(observation)
-            goal = self.goal_points[min(self.leg, len(self.legs) - 1)]
+            goal = self._aim(observation, self.goal_points[min(self.leg, len(self.legs) - 1)])
             obs = policy_observation(self.agent, observation, goal, getattr(self.goal_policy, "observation_frame",
                                                                             "world"))
             self._action = self._control(np.asarray(self._act(obs[None]), dtype=np.float64)[0])
@@ -136,6 +142,17 @@ class CompositionalPolicy:
         while not self.done and self._goals[self.leg].contains(point)[0]:
             self.leg += 1
             self.decisions_in_leg = 0
+            self.holding = self._hold is not None
+
+    def _aim(self, observation, goal) -> np.ndarray:
+        """Where the policy aims at this decision: its own position while the switching rule holds the leg's start,
+        else ``goal``."""
+        if not self.holding:
+            return goal
+        xy = agent_xy(observation)
+        self.holding = bool(self._hold.holding(agent_velocity(self.agent, observation)[None], (goal - xy)[None],
+                                               [self.decisions_in_leg])[0])
+        return xy if self.holding else goal
 
     def _act(self, obs):
         return self.goal_policy.act(obs) if hasattr(self.goal_policy, "act") else self.goal_policy(obs)
@@ -165,13 +182,18 @@ class CompositionalPolicy:
         maze = Maze(data["maze"], tuple(data["maze_grid"]), float(data["cell_size"]))
         legs = [Leg(leg["vertex"], from_dict(leg["goal"]), from_dict(leg["avoid"]),
                     None if leg["point"] is None else tuple(float(v) for v in leg["point"])) for leg in data["legs"]]
+        switching = data.get("switching_rule", AT_REGION)  # a policy saved before the rules were named: the paper's
+        if switching not in SWITCHING:
+            raise PolicyError(f"{path}: switching_rule {switching!r:.40} is not one of {', '.join(SWITCHING)}")
         goal_policy = _load_goal_policy(data["agent"], data["goal_policy"])
-        return cls(data["agent"], maze, legs, goal_policy, data["horizon"], env_dt=env_dt)
+        return cls(data["agent"], maze, legs, goal_policy, data["horizon"], env_dt=env_dt, switching=switching)
 
     def to_dict(self, goal_policy_record: dict) -> dict:
         return {"format": FORMAT, "version": VERSION, "agent": self.agent, "maze": self.maze.name,
                 "maze_grid": list(self.maze.grid), "cell_size": self.maze.cell_size, "horizon": self.horizon,
-                "control_period": self.control_period, "clearance": self.clearance, "switching": SWITCHING_RULE,
+                "control_period": self.control_period, "clearance": self.clearance,
+                "switching": SWITCHING_RULE if self._hold is None else f"{SWITCHING_RULE}; {self._hold.describe()}",
+                "switching_rule": self.switching,
                 "legs": [{"vertex": leg.vertex, "goal": leg.goal.to_dict(), "avoid": leg.avoid.to_dict(),
                           "point": None if leg.point is None else list(leg.point)} for leg in self.legs],
                 "goal_policy": goal_policy_record}
@@ -193,7 +215,8 @@ def save_run_policy(run_dir, maze: Maze, agent: str, graph, path: list[str], eva
     points = [aim(graph.region(v), graph.goal_point(v)) for v in path[1:]]
     legs = [Leg(v, graph.region(v), graph.avoid(u, v), None if p is None else tuple(float(x) for x in p))
             for u, v, p in zip(path, path[1:], points, strict=False)]
-    policy = CompositionalPolicy(agent, maze, legs, evaluator.policy, int(evaluator.horizon))
+    policy = CompositionalPolicy(agent, maze, legs, evaluator.policy, int(evaluator.horizon),
+                                 switching=getattr(evaluator, "switching", AT_REGION))
     data = policy.to_dict(record) | {"path": list(path)}
     from ..core.runfolder import write_atomic
 
@@ -246,6 +269,17 @@ def agent_xy(observation) -> np.ndarray:
     if xy.size != 2:
         raise SpecrefineError(f"an observation's achieved_goal is the agent's (x, y), got {xy.size} values")
     return xy.reshape(2)
+
+
+def agent_velocity(agent: str, observation) -> np.ndarray:
+    """The agent's planar velocity (vx, vy) from a Gymnasium-Robotics maze observation: the point mass's qvel, the
+    Ant's free joint's linear velocity (world frame, as ``BatchedSim.qvel[:, :2]``)."""
+    spec = get_agent(agent)
+    body = _finite(observation, "observation")
+    start = 2 if spec.planar else body.size - spec.act_dim - 6  # after qpos (without x, y)
+    if body.size < start + 2:
+        raise SpecrefineError(f"an {agent} observation has no velocity: {body.size} values")
+    return body[start:start + 2]
 
 
 def _finite(observation, key: str) -> np.ndarray:

@@ -11,7 +11,10 @@ point sampled uniformly from ``goal`` per rollout, at least ``clearance`` from w
 region allows (the paper's "representative waypoint randomly sampled from the inclusion set of the
 subtask's goal vertex"; ``goal_points="sampled"``), or with ``goal_points="centre"`` the goal region's centre in
 every rollout (beyond the paper: the policy's legs between sampled points are longer and more varied than the
-legs it then runs; :meth:`Evaluator.aim`).  :class:`EvaluationFacts` says the rule in words for the VLM.
+legs it then runs; :meth:`Evaluator.aim`).  ``switching`` names when the policy is fed a leg's goal point
+(:mod:`specrefine.sim.switching`): ``at-region`` (the paper's: as soon as the leg starts) or ``slow-turn``
+(beyond the paper: a leg that starts with the torso moving fast and away from its goal first brakes).
+:class:`EvaluationFacts` says the rule in words for the VLM.
 
 All ``n`` rollouts of a call (of every uncached subtask of an ``evaluate_many`` call) run in one
 :class:`~specrefine.sim.simulator.BatchedSim` (one per batch size, built lazily and reused); a rollout that
@@ -26,8 +29,8 @@ compaction of finished rollouts), thread count or CPU, the same successes (barri
 ends within rounding of a boundary), with floats equal to a tolerance. Results are cached in memory
 and, with ``cache_dir``, on disk: one compressed ``.npz`` per entry, named by the SHA-256 of the
 canonical JSON key (start distribution, goal, avoid, goal point, policy fingerprint, n, horizon,
-seed, agent, maze, clearance, code version), written atomically (a run interrupted midway keeps
-every entry it finished); an unreadable or mismatching entry is ignored with a warning and
+seed, agent, maze, clearance, switching rule unless ``at-region``, code version), written atomically (a run
+interrupted midway keeps every entry it finished); an unreadable or mismatching entry is ignored with a warning and
 recomputed.
 
 ``run_compositional`` runs a compositional policy (a sequence of legs, the goal switching when a
@@ -58,6 +61,7 @@ from ..core.results import (
     unreached,
     wilson_ci,
 )
+from ..sim.switching import AT_REGION, switching_rule
 from .cache import ResultCache
 from .rollouts import Controls, Plan, RolloutLoop, rows_stepped
 
@@ -119,13 +123,15 @@ class Evaluator:
 
     def __init__(self, maze: Maze, agent: str, policy, n: int = PAPER.rollouts, horizon: int | None = None,
                  seed: int = 0, cache_dir=None, nthread: int | None = None,
-                 goal_points: str = PAPER.goal_points):
+                 goal_points: str = PAPER.goal_points, switching: str = AT_REGION):
         from ..sim.simulator import build_model, contact_margin, footprint_radius
 
         spec = get_agent(agent)
         if goal_points not in GOAL_POINTS:
             raise SpecrefineError(f"goal points {goal_points!r}: expected one of {', '.join(GOAL_POINTS)}")
         self.goal_points = goal_points
+        self.hold = switching_rule(switching)  # checks the name
+        self.switching = switching
         if abs(maze.cell_size - spec.cell_size) > 1e-9:
             raise SpecrefineError(f"maze {maze.name!r} has cell size {maze.cell_size:g} m but the {agent} uses "
                                   f"{spec.cell_size:g} m: pass maze.for_agent({agent!r})")
@@ -264,6 +270,8 @@ class Evaluator:
                 "start": start_key, "legs": legs_key, "policy": fp, "n": int(n), "horizon": self.horizon,
                 "seed": seed if isinstance(seed, int) else repr(seed), "r": self.clearance,
                 "spawn": self.spawn_radius}
+        if self.switching != AT_REGION:  # at-region keeps the keys it always had: its caches stay valid
+            body["switching"] = self.switching
         text = json.dumps(body, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:40], text
 
@@ -278,7 +286,8 @@ class Evaluator:
     def fresh_copy(self, cache_dir=None) -> Evaluator:
         """The same evaluator (maze, agent, policy, n, horizon, seed) with zero counters and its own cache."""
         return Evaluator(self.maze, self.agent, self.policy, n=self.n, horizon=self.horizon, seed=self.seed,
-                         cache_dir=cache_dir, nthread=self.nthread, goal_points=self.goal_points)
+                         cache_dir=cache_dir, nthread=self.nthread, goal_points=self.goal_points,
+                         switching=self.switching)
 
     def evaluate_many(self, subtasks, seed=None, n: int | None = None) -> list[EdgeResult]:
         """``evaluate`` for each ``(start, goal, avoid, goal_point)``; the uncached ones are simulated together.
@@ -337,8 +346,8 @@ class Evaluator:
         """Run the compositional policy: legs ``[(goal, avoid, goal_point | None), ...]`` end to end.
 
         Each episode starts in ``start`` and pursues leg 0's goal point; on reaching a leg's goal region it
-        switches to the next leg (fresh ``horizon`` steps per leg).  It fails on entering the current leg's
-        avoid set, flipping, or running out of a leg's horizon.
+        switches to the next leg (fresh ``horizon`` steps per leg; its goal point fed as ``switching`` says).  It
+        fails on entering the current leg's avoid set, flipping, or running out of a leg's horizon.
         """
         n = int(n or self.n)
         seed = self.seed if seed is None else seed
@@ -406,7 +415,8 @@ class Evaluator:
         if sim.n > N:  # padding rows: copies of row 0, never checked
             sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
         plan = Plan(first, n_legs, goal_pts, goal_id, avoid_id, goals, avoids)
-        controls = Controls(self._act, self.observation_frame, self.sim, self.horizon, self.clearance, self.MIN_BATCH)
+        controls = Controls(self._act, self.observation_frame, self.sim, self.horizon, self.clearance, self.MIN_BATCH,
+                            self.hold)
         loop = RolloutLoop(plan, sim, controls).run()
         self.sim_steps += loop.sim_steps
         return loop.outputs()

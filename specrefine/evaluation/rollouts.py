@@ -7,7 +7,8 @@ of control steps. It fails on touching the leg's avoid set (``avoid.below(xy, cl
 out of the leg's horizon. A finished episode is frozen (zero action, no more checks, its trajectory padded with
 its last point). When at most half of the rows still run, the running ones are moved (full physics states,
 bit-exact) into a smaller BatchedSim (a power of two, at least ``min_batch``), so finished rollouts stop costing
-physics.
+physics. With a switching rule that holds (``Controls.hold``: :mod:`specrefine.sim.switching`'s ``slow-turn``), an
+episode at the start of a leg aims at its own position while the rule holds it, then at the leg's goal point.
 """
 
 from __future__ import annotations
@@ -46,7 +47,9 @@ class Plan:
 @dataclass(frozen=True)
 class Controls:
     """How it runs: ``act(obs)`` the policy, ``frame`` its observation frame, ``sim_of(size)`` the BatchedSim of
-    that many rows (for compaction), ``horizon`` control steps per leg, ``clearance`` the avoid test's distance."""
+    that many rows (for compaction), ``horizon`` control steps per leg, ``clearance`` the avoid test's distance,
+    ``hold`` the switching rule's hold at a leg's start (:func:`specrefine.sim.switching.switching_rule`; None:
+    ``at-region``)."""
 
     act: object
     frame: str
@@ -54,6 +57,7 @@ class Controls:
     horizon: int
     clearance: float
     min_batch: int
+    hold: object = None
 
 
 class RolloutLoop:
@@ -72,6 +76,7 @@ class RolloutLoop:
         self.active = np.ones(N, dtype=bool)
         self.lengths = np.full(N, self.T, dtype=np.int64)
         self.outcome = np.full(N, UNFINISHED, dtype=np.int8)
+        self.holding = np.full(N, controls.hold is not None)  # braking at the start of its leg (slow-turn)
         self.end_states = np.zeros((N, sim.state_dim))
         self.end_xy = np.zeros((N, 2))
         self.episode = np.concatenate([np.arange(N), np.full(sim.n - N, -1)])  # episode of each sim row (-1: padding)
@@ -135,6 +140,7 @@ class RolloutLoop:
             g = idx[reached]
             self.leg[g] += 1
             self.t_leg[g] = 0
+            self.holding[g] = self.c.hold is not None
             done = g[self.leg[g] == self.L_of[g]]
             if len(done):
                 self.outcome[done] = SUCCESS
@@ -171,7 +177,10 @@ class RolloutLoop:
         sim, episode, p = self.sim, self.episode, self.plan
         live = episode >= 0
         ep = np.where(live, episode, episode[0])
-        obs = sim.observe(p.goal_points[np.minimum(self.leg[ep], self.L_of[ep] - 1), ep], self.c.frame)
+        goals = p.goal_points[np.minimum(self.leg[ep], self.L_of[ep] - 1), ep]
+        if self.c.hold is not None:
+            self._hold(goals, ep, live)
+        obs = sim.observe(goals, self.c.frame)
         act = np.asarray(self.c.act(obs), dtype=np.float64)
         if not np.isfinite(act).all():  # MuJoCo would warn per step and write MUJOCO_LOG.TXT into the cwd
             raise PolicyError("the policy acts with NaN or infinite values on these observations: "
@@ -182,6 +191,16 @@ class RolloutLoop:
         self.padding_steps += int((~live).sum())
         self.xy[episode[live]] = sim.xy[live]
         self.flipped[episode[live]] = sim.flipped[live]
+
+    def _hold(self, goals: np.ndarray, ep: np.ndarray, live: np.ndarray) -> None:
+        """The rows still held at their leg's start (the switching rule) aim at their own position (in ``goals``)."""
+        rows = np.flatnonzero(live & self.holding[ep])
+        if not len(rows):
+            return
+        xy, episodes = self.sim.xy[rows], ep[rows]
+        still = self.c.hold.holding(self.sim.qvel[rows, :2], goals[rows] - xy, self.t_leg[episodes])
+        self.holding[episodes] = still
+        goals[rows[still]] = xy[still]
 
     def _task_output(self, rows: slice, steps: int) -> dict:
         lengths = self.lengths[rows]

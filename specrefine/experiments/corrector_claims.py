@@ -3,9 +3,10 @@
     specrefine corrector-claims --out data/results/corrector
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
-and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``ant-corrector`` with the Ant
-scaling grid's one-shot; writes claims.md and claims.json (every rule with its estimate, interval and verdict, every
-cell counted) and rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
+and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
+alone), ``corrector-gated`` (ours-corrector-gated) and ``ant-corrector`` with the Ant scaling grid's one-shot;
+writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
+rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
 marked partial.
 """
 
@@ -26,6 +27,9 @@ from . import comparison as cmp
 from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
 
 METHOD = "ours-corrector"
+LEVERS = ("ours-deeprepair", "ours-feasible", "ours-checked")
+GATED = "ours-corrector-gated"
+NON_INFERIORITY = 0.02  # ours-corrector-gated - ours-corrector: the interval's lower end at or above -this
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -176,6 +180,75 @@ def ant_study(root: Path = ROOT) -> dict | None:
             "zero": zero_runs(rows, METHOD, proposer, SCALING_MAZES)}
 
 
+def levers_study(root: Path = ROOT) -> dict | None:
+    """Each lever alone against ours (and ours-repair for the deep repair) and against ours-corrector on the
+    corrector-levers grid's cells: pooled success, paired difference (bootstrap over cells), cost."""
+    grid = GRIDS["corrector-levers"]
+    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + grid.tables, root)
+    if not any(r["method"] in LEVERS for r in rows):
+        return None
+    cells, failed = cmp.table_cells(rows, "point")
+    entries = []
+    for proposer in grid.proposers:
+        for lever in LEVERS:
+            references = ("ours",) + (("ours-repair",) if lever == "ours-deeprepair" else ()) + (METHOD,)
+            k, n, runs = pooled(rows, grid.mazes, lever, proposer, grid.seeds)
+            entries.append({"proposer": proposer, "lever": lever, "runs": runs, "success": k / n if n else math.nan,
+                            "versus": {ref: cmp.paired_difference(cells, failed, proposer, lever, ref, grid.seeds,
+                                                                  grid.mazes) for ref in references},
+                            "same": {ref: same_cells(cells, proposer, lever, ref, grid.mazes, grid.seeds)
+                                     for ref in references},
+                            "costs": costs(rows, proposer, grid.mazes, grid.seeds, first=lever)})
+    return {"mazes": list(grid.mazes), "seeds": list(grid.seeds), "entries": entries,
+            "n_expected": len(grid.mazes) * len(grid.seeds)}
+
+
+def same_cells(cells, proposer, first, second, mazes, seeds) -> int:
+    """Cells where both ran with the same success (the lever never acted: its code path is the reference's)."""
+    pairs = [(cells.get((m, first, proposer, s)), cells.get((m, second, proposer, s))) for m in mazes for s in seeds]
+    return sum(1 for a, b in pairs if a is not None and a == b)
+
+
+def pooled(rows, mazes, method, proposer, seeds) -> tuple[int, int, int]:
+    """(successes, episodes, runs) of ``method`` over ``mazes``, pooled."""
+    counts = [episodes_of(rows, maze, method, proposer, seeds) for maze in mazes]
+    return tuple(sum(c[i] for c in counts) for i in range(3))
+
+
+def gated_study(root: Path = ROOT) -> dict | None:
+    """ours-corrector-gated by the rules of docs/corrector.md, 'A gate on the correction'."""
+    grid = GRIDS["corrector-gated"]
+    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + (grid.table,), root)
+    if not any(r["method"] == GATED for r in rows):
+        return None
+    cells, failed = cmp.table_cells(rows, "point")
+    presets = ("imperfect:mild", "imperfect:moderate")
+    both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in presets}
+    both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in presets}
+    study = {"per_maze": [], "rooms": [], "zero": [], "costs": [], "corrector_costs": [],
+             "versus_corrector": cmp.paired_difference(both, both_failed, "both", GATED, METHOD, POINT_SEEDS,
+                                                       [f"{maze} {p}" for p in presets for maze in SCALING_MAZES])}
+    for proposer in presets:
+        study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=GATED)
+        study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, GATED, POINT_SEEDS))
+        study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, GATED, proposer, SCALING_MAZES)})
+        study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=GATED))
+        study["corrector_costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS))
+    study["held_out"] = gated_held_out(root)
+    return study
+
+
+def gated_held_out(root: Path = ROOT) -> list[dict]:
+    rows = load(GRIDS["corrector-held-out"].tables + (GRIDS["corrector-gated"].part_table(1),), root)
+    mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
+    out = []
+    for mix in HELD_OUT_MIXES:
+        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=(METHOD, "*"), method=GATED):
+            k, n, _ = episodes_of(rows, e["maze"], "ours", mix, HELD_OUT_SEEDS)
+            out.append(e | {"mix": MIX_NAMES[mix], "ours": k / n if n else math.nan})
+    return out
+
+
 def _num(x, fmt="{:.3f}") -> str:
     return "—" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
 
@@ -251,7 +324,8 @@ def _verdict(ok: bool, complete: bool) -> str:
     return ("holds" if ok else "does not hold") + ("" if complete else " (partial)")
 
 
-def markdown(point: dict, ant: dict | None, held_out: dict | None = None) -> str:
+def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
+             gated: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -309,7 +383,90 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None) -> str
             lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} |")
         lines += ["", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+    if levers:
+        lines += levers_markdown(levers)
+    if gated:
+        lines += gated_markdown(gated)
     return "\n".join(lines) + "\n"
+
+
+def _helps(entry: dict) -> str:
+    """The lever-alone rule's word for a paired difference against the method without it."""
+    word = {"higher": "helps", "lower": "hurts"}.get(entry["verdict"], "undecided")
+    return word + ("" if entry["complete"] else f" (partial: {entry['n_cells']} of {entry['n_expected']} cells)")
+
+
+def _sided(entry: dict) -> str:
+    return entry["verdict"] + ("" if entry["complete"] else f" (partial: {entry['n_cells']} of "
+                                                             f"{entry['n_expected']} cells)")
+
+
+def levers_markdown(lv: dict) -> list[str]:
+    lines = ["", f"Each lever alone (grid `corrector-levers`: {', '.join(lv['mazes'])}, seeds {lv['seeds']}): pooled "
+             "success, and the paired difference lever - reference over the same cells (95 % bootstrap over cells); "
+             "against the method without the lever: helps above 0, hurts below, else undecided.", "",
+             "| proposer | lever | runs | success | - ours | - ours-repair | - ours-corrector | proposer calls / ours "
+             "| cells with the same success as ours / ours-corrector |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for e in lv["entries"]:
+        v = e["versus"]
+        repair = f"{_signed(v['ours-repair'])} {_helps(v['ours-repair'])}" if "ours-repair" in v else "—"
+        lines.append(f"| {e['proposer']} | {e['lever']} | {e['runs']} | {_num(e['success'])} | "
+                     f"{_signed(v['ours'])} {_helps(v['ours'])} | {repair} | {_signed(v[METHOD])} {_sided(v[METHOD])}"
+                     f" | {_num(e['costs']['proposer_calls_ratio'], '{:.2f}x')} | {e['same']['ours']} / "
+                     f"{e['same'][METHOD]} |")
+    return lines
+
+
+def gated_verdicts(gs: dict) -> list[dict]:
+    """The rules of docs/corrector.md, 'A gate on the correction'."""
+    out = []
+    for c in gs["costs"]:
+        ratios = f"{_num(c['proposer_calls_ratio'], '{:.2f}x')}, {_num(c['evaluations_ratio'], '{:.2f}x')}"
+        out.append({"rule": f"{GATED}, {c['proposer']}: cost at most {COST_CAP}x ours (proposer calls, evaluations)",
+                    "value": f"{ratios} over {c['pairs']} pairs", "verdict": _cost_verdict(c)})
+    v = gs["versus_corrector"]
+    ok = not math.isnan(v["estimate"]) and v["ci_low"] >= -NON_INFERIORITY
+    out.append({"rule": f"{GATED} - {METHOD} (paired, U-chains, mild and moderate): lower end >= -{NON_INFERIORITY}",
+                "value": _paired_text(v), "verdict": _verdict(ok, v["complete"])})
+    for proposer in ("imperfect:mild", "imperfect:moderate"):
+        mazes = [e for e in gs["per_maze"] if e["proposer"] == proposer]
+        within = [e for e in mazes if e["runs"] and e["success"] >= e["reference_success"] - TOLERANCE]
+        complete = all(e["runs"] == len(POINT_SEEDS) for e in mazes)
+        out.append({"rule": f"{GATED}, {proposer}: within {TOLERANCE} of the oracle on every U-chain",
+                    "value": f"{len(within)} of {len(mazes)} mazes", "verdict": _verdict(len(within) == len(mazes),
+                                                                                        complete)})
+        rooms = next(e for e in gs["rooms"] if e["proposer"] == proposer)
+        out.append({"rule": f"{GATED}, {proposer}: flat from 1 to 5 rooms", "value": cmp._interval_text(rooms),
+                    "verdict": rooms["verdict"] + ("" if rooms["complete"] else " (partial)")})
+        zero = next(z for z in gs["zero"] if z["proposer"] == proposer)["runs"]
+        out.append({"rule": f"{GATED}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
+                    "verdict": _verdict(zero[0] == 0, complete)})
+    return out
+
+
+def gated_markdown(gs: dict) -> list[str]:
+    lines = ["", f"`{GATED}` (grid `corrector-gated`; its rules fixed before it ran, docs/corrector.md 'A gate on the "
+             "correction'):", "", "| rule | estimate | verdict |", "|---|---|---|"]
+    lines += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in gated_verdicts(gs)]
+    lines += ["", f"Cost beside {METHOD}'s on the same cells (mean over the mean of ours):", "",
+              "| proposer | method | pairs | evaluations | proposer calls | simulator steps |",
+              "|---|---|---|---|---|---|"]
+    for mine, full in zip(gs["costs"], gs["corrector_costs"]):
+        for name, c in ((GATED, mine), (METHOD, full)):
+            lines.append(f"| {c['proposer']} | {name} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
+                         f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
+    lines += ["", f"Per U-chain: {GATED} vs the oracle, pooled over seeds (Newcombe 95 %).", "",
+              "| proposer | maze | runs | gated | oracle | difference |", "|---|---|---|---|---|---|"]
+    lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
+              f"{_num(e['reference_success'])} | {_diff(e)} |" for e in gs["per_maze"]]
+    if any(e["runs"] for e in gs["held_out"]):
+        lines += ["", f"Held out (descriptive): {GATED} - {METHOD} per layout and mix (Newcombe 95 %), ours beside.",
+                  "", "| mix | maze | runs | gated | ours-corrector | difference | ours |",
+                  "|---|---|---|---|---|---|---|"]
+        lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])}"
+                  f" | {_diff(e)} | {_num(e['ours'])} |" for e in gs["held_out"]]
+    return lines
 
 
 def add_arguments(p) -> None:
@@ -323,10 +480,12 @@ def add_arguments(p) -> None:
 def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
+        levers, gated = levers_study(), gated_study()
         args.out.mkdir(parents=True, exist_ok=True)
-        write_atomic(args.out / "claims.md", markdown(point, ant, held_out))
-        record = {"point": point, "held_out": held_out, "ant": ant, "rules": verdicts(point, ant),
-                  "front": front(point, held_out)}
+        write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated))
+        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated,
+                  "rules": verdicts(point, ant) + (gated_verdicts(gated) if gated else []),
+                  "front": front(point, held_out, levers=levers, gated=gated)}
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
@@ -344,9 +503,11 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
     return sum(d for d, _ in done), sum(t for _, t in done)
 
 
-def front(point: dict, held_out: dict | None, root: Path = ROOT) -> dict[str, str]:
+def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
+          gated: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
-    counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector")}
+    counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
+                                                      "corrector-levers", "corrector-gated")}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -371,6 +532,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT) -> dict[str, st
     out["ratio"] = "; ".join(f"{e['proposer'].split(':')[1]} {cmp._interval_text(e)} ({e['verdict']}{_partial(e)})"
                              for e in ratios)
     out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
+    out["levers"] = _levers_text(levers) if levers else "not run yet"
+    out["gated"] = _gated_text(gated) if gated else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -380,6 +543,34 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT) -> dict[str, st
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
     return out
+
+
+def _levers_text(lv: dict) -> str:
+    parts = []
+    for proposer in dict.fromkeys(e["proposer"] for e in lv["entries"]):
+        here = [e for e in lv["entries"] if e["proposer"] == proposer and e["runs"]]
+        parts.append(f"{proposer.split(':')[1]}: " + ("; ".join(
+            f"{e['lever']} {_num(e['success'])} ({_signed(e['versus']['ours'])} over ours, "
+            f"{_helps(e['versus']['ours'])}; {_signed(e['versus'][METHOD])} against {METHOD}, {_proposer_calls(e)})"
+            for e in here) or "not run yet"))
+    return ". ".join(parts)
+
+
+def _signed(e: dict) -> str:
+    return "—" if math.isnan(e["estimate"]) else f"{e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}]"
+
+
+def _proposer_calls(e: dict) -> str:
+    return f"{_num(e['costs']['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
+
+
+def _gated_text(gs: dict) -> str:
+    v = gs["versus_corrector"]
+    costs = "; ".join(f"{c['proposer'].split(':')[1]} {_num(c['proposer_calls_ratio'], '{:.1f}x')} ({c['pairs']} pairs)"
+                      for c in gs["costs"])
+    ok = not math.isnan(v["estimate"]) and v["ci_low"] >= -NON_INFERIORITY
+    return (f"proposer calls over ours: {costs}; {GATED} - {METHOD} {_signed(v)} over {v['n_cells']} of "
+            f"{v['n_expected']} paired cells (no worse by -{NON_INFERIORITY}: {_verdict(ok, v['complete'])})")
 
 
 def _cost_text(c: dict) -> str:

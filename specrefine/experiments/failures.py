@@ -67,29 +67,33 @@ def leg_table(run, n_legs: int) -> list[dict]:
     return rows
 
 
-def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_points: str | None = None) -> dict:
+def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_points: str | None = None,
+                  switching: str | None = None, walls_only: bool = False) -> dict:
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
 
     ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
     "centre" (each leg aims at the centre of its goal vertex's set; beyond the paper); None: as the run measured
-    it (its configuration's ``goal_points``)."""
+    it (its configuration's ``goal_points``).  ``switching``: the switching rule (``sim.switching``); None: the
+    run's own.  ``walls_only``: the run with the walls alone (no ``no_inner_walls`` entry)."""
     from ..evaluation.evaluator import Evaluator
 
-    exp, graph, path, legs = _path_setup(result, seed, policy, goal_points)
-    agent, goal_points = result["agent"], exp.evaluator.goal_points
+    exp, graph, path, legs = _path_setup(result, seed, policy, goal_points, switching)
+    agent, goal_points, switching = result["agent"], exp.evaluator.goal_points, exp.evaluator.switching
     start = graph.region(path[0])
     centres = path_aims(graph, path)
     turns = turn_angles(centres)
     lengths = [float(np.linalg.norm(np.subtract(centres[k + 1], centres[k]))) for k in range(len(legs))]
     out = {"maze": exp.maze.name, "agent": agent, "seed": seed, "episodes": episodes, "policy": exp.policy_name,
-           "goal_points": goal_points,
+           "goal_points": goal_points, "switching": switching,
            "legs": [{"leg": k, "from": path[k], "to": path[k + 1], "turn_deg": turns[k], "length_m": lengths[k]}
                     for k in range(len(legs))]}
     bare = open_floor(exp.maze)
     variants = {"walls": (exp.evaluator, legs),
                 "no_inner_walls": (Evaluator(bare, agent, exp.policy, n=exp.evaluator.n, seed=seed,
-                                             goal_points=goal_points),
+                                             goal_points=goal_points, switching=switching),
                                    [(goal, bare.walls, point) for goal, _avoid, point in legs])}
+    if walls_only:
+        del variants["no_inner_walls"]
     for name, (evaluator, variant_legs) in variants.items():
         run = evaluator.run_compositional(start, variant_legs, n=episodes, seed=seed)
         counts = Counter(OUTCOMES[o] for o in run.outcome.tolist())
@@ -98,7 +102,7 @@ def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_poin
     return out
 
 
-def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
+def _path_setup(result: dict, seed: int, policy, goal_points: str | None, switching: str | None = None):
     """(experiment, graph, path, legs) of ``result``'s selected path, run as it was measured unless told."""
     from ..core.graph import TaskGraph
     from ..core.tables import goal_points_of
@@ -109,12 +113,14 @@ def _path_setup(result: dict, seed: int, policy, goal_points: str | None):
         raise SpecrefineError("the result has no selected path to re-run (no 'path' or 'graph')")
     if goal_points is None:
         goal_points = goal_points_of(result.get("config") or {})
+    if switching is None:
+        switching = (result.get("config") or {}).get("switching") or "at-region"
     if policy is None:  # the run's own (a run from before the config was recorded: the shipped one)
         policy = (result.get("config") or {}).get("policy") or "shipped"
     rollouts = int((result.get("config") or {}).get("rollouts") or result.get("rollouts_per_evaluation")
                    or PAPER.rollouts)
     exp = setup(result["maze"], agent=result["agent"], seed=seed, policy=policy, goal_points=goal_points,
-                rollouts=rollouts)
+                rollouts=rollouts, switching=switching)
     try:
         graph = TaskGraph.from_dict(result["graph"])
         path, legs = result["path"], path_legs(graph, result["path"])
@@ -153,22 +159,27 @@ def estimates_summary(report: dict) -> str:
 
 def summary(report: dict) -> str:
     lines = [f"{report['maze']} ({report['agent']}, {report['episodes']} episodes, seed {report['seed']}):"]
-    for name in ("walls", "no_inner_walls"):
+    variants = [name for name in ("walls", "no_inner_walls") if name in report]
+    for name in variants:
         r = report[name]
         lo, hi = r["ci"]
         lines.append(f"  {name:15s} success {r['rate']:.3f} [{lo:.3f}, {hi:.3f}]  outcomes {r['outcomes']}")
-    lines.append("  leg  turn  length  failures with walls / without (flipped+avoid+timeout)")
-    for leg, a, b in zip(report["legs"], report["walls"]["per_leg"], report["no_inner_walls"]["per_leg"]):
-        fa, fb = (a["flipped"] + a["avoid"] + a["timeout"]), (b["flipped"] + b["avoid"] + b["timeout"])
+    lines.append("  leg  turn  length  failures " + ("with walls / without" if len(variants) == 2 else "with walls")
+                 + " (flipped+avoid+timeout)")
+    for k, leg in enumerate(report["legs"]):
+        cells = []
+        for name in variants:
+            a = report[name]["per_leg"][k]
+            cells.append(f"{a['flipped'] + a['avoid'] + a['timeout']:3d} ({a['flipped']}+{a['avoid']}+{a['timeout']})")
         turn = "   -" if leg["turn_deg"] is None else f"{leg['turn_deg']:4.0f}"
-        lines.append(f"  {leg['leg']:3d}  {turn}  {leg['length_m']:5.1f}   {fa:3d} ({a['flipped']}+{a['avoid']}+"
-                     f"{a['timeout']}) / {fb:3d} ({b['flipped']}+{b['avoid']}+{b['timeout']})")
+        lines.append(f"  {leg['leg']:3d}  {turn}  {leg['length_m']:5.1f}   {' / '.join(cells)}")
     return "\n".join(lines)
 
 
 def add_arguments(p) -> None:
     from ..core.argtypes import bounded_int, out_path
     from ..evaluation.evaluator import GOAL_POINTS
+    from ..sim.switching import SWITCHING
 
     p.description = __doc__.split("\n\n")[0]
     p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
@@ -180,6 +191,12 @@ def add_arguments(p) -> None:
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
                         "centre: at the set's centre (beyond the paper) (default: as the run measured it)")
+    p.add_argument("--switching", choices=SWITCHING, default=None,
+                   help="at-region: the next goal point as soon as a goal region is entered (the paper's rule); "
+                        "slow-turn: a leg that starts fast and turned away from its goal brakes first (beyond the "
+                        "paper) (default: as the run measured it)")
+    p.add_argument("--walls-only", action="store_true",
+                   help="re-run the path with its walls only, not again with the inner walls removed")
     p.add_argument("--estimates", type=bounded_int("seed"), nargs="+", default=None, metavar="SEED",
                    help="instead of re-running episodes: estimate every leg again along the chain, once per seed "
                         "(default: none: re-run episodes)")
@@ -204,7 +221,7 @@ def run(args, p) -> int:
                 report = leg_estimates({**result, "maze": maze}, args.estimates, args.policy, args.goal_points)
             else:
                 report = path_failures({**result, "maze": maze}, args.episodes, args.seed, args.policy,
-                                       args.goal_points)
+                                       args.goal_points, args.switching, args.walls_only)
             if args.out is not None:
                 write_atomic(args.out, json.dumps(report, indent=1) + "\n")
     except SpecrefineError as e:

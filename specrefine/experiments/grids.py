@@ -359,6 +359,14 @@ GRIDS = {g.name: g for g in (
         seeds=(0, 1, 2, 3), mazes=("u_chain_3", "u_chain_3_subgoals", "u_chain_5", "u_chain_5_subgoals"), workers=1,
         code="722e118", table="data/results/corrector/levers.csv", out="runs/corrector_levers"),
     ExperimentGrid(
+        "corrector-gated", "docs/corrector.md, 'A gate on the correction' (issue 39; fixed 2026-11-27 before it ran)",
+        "point", parts=(Part(("ours-corrector-gated",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                             split="seeds"),
+                        Part(("ours-corrector-gated",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
+                             table="data/results/corrector/gated_held_out.csv", out="held_out")),
+        seeds=(0, 1, 2, 3), workers=1, code="3e309b5", table="data/results/corrector/gated.csv",
+        out="runs/corrector_gated"),
+    ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
         mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",

@@ -15,6 +15,11 @@ search found as a whole, on rollouts the search never saw:
    estimates), and the best replaces the path when its product of leg estimates is higher;
 4. until no leg below 1 is left untried or the correction's budget of proposer splits is spent.
 
+``min_failures`` > 1 (method ``ours-corrector-gated``) asks the proposer about a leg only when at least that many of
+its fresh rollouts failed: a leg losing a fraction of a per cent shows one failure in 128 about as often as a sound
+one, and splitting it spends proposer calls on noise (docs/corrector.md, 'Where the corrector still loses'). Such a
+leg is still offered the bypass, which asks nothing.
+
 Every alternative is a refinement of the same input edge (a longer or shorter chain of waypoints), so the refined
 graph still implies the input graph (Theorem 4.1, checked like every refinement). What the correction sees is what
 a real proposer's reply gives: waypoints, pictures and rollouts.
@@ -58,6 +63,11 @@ def weakest_untried(check: Check, tried: set) -> int | None:
     return min(legs, key=lambda i: (check.probabilities[i], i)) if legs else None
 
 
+def failures(result) -> int:
+    """How many of a leg's rollouts failed."""
+    return result.n - result.successes
+
+
 def _leg_key(check: Check, i: int) -> tuple:
     return tuple(check.path[i:i + 2])
 
@@ -94,7 +104,7 @@ def spliced(graph: TaskGraph, path: list[str], i: int, j: int, waypoints) -> tup
 
 def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
-            log: Callable[..., None]) -> tuple[TaskGraph, list[str], Check]:
+            log: Callable[..., None], min_failures: int = 1) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -110,6 +120,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
         start = graph.region(path[0]) if s == 0 else start_of(check.results[s - 1])
         options = [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
         spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
+        if failures(check.results[leg]) < min_failures:
+            spans = []
         for i, j in spans:
             if not may_split():
                 break

@@ -68,6 +68,7 @@ class SearchConfig:
     correct_splits_per_leg: float = 1.0  # the correction's proposer splits: this many per leg of the found path
     dead_weight: float | None = None  # beyond the paper: the weight of a leg that never succeeded (None: -log(0.5/n))
     correct_reach: float | None = None  # the correction drops a waypoint only where the leg it makes is this short
+    correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -391,7 +392,8 @@ class RefinementSearch:
         self.graph, path, _ = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
                                       seed=self.cfg.seed + CHECK_SEED_OFFSET, split_leg=split_leg,
                                       may_split=lambda: self.splits_generated < budget, reach=reach,
-                                      clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log)
+                                      clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log,
+                                      min_failures=self.cfg.correct_min_failures)
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
         return path

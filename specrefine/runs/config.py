@@ -77,6 +77,12 @@ def _goal_points() -> tuple[str, ...]:
     return GOAL_POINTS
 
 
+def _switching() -> tuple[str, ...]:
+    from ..sim.switching import SWITCHING
+
+    return SWITCHING
+
+
 def policy_arg(text: str) -> str:
     """'shipped', 'scripted' and a shipped checkpoint's name as they are; a path as ``str(Path(text))`` (the form
     run.json records)."""
@@ -120,6 +126,11 @@ class RunConfig:
                                      "the goal region per rollout, the paper's rule) or centre (the goal region's "
                                      "centre in every rollout; beyond the paper)", choices=_goal_points,
                                      shown="the preset's: best: sampled for point, centre for ant; paper: sampled")
+    switching: str = option("at-region", "when a leg's policy is fed the next goal point, in the search, the "
+                                         "measurement, the calibration and the saved policy alike: at-region (on "
+                                         "entering the goal region, the paper's rule) or slow-turn (a leg that starts "
+                                         "with the torso moving fast and turned away from its goal first brakes; "
+                                         "beyond the paper, docs/ant_experiments.md section 6)", choices=_switching)
     preset: str = option("best", "what the settings left unset default to: best (the best measured settings, per "
                                  "agent) or paper (every rule of the paper they depart from: docs/choices.md, "
                                  "'Presets')", choices=lambda: PRESETS)
@@ -144,9 +155,9 @@ class RunConfig:
 
     def record(self) -> dict:
         """What ``run.json`` records of this (resolved) configuration: a rerun into the folder with another record is
-        refused. Derived from the fields, with three rules that keep older folders' records valid: no proposer for a
-        method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not sampled; the preset
-        is not recorded (what it decided is)."""
+        refused. Derived from the fields, with four rules that keep older folders' records valid: no proposer for a
+        method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not sampled,
+        ``switching`` only when not at-region; the preset is not recorded (what it decided is)."""
         from .methods import get_method
 
         data = {k: v for k, v in self.to_dict().items() if k != "preset"}
@@ -156,6 +167,8 @@ class RunConfig:
             del data["evaluation"]
         if data["goal_points"] == PAPER.goal_points:
             del data["goal_points"]
+        if data["switching"] == "at-region":
+            del data["switching"]
         return data
 
     @classmethod

@@ -63,7 +63,7 @@ def load_goal_policy(agent: str, policy="shipped"):
 
 def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int = 0, rollouts: int = PAPER.rollouts,
           policy="shipped", out=None, cache_dir=None, evaluator=None, record_path=None,
-          spec: str | None = None, goal_points: str = PAPER.goal_points) -> Experiment:
+          spec: str | None = None, goal_points: str = PAPER.goal_points, switching: str = "at-region") -> Experiment:
     """Everything an experiment starts from.
 
     maze: a name in ``data/mazes/``, a ``.maze`` path or a :class:`Maze`; agent: a registered agent
@@ -74,7 +74,9 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     building one; record_path: where a ``litellm:`` proposer records its calls; spec: the task as an
     expression over the maze's letters (``"(a | b) -> c -> G"``, see ``specrefine.core.spec.parse_spec``),
     None = the maze's own task (its ``; spec:`` line, else its chain); goal_points: where a leg's policy aims,
-    "sampled" (a point drawn in the goal region per rollout, the paper's rule) or "centre" (``Evaluator.aim``).
+    "sampled" (a point drawn in the goal region per rollout, the paper's rule) or "centre" (``Evaluator.aim``);
+    switching: when a leg's policy is fed its goal point, "at-region" (the paper's) or "slow-turn"
+    (:mod:`specrefine.sim.switching`).
     """
     from ..core.spec import maze_task
     from ..evaluation.evaluator import Evaluator
@@ -89,10 +91,13 @@ def setup(maze, *, agent: str = "point", proposer: str | None = None, seed: int 
     if evaluator is None:
         goal_policy, policy_name = load_goal_policy(agent, policy)
         evaluator = Evaluator(maze, agent, goal_policy, n=rollouts, seed=seed, cache_dir=cache_dir,
-                              goal_points=goal_points)
+                              goal_points=goal_points, switching=switching)
     else:
         if (given := getattr(evaluator, "goal_points", PAPER.goal_points)) != goal_points:
             raise SpecrefineError(f"the evaluator given aims at {given} goal points, the run asks for {goal_points}")
+        if (given := getattr(evaluator, "switching", "at-region")) != switching:
+            raise SpecrefineError(f"the evaluator given switches goals by the {given} rule, the run asks for "
+                                  f"{switching}")
         goal_policy, policy_name = getattr(evaluator, "policy", None), "given with the evaluator"
     chosen = None
     if proposer is not None:

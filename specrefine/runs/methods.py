@@ -201,6 +201,11 @@ register_method("ours-corrector", ours_variant(repair=True, repair_depth=3, dead
                 "edge, then the found path's legs estimated again on 4x fresh rollouts and its weak legs split, "
                 "split over or bypassed while the path gains (refine/correct.py)",
                 colour="#c62828")
+register_method("ours-corrector-gated", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
+                                                     correct_rollouts=4, correct_reach="policy",
+                                                     correct_min_failures=3),
+                "beyond the paper: ours-corrector asking the proposer about a leg of the found path only when at "
+                "least 3 of its 4n fresh rollouts failed (a leg with fewer is only bypassed)", colour="#7f0000")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")

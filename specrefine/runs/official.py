@@ -11,8 +11,9 @@ before the run's own time limit.  AntMaze is made with ``include_cfrc_ext_in_obs
 
 Each episode: ``reset(options={"reset_cell": a start cell S (uniform over them), "goal_cell": the first
 goal cell})`` (the environment adds its own uniform noise of +-0.25 cell to both), then
-:class:`~specrefine.evaluation.compositional.CompositionalPolicy` ``act`` per step.  An episode ends, as in the
-evaluator, when the agent touches the current leg's avoid set (closer than the run's clearance), flips
+:class:`~specrefine.evaluation.compositional.CompositionalPolicy` ``act`` per step (with the run's switching rule,
+``policy.json``'s ``switching_rule``: ``at-region`` for a run from before the rules were named).  An episode ends,
+as in the evaluator, when the agent touches the current leg's avoid set (closer than the run's clearance), flips
 (Ant), has reached every leg's goal region, or uses a leg's ``horizon`` decisions.  Its xy at every
 environment step is then judged by this package's monitor on the ORIGINAL task (``result.json``'s
 ``input_graph``: walls and hazards avoided, the original goal reached); a flipped Ant fails.
@@ -167,7 +168,8 @@ def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, rese
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
-                         "clearance": policy.clearance, "start": start, "reset_noise": reset_noise},
+                         "clearance": policy.clearance, "start": start, "reset_noise": reset_noise,
+                         "switching": policy.switching},
             "wall_seconds": time.time() - t0}
     partial = partial_path(target)
     if interrupted:  # keep the finished episodes beside, never as, the complete record
@@ -256,7 +258,9 @@ def _run_preset(result: dict) -> str:
 def summary(data: dict) -> str:
     lo, hi = data["success_ci"]
     line = (f"official {data['env_id']}: success on the original task {data['success_rate']:.3f} "
-            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')})")
+            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')}")
+    rule = (data.get("settings") or {}).get("switching", "at-region")
+    line += ")" if rule == "at-region" else f"; switching: {rule})"
     if data.get("sim_success_rate") is not None:
         slo, shi = data["sim_success_ci"]
         line += (f"\nthis package's simulator: {data['sim_success_rate']:.3f} (95% CI {slo:.3f}-{shi:.3f}, "

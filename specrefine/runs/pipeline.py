@@ -111,7 +111,7 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     with claim(out, args) as out:
         exp = setup(maze, agent=config.agent, proposer=proposer, seed=config.seed, rollouts=config.rollouts,
                     policy=config.policy, out=out, evaluator=evaluator, record_path=out / "vlm_recording.jsonl",
-                    spec=config.spec, goal_points=config.goal_points)
+                    spec=config.spec, goal_points=config.goal_points, switching=config.switching)
         write_record(out, args)  # only once every argument proved usable: a refused run leaves no record
         with RunProgress(exp.evaluator, exp.proposer, enabled=progress) as shown:
             return _refine(exp, config, out, t0, shown)
@@ -141,6 +141,7 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data["search_estimate"] = data["predicted_success"]  # the search's own product (biased upward)
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"], data["goal_points"] = config.evaluation, config.goal_points
+    data["switching"] = config.switching  # when each leg's goal point is fed (sim.switching)
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["commit"] = code_commit()  # which code: the checkout's commit, "-dirty" if specrefine/ was edited
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])

@@ -17,6 +17,7 @@ from ..core.agents import get_agent
 from ..core.results import wilson_ci
 from .policy import GoalPolicy
 from .simulator import BatchedSim, direction_of_travel, sample_goals, sample_turn_goals
+from .switching import AT_REGION, switching_rule
 
 
 def _frame(policy) -> str:
@@ -68,22 +69,25 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
 
 def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
                    hi: float | None = None, seed: int = 0, horizon: int | None = None,
-                   turn: tuple[float, float] | None = None) -> dict:
+                   turn: tuple[float, float] | None = None, switching: str = AT_REGION) -> dict:
     """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
 
     This is how a compositional policy uses the goal policy (the next subtask starts from a moving
     state); per goal it reports how many episodes got there and how many flipped on the way, and the mean planar
     speed at the switches.  ``turn`` = (lo, hi) degrees: every goal after the first turns by that much from the
-    direction of travel at the switch (``simulator.sample_turn_goals``); None: any direction.
+    direction of travel at the switch (``simulator.sample_turn_goals``); None: any direction.  ``switching``: when
+    the policy is fed a new goal (:mod:`specrefine.sim.switching`, as a compositional policy's legs).
     """
+    hold = switching_rule(switching)
     task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
     index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
-    alive = np.ones(episodes, dtype=bool)
+    alive, holding = np.ones(episodes, dtype=bool), np.full(episodes, hold is not None)
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
     switch_speeds = []
     with torch.inference_mode():
         while alive.any():
-            sim.step(np.where(alive[:, None], policy.act(sim.observe(goal, _frame(policy))), 0.0))
+            aim = goal if hold is None else _held_aim(hold, sim, goal, t, holding)
+            sim.step(np.where(alive[:, None], policy.act(sim.observe(aim, _frame(policy))), 0.0))
             t += 1
             flip = alive & sim.flipped
             np.add.at(flips, index[flip], 1)
@@ -92,6 +96,7 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             np.add.at(reached, index[hit], 1)
             index[hit] += 1
             t[hit] = 0
+            holding[hit] = hold is not None
             switch = hit & (index < goals)
             velocity = sim.qvel[switch, :2]
             switch_speeds.extend(np.linalg.norm(velocity, axis=1))
@@ -111,7 +116,15 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             "reached": reached.tolist(), "flipped": flips.tolist(), "timed_out": timeouts.tolist(),
             "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum())),
             **({} if turn is None else {"turn_degrees": list(turn)}),
-            "mean_switch_speed_mps": float(np.mean(switch_speeds)) if switch_speeds else None}
+            "mean_switch_speed_mps": float(np.mean(switch_speeds)) if switch_speeds else None,
+            **({} if hold is None else {"switching": switching})}
+
+
+def _held_aim(hold, sim: BatchedSim, goal: np.ndarray, t: np.ndarray, holding: np.ndarray) -> np.ndarray:
+    """The goals fed this step: each row's own position while the switching rule holds its new goal's start."""
+    xy, rows = sim.xy, np.flatnonzero(holding)
+    holding[rows] = hold.holding(sim.qvel[rows, :2], goal[rows] - xy[rows], t[rows])
+    return np.where(holding[:, None], xy, goal)
 
 
 def success_by_distance(result: dict, bins: int = 8) -> list[dict]:

@@ -6,6 +6,8 @@ evaluation and refinement use :class:`specrefine.sim.simulator.BatchedSim` alone
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import torch
 from tensordict import TensorDict
@@ -82,17 +84,23 @@ class GoalReachEnv(EnvBase):
     def _set_seed(self, seed: int | None):
         self.rng = np.random.default_rng(seed)
 
-    def _obs_td(self, success, flipped, wall) -> TensorDict:
+    def _obs_td(self, observation, success, flipped, wall) -> TensorDict:
         flags = {k: torch.from_numpy(v).unsqueeze(-1) for k, v in (("success", success), ("flipped", flipped),
                                                                   ("wall", wall))}
-        return TensorDict({"observation": torch.from_numpy(self.sim.observe(self.goals, self.frame)), **flags},
-                          batch_size=self.batch_size)
+        return TensorDict({"observation": torch.from_numpy(observation), **flags}, batch_size=self.batch_size)
 
     def _reset(self, tensordict: TensorDict | None = None, **kwargs) -> TensorDict:
         mask = np.ones(self.sim.n, dtype=bool)
         if tensordict is not None and "_reset" in tensordict.keys():
             mask = tensordict["_reset"].reshape(self.sim.n).numpy().copy()
-        idx = np.flatnonzero(mask)
+        zeros = np.zeros(self.sim.n, dtype=bool)
+        out = self._obs_td(self.restart(np.flatnonzero(mask)), zeros, zeros, zeros)
+        out.update(self._dones(zeros, zeros))
+        return out
+
+    def restart(self, idx: np.ndarray) -> np.ndarray:
+        """Start new episodes in the envs ``idx``; returns every env's observation (numpy: the trainer's collector
+        calls this and :meth:`advance` directly, without TorchRL's per-step machinery)."""
         if self.maze is None:
             self.sim.reset(rng=self.rng, idx=idx)
         else:
@@ -102,10 +110,7 @@ class GoalReachEnv(EnvBase):
         self._new_goals(idx, chained=False)
         self.t[idx] = 0
         self.goal_index[idx] = 0
-        zeros = np.zeros(self.sim.n, dtype=bool)
-        out = self._obs_td(zeros, zeros, zeros)
-        out.update(self._dones(zeros, zeros))
-        return out
+        return self.sim.observe(self.goals, self.frame)
 
     def _new_goals(self, idx: np.ndarray, chained: bool = True) -> None:
         """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are;
@@ -154,8 +159,16 @@ class GoalReachEnv(EnvBase):
         return np.abs(moved[:, 0] * unit[:, 1] - moved[:, 1] * unit[:, 0])
 
     def _step(self, tensordict: TensorDict) -> TensorDict:
+        step = self.advance(tensordict["action"].numpy())
+        out = self._obs_td(step.observation, step.success, step.flipped, step.wall)
+        out["reward"] = torch.from_numpy(step.reward).unsqueeze(-1)
+        out.update(self._dones(step.terminated, step.truncated))
+        return out
+
+    def advance(self, action: np.ndarray) -> Transition:
+        """One control step of every env, numpy in and out (what :meth:`_step` wraps in a TensorDict)."""
         before = self.sim.xy.copy()
-        self.sim.step(tensordict["action"].numpy())
+        self.sim.step(action)
         self.t += 1
         dist = np.linalg.norm(self.goals - self.sim.xy, axis=1)
         success, flipped = dist < self.radius, self.sim.flipped
@@ -175,7 +188,17 @@ class GoalReachEnv(EnvBase):
             self._new_goals(np.flatnonzero(more))
         terminated = (success & ~more) | flipped | hit
         truncated = ~terminated & (self.t >= task.max_steps)
-        out = self._obs_td(success, flipped, hit)
-        out["reward"] = torch.from_numpy(reward.astype(np.float32)).unsqueeze(-1)
-        out.update(self._dones(terminated, truncated))
-        return out
+        return Transition(self.sim.observe(self.goals, self.frame), reward.astype(np.float32), success, flipped, hit,
+                          terminated, truncated)
+
+
+class Transition(NamedTuple):
+    """One control step of every env (rows), as :meth:`GoalReachEnv.advance` returns it."""
+
+    observation: np.ndarray  # after the step (float32)
+    reward: np.ndarray  # float32
+    success: np.ndarray  # bool, as are the rest
+    flipped: np.ndarray
+    wall: np.ndarray
+    terminated: np.ndarray
+    truncated: np.ndarray

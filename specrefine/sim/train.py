@@ -35,10 +35,13 @@ from ..core.agents import AGENTS, get_agent
 from ..core.argtypes import bounded_int, out_path
 from ..core.errors import SpecrefineError
 from ..core.runfolder import open_append
+from .collect import BatchCollector
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
+from .ppo import ClipPPO, add_advantages
 from .reach_env import GoalReachEnv
+from .switching import AT_REGION, SWITCHING
 
 __all__ = ["PPO_DIAGNOSTICS", "Config", "Trainer", "config_arguments", "explained_variance", "make_config", "main",
            "make_modules", "train",
@@ -215,9 +218,7 @@ def _first_line(exc: Exception) -> str:
 
 class Trainer:
     def __init__(self, cfg: Config, out: str | Path, resume: bool = False, progress: bool = True):
-        from torchrl.collectors import Collector
         from torchrl.objectives import ClipPPOLoss
-        from torchrl.objectives.value import GAE
 
         self.cfg, self.out, self.progress = cfg, Path(out), progress
         self.out.mkdir(parents=True, exist_ok=True)
@@ -234,18 +235,20 @@ class Trainer:
                                 frame=cfg.observation_frame, maze=training_maze(cfg.train_maze), turn=cfg.turn_goals,
                                 goal_points=cfg.train_goal_points)
         self.actor, self.critic = make_modules(self.policy, self.env)
+        # TorchRL's loss holds the actor's and critic's parameters: its state_dict is a checkpoint's "loss" (every
+        # checkpoint so far); the update computes the same loss with ppo.ClipPPO, without its per-call machinery
         self.loss = ClipPPOLoss(self.actor, self.critic, clip_epsilon=cfg.clip_epsilon,
                                 entropy_coeff=cfg.entropy_coef, critic_coeff=cfg.critic_coef,
                                 loss_critic_type="l2", normalize_advantage=True)
-        self.gae = GAE(gamma=cfg.gamma, lmbda=cfg.gae_lambda, value_network=self.critic, average_gae=False)
+        self.value = self.critic.module  # observation -> value, the plain module
+        self.ppo = ClipPPO(self.policy, self.value, cfg.clip_epsilon, cfg.entropy_coef, cfg.critic_coef)
         self.optim = torch.optim.Adam(self.loss.parameters(), lr=cfg.lr, eps=1e-5)
         self.frames, self.iteration, self.wall = 0, 0, 0.0
         if resume and (self.out / "checkpoint.pt").is_file():
             self._load_checkpoint(self.out / "checkpoint.pt")
         elif cfg.init:
             self._load_weights(cfg.init)
-        self.collector = Collector(self.env, self.actor, frames_per_batch=cfg.frames_per_batch, total_frames=-1,
-                                   auto_register_policy_transforms=False)
+        self.collector = BatchCollector(self.env, self.policy, cfg.steps_per_env)
         self.ep_return = np.zeros(cfg.num_envs)
 
     # checkpointing
@@ -300,14 +303,13 @@ class Trainer:
         if cfg.anneal_lr:
             for g in self.optim.param_groups:
                 g["lr"] = cfg.lr * max(0.05, 1.0 - self.frames / cfg.frames)
-        with torch.no_grad():
-            self.gae(batch)
+        add_advantages(batch, self.value, cfg.gamma, cfg.gae_lambda)
         flat = batch.reshape(-1)
         critic_only = self.frames < cfg.critic_warmup_frames  # a fresh critic's advantages would steer the actor wrong
         stats: dict[str, list[float]] = {key: [] for key in ("loss", *PPO_DIAGNOSTICS)}
         for _ in range(cfg.epochs):
             for idx in torch.randperm(flat.shape[0]).split(cfg.minibatch):
-                losses = self.loss(flat[idx])
+                losses = self.ppo(flat[idx])
                 total = losses["loss_critic"] if critic_only else \
                     losses["loss_objective"] + losses["loss_critic"] + losses.get("loss_entropy", 0.0)
                 self.optim.zero_grad()
@@ -316,7 +318,7 @@ class Trainer:
                 self.optim.step()
                 stats["loss"].append(total.item())
                 for key, name in PPO_DIAGNOSTICS.items():
-                    if name in losses.keys():
+                    if name in losses:
                         stats[key].append(float(losses[name].detach().float().mean()))
         self.policy.norm.update(batch["observation"])  # after the update: stored log-probs stay valid
         out = {key: float(np.mean(v)) for key, v in stats.items() if v}
@@ -347,9 +349,8 @@ class Trainer:
         last_ck = time.time()
         log = open_append(self.out / "log.jsonl", "training log")  # never through a link
         t_batch = time.time()
-        for batch in self.collector:
-            if self.frames >= cfg.frames:
-                break
+        while self.frames < cfg.frames:
+            batch = self.collector.collect()
             info = self.episode_stats(batch)
             info.update(self.update(batch))
             self.frames += batch.numel()
@@ -366,7 +367,6 @@ class Trainer:
             if now - last_ck > cfg.checkpoint_every_s:
                 self.save_checkpoint()
                 last_ck = now
-        self.collector.shutdown()
         log.close()
         bar.close()
         self.save_checkpoint()
@@ -396,6 +396,10 @@ def add_arguments(ap) -> None:
     ap.add_argument("--chain", type=bounded_int("chain"), default=None, metavar="K",
                     help="with --evaluate: K goals in a row per episode, no reset (see evaluate_chain) "
                          "(default: one goal per episode)")
+    ap.add_argument("--switching", choices=SWITCHING, default=AT_REGION,
+                    help="with --evaluate --chain: when the policy is fed the next goal: at-region (at once) or "
+                         "slow-turn (a fast, turned start brakes first; specrefine.sim.switching) (default: "
+                         "at-region)")
     config_arguments(ap)
 
 
@@ -411,7 +415,8 @@ def run(args, ap) -> int:
         if args.evaluate and args.chain:
             lo, hi = args.goal_range or (None, None)
             turn = None if args.turn_goals is None else turn_range(args.turn_goals)
-            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed, turn=turn)
+            res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed, turn=turn,
+                                 switching=args.switching)
             print(json.dumps(res))
             return 0
         if args.evaluate:
