@@ -66,25 +66,3 @@ def test_batch_steps_count_what_one_batch_steps():
     res = alone.evaluate(*subtasks[0][:3])
     steps, padding = batch_steps(res.lengths, np.zeros(13, dtype=int), 1, Evaluator.MIN_BATCH)
     assert padding > 0 and int(steps[0]) + padding == res.steps == alone.sim_steps  # the task carries its padding
-
-
-def test_a_failing_half_stops_the_other_and_raises():
-    import threading
-
-    from specrefine.core.errors import PolicyError
-
-    maze = load_maze("u_maze")
-    policy = load_policy("point")
-    calls = {"main": 0, "other": 0}
-
-    def failing(obs):  # the policy turns to NaN in this thread's half after 5 steps
-        mine = threading.current_thread() is threading.main_thread()
-        calls["main" if mine else "other"] += 1
-        out = policy.act(obs)
-        return out * np.nan if mine and calls["main"] > 5 else out
-
-    ev = Evaluator(maze, "point", policy, n=32, horizon=60, seed=0, nthread=2)
-    ev._act = failing
-    with pytest.raises(PolicyError, match="NaN"):
-        ev.evaluate(*_subtasks(maze)[0][2][:3])  # S to the corner: 9-13 steps
-    assert calls["other"] < 10  # the other half stopped at its next step (30 steps without the failure)

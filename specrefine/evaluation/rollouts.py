@@ -89,7 +89,6 @@ class RolloutLoop:
         self.traj[:, 0] = self.xy
         self.steps = np.zeros(len(plan.n_legs), dtype=np.int64)  # rows held by each task's episodes, per step
         self.padding_steps = 0
-        self.stopped = False  # set from another thread: leave the run at the next step (its caller failed)
 
     def run(self) -> RolloutLoop:
         import torch
@@ -98,7 +97,7 @@ class RolloutLoop:
         with torch.inference_mode():
             for t in range(1, self.T):
                 running = int(self.active.sum())
-                if not running or self.stopped:
+                if not running:
                     break
                 self._compact(running)
                 self._step()
@@ -281,9 +280,6 @@ def run_in_lanes(plan: Plan, states: np.ndarray, controls: Controls, sims_of) ->
     other.start()
     try:
         loops[0].run()
-    except BaseException:
-        loops[1].stopped = True  # this half failed or was interrupted (Ctrl-C): the other stops at its next step
-        raise
     finally:
         other.join()
     if failed:
