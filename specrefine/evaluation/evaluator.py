@@ -43,10 +43,8 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import os
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -65,7 +63,7 @@ from ..core.results import (
 )
 from ..sim.switching import AT_REGION, switching_rule
 from .cache import ResultCache
-from .rollouts import Controls, Plan, RolloutLoop, rows_stepped, run_in_lanes
+from .rollouts import Controls, Plan, RolloutLoop, rows_stepped
 
 log = logging.getLogger(__name__)  # one line per record (no echoed source line, as a warning has)
 
@@ -198,25 +196,14 @@ class Evaluator:
         """Former name of :attr:`clearance` (torso + contact margin), kept for older notebooks."""
         return self.clearance
 
-    def sim(self, batch: int | None = None, lane: int | None = None):
-        """The BatchedSim of ``batch`` rows (default: ``n``; built on first use, then reused); ``lane`` 0 or 1: one
-        of :func:`~.rollouts.run_in_lanes`'s halves' own, stepping on the thread that runs it."""
+    def sim(self, batch: int | None = None):
+        """The BatchedSim of ``batch`` rows (default: ``n``; built on first use, then reused)."""
         from ..sim.simulator import BatchedSim
 
-        key = (int(batch or self.n), lane)
-        if key not in self._sims:
-            self._sims[key] = BatchedSim(self.agent, self.maze, key[0], nthread=self.nthread if lane is None else 1,
-                                         model=self._model)
-        return self._sims[key]
-
-    @property
-    def lanes(self) -> bool:
-        """Whether batches run as two halves side by side (:func:`~.rollouts.run_in_lanes`): with two cores or more
-        for MuJoCo and a policy that acts on each row alone (a :class:`~specrefine.sim.policy.GoalPolicy`)."""
-        from ..sim.policy import GoalPolicy
-
-        cores = min(os.cpu_count() or 1, 2) if self.nthread is None else self.nthread
-        return cores >= 2 and isinstance(self.policy, GoalPolicy)
+        batch = int(batch or self.n)
+        if batch not in self._sims:
+            self._sims[batch] = BatchedSim(self.agent, self.maze, batch, nthread=self.nthread, model=self._model)
+        return self._sims[batch]
 
     @property
     def built_sims(self) -> tuple:
@@ -430,14 +417,9 @@ class Evaluator:
         plan = Plan(first, n_legs, goal_pts, goal_id, avoid_id, goals, avoids)
         controls = Controls(self._act, self.observation_frame, self.sim, self.horizon, self.clearance, self.MIN_BATCH,
                             self.hold)
-        if self.lanes and N >= 2 * self.MIN_BATCH:
-            outputs, steps = run_in_lanes(plan, sim.get_state()[:N], controls,
-                                          [partial(self.sim, lane=lane) for lane in (0, 1)])
-        else:
-            loop = RolloutLoop(plan, sim, controls).run()
-            outputs, steps = loop.outputs(), loop.sim_steps
-        self.sim_steps += steps
-        return outputs
+        loop = RolloutLoop(plan, sim, controls).run()
+        self.sim_steps += loop.sim_steps
+        return loop.outputs()
 
 
 def _edge_result(out: dict, n: int) -> EdgeResult:

@@ -9,15 +9,11 @@ its last point). When at most half of the rows still run, the running ones are m
 bit-exact) into a smaller BatchedSim (a power of two, at least ``min_batch``), so finished rollouts stop costing
 physics. With a switching rule that holds (``Controls.hold``: :mod:`specrefine.sim.switching`'s ``slow-turn``), an
 episode at the start of a leg aims at its own position while the rule holds it, then at the leg's goal point.
-
-:func:`run_in_lanes` runs a plan as two halves side by side, each a RolloutLoop in its own thread: MuJoCo (which
-lets go of Python's lock) steps one half while the policy and the checks of the other run, so both cores work.
 """
 
 from __future__ import annotations
 
-import threading
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -237,79 +233,3 @@ def rows_stepped(lengths, min_batch: int) -> int:
         rows = compacted(rows, int(still), min_batch)
         total += rows
     return total
-
-
-def batch_steps(lengths, task_of, tasks: int, min_batch: int) -> tuple[np.ndarray, int]:
-    """Per task, the rows its episodes hold while a :class:`RolloutLoop` runs episodes of these ``lengths`` side by
-    side from a sim of ``len(lengths)`` rounded up to ``min_batch``, and the padding rows beside them (its ``steps``
-    and ``padding_steps``): a batch's cost follows from its episodes' lengths alone (:func:`rows_stepped`'s total)."""
-    lengths, task_of = np.asarray(lengths, dtype=np.int64), np.asarray(task_of)
-    running = len(lengths) - np.cumsum(np.bincount(lengths))  # running[t]: episodes still going before step t
-    rows = -(-len(lengths) // min_batch) * min_batch
-    held = np.bincount(task_of, minlength=tasks)  # each task's episodes in the sim (finished ones until compacted)
-    steps, padding = np.zeros(tasks, dtype=np.int64), 0
-    for t, still in enumerate(running[1:], start=1):
-        if not still:
-            break
-        size = compacted(rows, int(still), min_batch)
-        if size != rows:
-            rows, held = size, np.bincount(task_of[lengths > t], minlength=tasks)
-        steps += held
-        padding += rows - int(held.sum())
-    return steps, padding
-
-
-def run_in_lanes(plan: Plan, states: np.ndarray, controls: Controls, sims_of) -> tuple[list[dict], int]:
-    """Run ``plan`` from the full physics ``states`` of its episodes as two halves side by side: episodes ``[0, h)``
-    in this thread, ``[h, N)`` in another, each a :class:`RolloutLoop` in the sims of ``sims_of[i](size)``.
-
-    Every episode runs as it would in one batch: its physics is its own row's, moved bit for bit when a half
-    shrinks, and the policy must act on each row alone (true of the MLP policies for batches of 4 rows or more,
-    which the halves' ``min_batch`` keeps).  Returns :meth:`RolloutLoop.outputs` per task, with the steps
-    counted as one batch of the plan counts them (:func:`batch_steps`), and their total (its ``sim_steps``)."""
-    N, m = plan.episodes, controls.min_batch
-    h = min(N, -(-(N // 2) // m) * m)
-    loops = []
-    for lo, hi, sim_of in ((0, h, sims_of[0]), (h, N, sims_of[1])):
-        sim = sim_of(-(-(hi - lo) // m) * m)
-        part = states[lo:hi]
-        sim.reset(states=np.concatenate([part, np.repeat(part[:1], sim.n - len(part), axis=0)]))
-        loops.append(RolloutLoop(_part(plan, lo, hi), sim, replace(controls, sim_of=sim_of)))
-    failed = []
-    other = threading.Thread(target=_run_catching, args=(loops[1], failed), name="rollout-lane")
-    other.start()
-    try:
-        loops[0].run()
-    finally:
-        other.join()
-    if failed:
-        raise failed[0]
-    lengths = np.concatenate([loop.lengths for loop in loops])
-    steps, padding = batch_steps(lengths, plan.task_of, len(plan.n_legs), m)
-    if len(steps) == 1:  # a task alone carries the padding rows it was rounded up to, as in RolloutLoop.outputs
-        steps, padding = steps + padding, 0
-    outputs = [_joined(a, b, int(k)) for a, b, k in zip(loops[0].outputs(), loops[1].outputs(), steps, strict=True)]
-    return outputs, int(steps.sum()) + padding
-
-
-def _run_catching(loop: RolloutLoop, failed: list) -> None:
-    try:
-        loop.run()
-    except BaseException as exc:  # noqa: BLE001 - handed to the calling thread, which raises it
-        failed.append(exc)
-
-
-def _part(plan: Plan, lo: int, hi: int) -> Plan:
-    """The episodes ``[lo, hi)`` of ``plan`` as a plan of their own (a task may have none of them)."""
-    return replace(plan, first=np.clip(plan.first, lo, hi) - lo, goal_points=plan.goal_points[:, lo:hi])
-
-
-def _joined(a: dict, b: dict, steps: int) -> dict:
-    """One task's outputs from its episodes in the two halves (trajectories padded with their last point, as
-    :meth:`RolloutLoop.outputs` pads them)."""
-    used = max(a["trajectories"].shape[1], b["trajectories"].shape[1])
-    trajectories = [np.concatenate([tr, np.repeat(tr[:, -1:], used - tr.shape[1], axis=1)], axis=1)
-                    for tr in (a["trajectories"], b["trajectories"])]
-    joined = {key: np.concatenate([a[key], b[key]]) for key in ("legs_done", "lengths", "outcome", "end_states",
-                                                                 "end_xy")}
-    return joined | {"trajectories": np.concatenate(trajectories), "steps": steps}
