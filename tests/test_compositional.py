@@ -129,7 +129,9 @@ def test_a_run_saves_its_switching_rule_and_official_runs_it(tmp_path, capsys):
     assert json.loads((out / "result.json").read_text())["config"]["switching"] == "slow-turn"
     data = json.loads((out / POLICY_JSON).read_text())
     assert data["switching_rule"] == "slow-turn" and CompositionalPolicy.load(out).switching == "slow-turn"
+    capsys.readouterr()
     assert main(["official", str(out), "--episodes", "2"]) == 0
+    assert "; switching: slow-turn)" in capsys.readouterr().out
     assert json.loads((out / "official.json").read_text())["settings"]["switching"] == "slow-turn"
     (out / POLICY_JSON).write_text(json.dumps({**data, "switching_rule": "blend"}))
     with pytest.raises(PolicyError, match="switching_rule"):

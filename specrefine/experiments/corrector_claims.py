@@ -233,7 +233,10 @@ def gated_study(root: Path = ROOT) -> dict | None:
         study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, GATED, POINT_SEEDS))
         study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, GATED, proposer, SCALING_MAZES)})
         study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=GATED))
-        study["corrector_costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS))
+        ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == GATED and r["proposer"] == proposer
+               and cmp.is_done(r)}  # the corrector's cost on the cells the gated corrector ran
+        study["corrector_costs"].append(costs([r for r in rows if (r["maze"], r["seed"]) in ran], proposer,
+                                              SCALING_MAZES, POINT_SEEDS))
     study["held_out"] = gated_held_out(root)
     return study
 

@@ -258,7 +258,9 @@ def _run_preset(result: dict) -> str:
 def summary(data: dict) -> str:
     lo, hi = data["success_ci"]
     line = (f"official {data['env_id']}: success on the original task {data['success_rate']:.3f} "
-            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')})")
+            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')}")
+    rule = (data.get("settings") or {}).get("switching", "at-region")
+    line += ")" if rule == "at-region" else f"; switching: {rule})"
     if data.get("sim_success_rate") is not None:
         slo, shi = data["sim_success_ci"]
         line += (f"\nthis package's simulator: {data['sim_success_rate']:.3f} (95% CI {slo:.3f}-{shi:.3f}, "
