@@ -72,3 +72,15 @@ def test_refine_benchmark_runs_both_evaluations_and_resumes(tmp_path, capsys):
     assert main(args) == 0  # resumed: nothing rerun, the same summary
     assert len(table.read_text().splitlines()) == 3
     assert json.loads(capsys.readouterr().out.strip().splitlines()[-1]) == out
+
+
+def test_training_benchmark_reports_the_raw_rollout_ceiling_of_the_same_batch_shape():
+    from specrefine.bench.training import bench_train
+
+    out = bench_train("point", batches=1, reference=False)
+    ours = out["ours"]
+    assert (ours["num_envs"], ours["steps_per_env"], out["raw_nthread"]) == (64, 32, ours["sim_threads"])
+    assert len(ours["fps_per_batch"]) == 1 and out["raw_rollout_steps_per_s"] > 0
+    assert out["ratio_vs_raw_rollout"] == round(ours["fps_median"] / out["raw_rollout_steps_per_s"], 3)
+    assert out["ratio_vs_raw_per_step"] == round(ours["fps_median"] / out["raw_per_step_steps_per_s"], 3)
+    assert "reference_minibatch64" not in out

@@ -182,3 +182,25 @@ def test_without_the_gate_a_single_fresh_failure_is_split():
     book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
     _, result = run(LegTable(LUCKY, ONE_FAILURE), book, correct_rollouts=4)
     assert (3.0, 6.0) in book.queries and xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]
+
+
+def test_a_leg_no_fresh_rollout_reaches_is_not_split():
+    # fresh, the middle leg never succeeds, so nothing reaches the last one: the proposer is asked about the dead
+    # leg (and over its end waypoint), never about the unreached leg, whose split would start from no state (that
+    # crashed two ours-checked cells of the levers grid at code 722e118, in Algorithm 2's round)
+    from specrefine.refine.correct import correct
+
+    g = _chain_graph()
+    path = ["S", *g.split_edge("S", "G", [Disc(3, 0, 0.5), Disc(6, 0, 0.5)]), "G"]
+    asked = []
+
+    def split_leg(graph, a, b, result, start):
+        asked.append((graph.region(a).centre()[0], graph.region(b).centre()[0], start))
+        return None
+
+    _, kept, check = correct(g, path, LegTable({}, {(3.0, 6.0): 0.0}), rollouts=128, seed=CHECK_SEED_OFFSET,
+                             split_leg=split_leg, may_split=lambda: True, reach=0.0, clearance=0.0,
+                             log=lambda *a, **k: None)
+    assert [(a, b) for a, b, _ in asked] == [(3.0, 6.0), (3.0, 10.0)]
+    assert all(start is not None for *_, start in asked)
+    assert kept == path and check.probabilities == [1.0, 0.0, 0.0]

@@ -168,6 +168,8 @@ def test_the_gated_corrector_is_judged_against_the_corrector_by_its_margin(tmp_p
     within = v[f"{cc.GATED}, imperfect:mild: within 0.05 of the oracle on every U-chain"]
     assert within["verdict"] == ("holds" if gated >= 0.94 else "does not hold")
     assert gs["held_out"] and not any(e["runs"] for e in gs["held_out"])  # its held-out part has not run
+    assert [(c["proposer"], c["method"], c["pairs"]) for c in gs["held_out_costs"]] == [
+        ("mix A", cc.GATED, 0), ("mix A", cc.METHOD, 0), ("mix B", cc.GATED, 0), ("mix B", cc.METHOD, 0)]
     assert cc._gated_text(gs).startswith("proposer calls over ours: mild 1.7x (36 pairs); moderate 1.7x (36 pairs)")
 
 

@@ -73,6 +73,8 @@ def test_the_losses_the_correction_and_its_splits_are_counted_from_the_folders(f
     # the two-failure leg
     assert mild["projected_ratio_gate_2"] == pytest.approx(26 * 0.8 / 5)
     assert mild["projected_ratio_gate_3"] == pytest.approx(26 * 0.7 / 5)
+    u_chains = next(e for e in s["cost_u_chains"] if e["proposer"] == "imperfect:mild")
+    assert (u_chains["pairs"], u_chains["proposer_calls"], u_chains["ours_proposer_calls"]) == (1, 20, 4)
 
 
 def test_the_command_writes_its_tables_and_a_folder_without_runs_is_one_line(folders, tmp_path):

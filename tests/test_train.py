@@ -309,3 +309,13 @@ def test_sampled_training_goal_points_need_a_training_maze(tmp_path, capsys):
     assert err.count("\n") == 1 and "needs --train-maze" in err and not out.exists()
     cfg = make_config("point", train_maze="random:3x3:0", train_goal_points="sampled", goals_per_episode=4)
     assert Trainer(cfg, tmp_path / "walls", progress=False).env.goal_points == "sampled"
+
+
+def test_the_update_runs_on_its_own_torch_threads_and_gives_them_back(tmp_path):
+    tr = Trainer(make_config("point", seed=0, num_envs=8, steps_per_env=32, update_threads=2, checkpoint_every_s=1e9),
+                 tmp_path / "run", progress=False)
+    seen = []
+    step = tr.optim.step
+    tr.optim.step = lambda *a, **k: (seen.append(torch.get_num_threads()), step(*a, **k))[1]
+    tr.update(tr.collector.collect())
+    assert set(seen) == {2} and torch.get_num_threads() == 1  # the collection keeps torch_threads

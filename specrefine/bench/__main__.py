@@ -39,9 +39,11 @@ def add_arguments(ap) -> None:
     g.add_argument("--batch", type=bounded_int("batch"), default=32, help="rollouts per batch")
     g.add_argument("--seconds", type=positive_float, default=9.0, help="time spent in the evaluator measurement")
     g.add_argument("--gym-steps", type=bounded_int("gym_steps"), default=2000, help="GymEnv steps measured")
-    t = bench("train", "PPO training frames/s: our config vs the reference TorchRL config")
+    t = bench("train", "PPO training frames/s vs raw mujoco.rollout, and vs the reference TorchRL config")
     t.add_argument("--agent", choices=list(AGENTS), default="ant", help="the agent")
     t.add_argument("--batches", type=bounded_int("batches"), default=4, help="measured batches per configuration")
+    t.add_argument("--no-reference", action="store_true",
+                   help="skip the reference TorchRL config (minibatch 64) (default: run it too)")
     r = bench("refine", "a refinement run's cost: fixed vs adaptive evaluation, side by side")
     r.add_argument("--agent", choices=list(AGENTS), default="ant", help="the agent")
     r.add_argument("--mazes", nargs="+", default=["split_doorway", "u_maze", "u_chain_2"], help="mazes")
@@ -84,7 +86,7 @@ def run(args, ap) -> int:
             out = bench_refinement(args.mazes, args.seeds, args.agent, args.method, args.proposer, args.table,
                                    args.episodes)
         else:
-            out = bench_train(args.agent, args.batches)
+            out = bench_train(args.agent, args.batches, not args.no_reference)
     except SpecrefineError as exc:
         ap.exit(2, f"{ap.prog}: error: {exc}\n")
     print(json.dumps(out), flush=True)

@@ -233,9 +233,22 @@ def gated_study(root: Path = ROOT) -> dict | None:
         study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, GATED, POINT_SEEDS))
         study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, GATED, proposer, SCALING_MAZES)})
         study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=GATED))
-        study["corrector_costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS))
+        ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == GATED and r["proposer"] == proposer
+               and cmp.is_done(r)}  # the corrector's cost on the cells the gated corrector ran
+        study["corrector_costs"].append(costs([r for r in rows if (r["maze"], r["seed"]) in ran], proposer,
+                                              SCALING_MAZES, POINT_SEEDS))
     study["held_out"] = gated_held_out(root)
+    study["held_out_costs"] = gated_held_out_costs(root)
     return study
+
+
+def gated_held_out_costs(root: Path = ROOT) -> list[dict]:
+    """Per held-out mix: the gated corrector's and the corrector's mean cost over ours's on the same cells."""
+    rows = load(GRIDS["corrector-held-out"].tables + (GRIDS["corrector-gated"].part_table(1),), root)
+    mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
+    return [costs(rows, mix, mazes, HELD_OUT_SEEDS, first=method) | {"proposer": f"mix {MIX_NAMES[mix]}",
+                                                                      "method": method}
+            for mix in HELD_OUT_MIXES for method in (GATED, METHOD)]
 
 
 def gated_held_out(root: Path = ROOT) -> list[dict]:
@@ -466,6 +479,11 @@ def gated_markdown(gs: dict) -> list[str]:
                   "|---|---|---|---|---|---|---|"]
         lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])}"
                   f" | {_diff(e)} | {_num(e['ours'])} |" for e in gs["held_out"]]
+        lines += ["", "| held-out mix | method | pairs | evaluations | proposer calls | simulator steps |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {c['proposer']} | {c['method']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
+                  f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"
+                  for c in gs["held_out_costs"]]
     return lines
 
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.runfolder import write_atomic
+from .grids import SCALING_MAZES
 from .taxonomy import Run, read_runs
 
 METHOD = "ours-corrector"
@@ -139,7 +140,9 @@ def study(corrector: list[Run], ours: list[Run], oracle: list[Run], mazes=LONG_M
     return {"mazes": list(mazes), "losses": {METHOD: losses(long_), "ours": losses(ours_long),
                                              "oracle": losses(oracle_long)},
             "correction": correction(long_), "splits_by_failures": splits_by_failures(mine),
-            "cost": [cost(mine, theirs, p) for p in PROPOSERS], "runs": len(mine)}
+            "cost": [cost(mine, theirs, p) for p in PROPOSERS], "runs": len(mine),
+            "cost_u_chains": [cost([r for r in mine if r.result["maze"] in SCALING_MAZES], theirs, p)
+                              for p in PROPOSERS]}
 
 
 def _f(x, fmt="{:.3f}") -> str:
@@ -177,14 +180,21 @@ def markdown(s: dict) -> str:
               "and in the correction (its logged splits: a lower bound); projected: each run's proposer calls scaled "
               "by the share of its Algorithm 1 calls left without the correction's splits of legs with fewer fresh "
               "failures than the gate (an estimate from the logs, not a run).", "",
-              "| proposer | pairs | proposer calls | ours | ratio | Algorithm 1 calls | in the correction | "
-              + " | ".join(f"projected, gate {g}" for g in GATES) + " |", "|---|---|---|---|---|---|---|"
-              + "---|" * len(GATES)]
-    for e in s["cost"]:
-        lines.append(f"| {e['proposer']} | {e['pairs']} | {e['proposer_calls']} | {e['ours_proposer_calls']} | "
-                     f"{_f(e['ratio'], '{:.2f}x')} | {e['algorithm1_calls']} | {e['algorithm1_in_correction']} | "
-                     + " | ".join(_f(e[f"projected_ratio_gate_{g}"], "{:.2f}x") for g in GATES) + " |")
+              *COST_HEADER, *map(_cost_row, s["cost"]), "",
+              "The same on the U-chain cells alone (U-chain 1-5 with and without subgoals: the cells of grid "
+              "`corrector-gated`):", "", *COST_HEADER, *map(_cost_row, s["cost_u_chains"])]
     return "\n".join(lines) + "\n"
+
+
+COST_HEADER = ("| proposer | pairs | proposer calls | ours | ratio | Algorithm 1 calls | in the correction | "
+               + " | ".join(f"projected, gate {g}" for g in GATES) + " |", "|---|---|---|---|---|---|---|"
+               + "---|" * len(GATES))
+
+
+def _cost_row(e: dict) -> str:
+    return (f"| {e['proposer']} | {e['pairs']} | {e['proposer_calls']} | {e['ours_proposer_calls']} | "
+            f"{_f(e['ratio'], '{:.2f}x')} | {e['algorithm1_calls']} | {e['algorithm1_in_correction']} | "
+            + " | ".join(_f(e[f"projected_ratio_gate_{g}"], "{:.2f}x") for g in GATES) + " |")
 
 
 def add_arguments(p) -> None:

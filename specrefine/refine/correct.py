@@ -126,6 +126,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             if not may_split():
                 break
             leg_start = graph.region(path[0]) if i == 0 else start_of(check.results[i - 1])
+            if leg_start is None:  # no fresh rollout reaches the leg: nothing to start its split from
+                break
             if j == i + 1:
                 result = check.results[i]
             else:  # the span over a waypoint: how its straight edge does, for the proposer's picture

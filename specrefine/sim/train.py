@@ -75,6 +75,8 @@ class Config:
     critic_coef: float = knob(0.5, "value loss coefficient")
     max_grad_norm: float = knob(0.5, "gradient norm clip")
     torch_threads: int = knob(1, "torch threads")
+    update_threads: int | None = knob(None, "torch threads of the PPO update (default: torch_threads); the "
+                                            "collection keeps torch_threads, as MuJoCo's threads have the cores then")
     sim_threads: int = knob(2, "mujoco.rollout threads")
     checkpoint_every_s: float = knob(120.0, "seconds between checkpoints")
     goals_per_episode: int = knob(1, "> 1: chain this many goals per episode, each drawn where the last was reached")
@@ -299,6 +301,14 @@ class Trainer:
 
     # one PPO update on a collected batch
     def update(self, batch) -> dict:
+        threads = torch.get_num_threads()
+        torch.set_num_threads(self.cfg.update_threads or self.cfg.torch_threads)
+        try:
+            return self._update(batch)
+        finally:
+            torch.set_num_threads(threads)
+
+    def _update(self, batch) -> dict:
         cfg = self.cfg
         if cfg.anneal_lr:
             for g in self.optim.param_groups:
