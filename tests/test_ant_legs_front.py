@@ -1,0 +1,77 @@
+"""Issue 42's sentence on README's front page and the slow-turn checks' table re-derive from their files
+(data/results/ant/switching_checks, scripts/switching_table.py)."""
+
+import importlib.util
+import json
+import re
+import shutil
+from pathlib import Path
+
+from specrefine.core.results import difference_text
+from specrefine.experiments.legs import kind_table
+
+ROOT = Path(__file__).resolve().parents[1]
+CHECKS = ROOT / "data" / "results" / "ant" / "switching_checks"
+_spec = importlib.util.spec_from_file_location("switching_table", ROOT / "scripts" / "switching_table.py")
+switching_table = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(switching_table)
+
+
+def front(name: str) -> str:
+    text = (ROOT / "README.md").read_text()
+    found = re.search(rf"<!-- front {name} -->(.*?)<!-- /front {name} -->", text, flags=re.S)
+    assert found, f"README has no '{name}' marker"
+    return " ".join(found.group(1).split())
+
+
+def pooled(points: str, rule: str) -> tuple[int, int]:
+    reports = switching_table.held_out(CHECKS, points, rule).values()
+    return sum(r["walls"]["success"] for r in reports), sum(r["episodes"] for r in reports)
+
+
+def test_checks_table_regenerates(tmp_path, monkeypatch):
+    monkeypatch.chdir(ROOT)  # the sampled at-region side falls back to stage 5's own files, relative paths
+    for f in CHECKS.glob("*.json"):
+        shutil.copy(f, tmp_path / f.name)
+    text = switching_table.main(tmp_path)
+    assert text.replace(str(tmp_path), str(CHECKS.relative_to(ROOT))) == (CHECKS / "checks.md").read_text()
+
+
+def test_front_sentence_recomputes(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    slow, at = pooled("centre", "slow-turn"), pooled("centre", "at-region")
+    assert slow[1] == at[1] == 900
+    expected = f"{slow[0]} of {slow[1]} against {at[0]} of {at[1]}, {difference_text(*slow, *at)}"
+    assert front("slow-turn") == expected
+    sampled = {rule: pooled("sampled", rule) for rule in switching_table.RULES}
+    assert front("slow-turn sampled") == (f"{sampled['slow-turn'][0]} against {sampled['at-region'][0]} "
+                                          f"of {sampled['at-region'][1]}")
+
+
+def test_stage7_held_out_recomputes():
+    folder = ROOT / "data" / "results" / "ant" / "stage7_checks"
+    counts = {}
+    for tag in ("stage7", "stage5"):
+        reports = [json.loads(p.read_text()) for p in sorted(folder.glob(f"u_chain_2_s?_{tag}.json"))]
+        assert len(reports) == 3, f"{tag}: {len(reports)} held-out reports"
+        counts[tag] = (sum(r["walls"]["success"] for r in reports), sum(r["episodes"] for r in reports))
+    assert front("stage7") == f"{counts['stage7'][0]} against {counts['stage5'][0]} of {counts['stage5'][1]}"
+
+
+def turning_loss(points: str, rule: str) -> str:
+    table = kind_table(list(switching_table.held_out(CHECKS, points, rule).values()))
+    row = next(line for line in table.splitlines() if line.startswith("| turning |"))
+    return f"{100 * float(row.split('|')[-2].split()[0]):.2f} %"
+
+
+def test_front_turning_legs_recompute(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert front("slow-turn turning") == (f"{turning_loss('centre', 'slow-turn')} against "
+                                          f"{turning_loss('centre', 'at-region')}")
+
+
+def test_front_train_ratio_recomputes():
+    lines = (ROOT / "data" / "results" / "bench" / "train_ant.jsonl").read_text().splitlines()
+    runs = [json.loads(line) for line in lines if line.strip()]
+    ratios = sorted(r["ratio_vs_raw_rollout"] for r in runs)
+    assert front("train ratio") == f"{ratios[0]:.2f}-{ratios[-1]:.2f}"
