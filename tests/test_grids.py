@@ -68,6 +68,8 @@ def test_the_pinned_code_takes_the_grids_arguments(g):
     moved = _git("cat-file", "-e", f"{g.code}:specrefine/runs/sweep.py").returncode == 0  # the sub-package layout
     module = "specrefine/runs/sweep.py" if moved else "specrefine/sweep.py"
     source = _git("show", f"{g.code}:{module}").stdout
+    if moved:  # the RunConfig fields that add_run_options turns into the sweep's options
+        source += _git("show", f"{g.code}:specrefine/runs/config.py").stdout
     options = {a for i in range(len(g.parts)) for args in grids.sweep_args(g, i) for a in args if a.startswith("--")}
     # an option is spelled out ("--policy") or, for the RunConfig fields add_run_options turns into options, named
     # ("episodes", "goal_points")

@@ -57,6 +57,7 @@ class ExperimentGrid:
     policy_in_checkout: bool = False  # the checkout's copy (an absolute path), not the pinned code tree's
     evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
     goal_points: str | None = None  # None: what the pinned code defaulted to, the paper's sampled points (not passed)
+    switching: str | None = None  # None: the pinned code's rule, the paper's at-region (not passed)
     rollouts: int | None = None  # None: the sweep's default (not passed)
     episodes: int | None = None
     workers: int = 2
@@ -134,6 +135,8 @@ def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int
         common += ["--evaluation", g.evaluation]
     if g.goal_points:
         common += ["--goal-points", g.goal_points]
+    if g.switching:
+        common += ["--switching", g.switching]
     if (policy := _policy(g, part, root)) != "shipped":
         common += ["--policy", policy]
     for name, value in _budget(g).items():
@@ -169,7 +172,8 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      goal_points=g.goal_points or PAPER.goal_points, **_budget(g))
+                      goal_points=g.goal_points or PAPER.goal_points, **_budget(g),
+                      **({"switching": g.switching} if g.switching else {}))
     return list(dict.fromkeys(cells))
 
 
@@ -371,6 +375,13 @@ GRIDS = {g.name: g for g in (
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
         mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
         workers=1, code="5356175", table="data/results/corrector/ant.csv", out="runs/ant_corrector"),
+    ExperimentGrid(
+        "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
+        "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
+        parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2), mazes=("u_chain_3", "u_chain_5"),
+        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", switching="slow-turn",
+        workers=1, code="b6cb752", table="data/results/ant/switching_checks/uchain_slow_turn.csv",
+        out="runs/ant_switching"),
 )}
 
 
