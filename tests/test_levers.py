@@ -56,6 +56,8 @@ def test_a_lever_aiming_at_centres_is_named_so(tmp_path):
     assert levers.label("ours", rows) == "ours"  # a table from before the column: the paper's rule
     rows = {k: {**r, "goal_points": "centre"} for k, r in rows.items()}
     assert levers.label("ours", rows) == "ours (centre goal points)"
+    rows = {k: {**r, "cell": r["cell"] + "__switching-slow-turn"} for k, r in rows.items()}
+    assert levers.label("ours", rows) == "ours (centre goal points; slow-turn switching)"
 
 
 def test_a_layout_is_paired_with_another_maze_of_the_baseline_seed_by_seed(tmp_path, capsys):

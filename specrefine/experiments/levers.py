@@ -30,9 +30,13 @@ def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], 
 
 
 def label(method: str, rows: dict) -> str:
-    """The method's name, with its goal-point rule when its runs aimed at the sets' centres."""
+    """The method's name, with its goal-point rule when its runs aimed at the sets' centres and its switching rule
+    when not the paper's (the table has no column for it: a cell id ends in ``__switching-RULE``)."""
     rules = sorted({goal_points_of(r) for r in rows.values()})
-    return method if rules in ([], [PAPER.goal_points]) else f"{method} ({', '.join(rules)} goal points)"
+    switching = sorted({r["cell"].split("__switching-")[1] for r in rows.values() if "__switching-" in r["cell"]})
+    notes = ([] if rules in ([], [PAPER.goal_points]) else [f"{', '.join(rules)} goal points"]) + \
+        [f"{', '.join(switching)} switching"] * bool(switching)
+    return f"{method} ({'; '.join(notes)})" if notes else method
 
 
 def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:
