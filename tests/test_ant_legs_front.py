@@ -1,6 +1,7 @@
 """Issue 42's sentence on README's front page and the slow-turn checks' table re-derive from their files
 (data/results/ant/switching_checks, scripts/switching_table.py)."""
 
+import csv
 import importlib.util
 import json
 import re
@@ -75,3 +76,18 @@ def test_front_train_ratio_recomputes():
     runs = [json.loads(line) for line in lines if line.strip()]
     ratios = sorted(r["ratio_vs_raw_rollout"] for r in runs)
     assert front("train ratio") == f"{ratios[0]:.2f}-{ratios[-1]:.2f}"
+
+
+def pooled_u_chain_3(table: Path) -> str:
+    with table.open(newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["maze"] == "u_chain_3" and r["method"] == "ours"
+                and r["status"] == "ok" and int(r["seed"]) in (0, 1, 2)]
+    assert len(rows) == 3, f"{table}: {len(rows)} U-chain 3 runs"
+    won = sum(float(r["success_rate"]) * int(r["episodes"]) for r in rows)
+    return f"{won / sum(int(r['episodes']) for r in rows):.3f}"
+
+
+def test_front_slow_turn_u_chain_3_recomputes():
+    slow = pooled_u_chain_3(CHECKS / "uchain_slow_turn.csv")
+    at = pooled_u_chain_3(ROOT / "data" / "results" / "ant" / "centre.csv")
+    assert front("slow-turn uchain3") == f"{slow} against {at}"
