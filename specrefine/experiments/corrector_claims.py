@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, wilson_ci
-from ..core.runfolder import save_figure, write_atomic
+from ..core.runfolder import ensure_dir, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
@@ -499,7 +499,7 @@ def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
         levers, gated = levers_study(), gated_study()
-        args.out.mkdir(parents=True, exist_ok=True)
+        ensure_dir(args.out)
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated))
         record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated,
                   "rules": verdicts(point, ant) + (gated_verdicts(gated) if gated else []),
