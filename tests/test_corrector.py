@@ -204,3 +204,63 @@ def test_a_leg_no_fresh_rollout_reaches_is_not_split():
     assert [(a, b) for a, b, _ in asked] == [(3.0, 6.0), (3.0, 10.0)]
     assert all(start is not None for *_, start in asked)
     assert kept == path and check.probabilities == [1.0, 0.0, 0.0]
+
+
+# --- lean judging (method ours-corrector-lean): a leg must earn its place -----------------------------------------
+def test_lean_judging_declines_three_sound_legs_for_one_that_failed_once():
+    # raw, 128 of 128 on three legs beats 127 of 128 on one; by posterior means one more switch costs more than that
+    for lean, expected in ((False, [0.0, 3.0, 4.0, 5.0, 6.0, 10.0]), (True, [0.0, 3.0, 6.0, 10.0])):
+        book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4, 5]})
+        _, result = run(LegTable(LUCKY, ONE_FAILURE), book, correct_rollouts=4, correct_lean=lean)
+        assert (3.0, 6.0) in book.queries and xs(result) == expected
+
+
+def test_lean_judging_still_takes_a_split_that_mends_a_refuted_leg():
+    book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4, 5]})
+    _, result = run(LegTable(LUCKY, FRESH), book, correct_rollouts=4, correct_lean=True)
+    assert xs(result) == [0.0, 3.0, 4.0, 5.0, 6.0, 10.0]
+
+
+def test_lean_offers_every_waypoint_its_bypass_and_takes_the_shorter_path():
+    # every leg sound on fresh rollouts, so no leg is weak; lean still drops the waypoint at 3 (S -> 6 in reach)
+    for lean, expected in ((False, [0.0, 3.0, 6.0, 10.0]), (True, [0.0, 6.0, 10.0])):
+        g, result = run(LegTable(LUCKY), AnswerBook({(0.0, 10.0): [3, 6]}), correct_rollouts=4, correct_reach=10.0,
+                        correct_lean=lean)
+        assert xs(result) == expected
+        assert check_refines(result.graph, g) == []
+        pruned = [s for s in result.steps if s["event"] == "correct-prune"]
+        assert bool(pruned) == lean
+        if lean:
+            assert pruned[0]["accepted"] == "bypass" and pruned[0]["tried"][0]["legs"] == 2
+
+
+def test_lean_keeps_a_waypoint_whose_bypass_fails_more():
+    fresh = {(0.0, 6.0): 0.9, (3.0, 10.0): 0.9}  # either bypass loses a tenth
+    _, result = run(LegTable(LUCKY, fresh), AnswerBook({(0.0, 10.0): [3, 6]}), correct_rollouts=4,
+                    correct_reach=10.0, correct_lean=True)
+    assert xs(result) == [0.0, 3.0, 6.0, 10.0]
+    assert [s["accepted"] for s in result.steps if s["event"] == "correct-prune"] == [None, None]
+
+
+def test_posterior_mean_of_a_leg_nothing_reached_is_zero():
+    from specrefine.core.results import unreached
+    from specrefine.refine.correct import posterior_mean
+
+    assert posterior_mean(unreached()) == 0.0
+    assert posterior_mean(_Arrive(1.0, n=128)) == pytest.approx(129 / 130)
+
+
+def test_ours_corrector_lean_runs_end_to_end_and_logs_its_pruning(tmp_path):
+    import json
+
+    from specrefine.runs.pipeline import refine_maze
+
+    out = tmp_path / "run"
+    result = refine_maze("u_chain_2", method="ours-corrector-lean", proposer="imperfect:mild", out=out,
+                         agent="point", rollouts=8, episodes=20, seed=0)
+    steps = [json.loads(line) for line in (out / "steps.jsonl").read_text().splitlines()]
+    events = [s["event"] for s in steps]
+    assert events[-1] == "done" and "correct-check" in events and "correct-done" in events
+    done = next(s for s in steps if s["event"] == "correct-done")
+    assert len(done["path"]) - 1 == result.data["path_edges"]
+    assert result.data["method"] == "ours-corrector-lean" and result.data["refines_input"] is True

@@ -15,6 +15,15 @@ search found as a whole, on rollouts the search never saw:
    estimates), and the best replaces the path when its product of leg estimates is higher;
 4. until no leg below 1 is left untried or the correction's budget of proposer splits is spent.
 
+``lean`` (method ``ours-corrector-lean``): a leg must earn its place. An alternative is judged by the product of its
+legs' posterior means (s + 1) / (n + 2) (uniform prior) instead of their raw frequencies, so that each leg costs
+about one rollout's worth even at 128 of 128, and a split that replaces one leg failing once by three that never
+fail on the same draw is no longer taken on that draw alone; it replaces the path when it scores higher. After the
+weak legs, every inner waypoint of the path that one split put there is offered its bypass (one leg instead of
+two, where the straight leg is clear and in reach), judged the same way: the correction's splits and a proposer's
+close waypoints leave paths longer than they need be (27.9 legs against the oracle's 18.8 on U-chain 4-5,
+docs/corrector.md), and each switch loses some episodes that 128 rollouts do not show.
+
 ``min_failures`` > 1 (method ``ours-corrector-gated``) asks the proposer about a leg only when at least that many of
 its fresh rollouts failed: a leg losing a fraction of a per cent shows one failure in 128 about as often as a sound
 one, and splitting it spends proposer calls on noise (docs/corrector.md, 'Where the corrector still loses'). Such a
@@ -55,6 +64,16 @@ def check_path(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *
     nothing reached path[0], every leg unreached)."""
     estimates = estimate_legs(evaluator, start, path_legs(graph, path), seed=seed, n=rollouts)
     return Check(results=estimates.results, path=list(path))
+
+
+def posterior_mean(result) -> float:
+    """(s + 1) / (n + 2): a leg's success under a uniform prior; 0 for a leg nothing reached."""
+    return (result.successes + 1) / (result.n + 2) if result.n > 0 else 0.0
+
+
+def lean_score(check: Check) -> float:
+    """The product of the legs' posterior means: each leg costs about one rollout's worth at n of n."""
+    return math.prod(posterior_mean(r) for r in check.results) if check.results else 0.0
 
 
 def weakest_untried(check: Check, tried: set) -> int | None:
@@ -104,20 +123,21 @@ def spliced(graph: TaskGraph, path: list[str], i: int, j: int, waypoints) -> tup
 
 def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
-            log: Callable[..., None], min_failures: int = 1) -> tuple[TaskGraph, list[str], Check]:
+            log: Callable[..., None], min_failures: int = 1, lean: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
     An alternative is judged on the legs it changes and the leg after them (the window), from the same fresh start
     states as the current path's legs there; it replaces the path when it gains at least one rollout's worth
-    (1 / rollouts) over the window, and the path's legs from the window on are then checked again."""
-    check = check_path(graph, path, evaluator, rollouts=rollouts, seed=seed, start=graph.region(path[0]))
-    log("correct-check", path=path, p=check.p, probabilities=check.probabilities)
+    (1 / rollouts) over the window (``lean``: when its posterior score there is higher), and the path's legs from
+    the window on are then checked again. ``lean`` then offers every inner waypoint its bypass (module doc)."""
+    state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
+                                           start=graph.region(path[0])), evaluator, rollouts, seed, lean)
+    log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
     tried: set = set()
-    while (leg := weakest_untried(check, tried)) is not None:
-        tried.add(_leg_key(check, leg))
-        s, e = max(leg - 1, 0), min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e]
-        start = graph.region(path[0]) if s == 0 else start_of(check.results[s - 1])
+    while (leg := weakest_untried(state.check, tried)) is not None:
+        tried.add(_leg_key(state.check, leg))
+        graph, path, check = state.graph, state.path, state.check
         options = [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
         spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
         if failures(check.results[leg]) < min_failures:
@@ -137,20 +157,73 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             fix = split_leg(*_with_edge(graph, path, i, j), path[i], path[j], result, leg_start)
             if fix is not None and fix.waypoints:
                 options.append(("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints)))
-        current = math.prod(check.probabilities[s:e])
-        judged = [(kind, g, p, check_path(g, p[s:p.index(path[e]) + 1], evaluator, rollouts=rollouts, seed=seed,
-                                          start=start)) for kind, g, p in options]
-        best = max(judged, key=lambda o: o[3].p, default=None)
-        accepted = best is not None and best[3].p >= current + 1.0 / rollouts
-        log("correct-leg", leg=leg, edge=path[leg:leg + 2], p_leg=check.probabilities[leg], p_window=current,
-            tried=[{"kind": kind, "p_window": c.p, "legs": len(p) - 1} for kind, _, p, c in judged],
-            accepted=best[0] if accepted else None)
-        if accepted:
-            graph, path = best[1], best[2]
-            rest = check_path(graph, path[s:], evaluator, rollouts=rollouts, seed=seed, start=start)
-            check = Check(results=check.results[:s] + rest.results, path=list(path))
-    log("correct-done", path=path, p=check.p, probabilities=check.probabilities)
-    return graph, path, check
+        judged, accepted = state.judge(leg, options)
+        log("correct-leg", leg=leg, edge=path[leg:leg + 2], p_leg=check.probabilities[leg], p_window=judged.current,
+            tried=judged.tried, accepted=accepted)
+    if lean:
+        _prune(state, reach, clearance, log)
+    log("correct-done", path=state.path, p=state.check.p, probabilities=state.check.probabilities)
+    return state.graph, state.path, state.check
+
+
+@dataclass
+class Judged:
+    current: float  # the window's score on the current path
+    tried: list  # per alternative: its kind, window score and legs
+
+
+@dataclass
+class _State:
+    """The path being corrected, its fresh check, and how alternatives to it are judged."""
+
+    graph: TaskGraph
+    path: list[str]
+    check: Check
+    evaluator: SubtaskEvaluator
+    rollouts: int
+    seed: int
+    lean: bool
+
+    def score(self, check: Check) -> float:
+        return lean_score(check) if self.lean else check.p
+
+    def judge(self, leg: int, options: list) -> tuple[Judged, str | None]:
+        """Judge ``options`` (kind, graph, path) against the path over the window around ``leg``; the best replaces
+        the path (and the path is checked again from the window on) when it wins. -> (what was judged, the kind
+        accepted or None)."""
+        graph, path, check = self.graph, self.path, self.check
+        s, e = max(leg - 1, 0), min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e]
+        start = graph.region(path[0]) if s == 0 else start_of(check.results[s - 1])
+        current = self.score(Check(results=check.results[s:e]))
+        judged = [(kind, g, p, check_path(g, p[s:p.index(path[e]) + 1], self.evaluator, rollouts=self.rollouts,
+                                          seed=self.seed, start=start)) for kind, g, p in options]
+        best = max(judged, key=lambda o: self.score(o[3]), default=None)
+        if self.lean:
+            wins = best is not None and self.score(best[3]) > current
+        else:
+            wins = best is not None and best[3].p >= current + 1.0 / self.rollouts
+        if wins:
+            self.graph, self.path = best[1], best[2]
+            rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=self.seed,
+                              start=start)
+            self.check = Check(results=check.results[:s] + rest.results, path=list(self.path))
+        tried = [{"kind": kind, "p_window": self.score(c), "legs": len(p) - 1} for kind, _, p, c in judged]
+        return Judged(current, tried), best[0] if wins else None
+
+
+def _prune(state: _State, reach: float, clearance: float, log: Callable[..., None]) -> None:
+    """Offer each inner waypoint of the path, first to last, its bypass (``lean``: module doc)."""
+    m = 1
+    while m < len(state.path) - 1:
+        allowed = (m - 1, m + 1) in bypasses(state.graph, state.path, m - 1, reach, clearance)
+        if not allowed:
+            m += 1
+            continue
+        waypoint = state.path[m]
+        judged, accepted = state.judge(m - 1, [("bypass", *bypassed(state.graph, state.path, m - 1, m + 1))])
+        log("correct-prune", waypoint=waypoint, p_window=judged.current, tried=judged.tried, accepted=accepted)
+        if accepted is None:
+            m += 1
 
 
 def _with_edge(graph: TaskGraph, path: list[str], i: int, j: int) -> tuple[TaskGraph]:

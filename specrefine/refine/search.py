@@ -69,6 +69,7 @@ class SearchConfig:
     dead_weight: float | None = None  # beyond the paper: the weight of a leg that never succeeded (None: -log(0.5/n))
     correct_reach: float | None = None  # the correction drops a waypoint only where the leg it makes is this short
     correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
+    correct_lean: bool = False  # the correction judges by posterior means and offers every waypoint its bypass
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -393,7 +394,7 @@ class RefinementSearch:
                                       seed=self.cfg.seed + CHECK_SEED_OFFSET, split_leg=split_leg,
                                       may_split=lambda: self.splits_generated < budget, reach=reach,
                                       clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log,
-                                      min_failures=self.cfg.correct_min_failures)
+                                      min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean)
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
         return path

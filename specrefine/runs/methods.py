@@ -206,6 +206,11 @@ register_method("ours-corrector-gated", ours_variant(repair=True, repair_depth=3
                                                      correct_min_failures=3),
                 "beyond the paper: ours-corrector asking the proposer about a leg of the found path only when at "
                 "least 3 of its 4n fresh rollouts failed (a leg with fewer is only bypassed)", colour="#7f0000")
+register_method("ours-corrector-lean", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
+                                                    correct_rollouts=4, correct_reach="policy", correct_lean=True),
+                "beyond the paper: ours-corrector whose legs must earn their place: alternatives judged by the "
+                "product of the legs' posterior means, and every waypoint of the corrected path offered its bypass",
+                colour="#ff7043")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
