@@ -112,3 +112,17 @@ def test_tuned_study_pairs_the_tuned_repair_with_the_repair_per_preset(tmp_path)
     write_csv(table, rows)
     assert rc.main([str(table), "--tuned", "--out", str(tmp_path / "o")]) == 0
     assert json.loads((tmp_path / "o" / "tuned_claims.json").read_text())["claims"][0]["verdict"] == "helps"
+
+
+def test_cli_refuses_a_folder_another_command_is_writing(tmp_path, capsys):
+    from specrefine.core.runfolder import locked
+
+    write_csv(tmp_path / "t.csv", grid_rows(lambda maze, m, seed: 0.5))
+    out = tmp_path / "out"
+    out.mkdir()
+    with locked(out), pytest.raises(SystemExit) as exc:
+        rc.main([str(tmp_path / "t.csv"), "--out", str(out)])
+    assert exc.value.code == 2 and "in use" in capsys.readouterr().err
+    assert list(out.iterdir()) == []
+    assert rc.main([str(tmp_path / "t.csv"), "--out", str(out)]) == 0  # free again: written, and no lock left
+    assert (out / "claims.md").is_file() and not (out / ".lock").exists()

@@ -76,3 +76,16 @@ def test_a_missing_oracle_is_one_line(sweep, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "specrefine.experiments.taxonomy", str(sweep / "sweep"),
                            "--oracle", str(tmp_path / "nope.csv")], capture_output=True, text=True)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_a_folder_another_command_is_writing_is_refused_in_one_line(sweep):
+    from specrefine.core.runfolder import locked
+
+    out = sweep / "busy"
+    out.mkdir()
+    with locked(out):  # another holder of the folder's lock (a sweep, or a second analysis command)
+        proc = subprocess.run([sys.executable, "-m", "specrefine.experiments.taxonomy", str(sweep / "sweep"),
+                               "--oracle", str(sweep / "oracle.csv"), "--out", str(out)], capture_output=True,
+                              text=True)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "in use" in proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == []

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, wilson_ci
-from ..core.runfolder import ensure_dir, save_figure, write_atomic
+from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
@@ -499,13 +499,13 @@ def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
         levers, gated = levers_study(), gated_study()
-        ensure_dir(args.out)
-        write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated))
         record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated,
                   "rules": verdicts(point, ant) + (gated_verdicts(gated) if gated else []),
                   "front": front(point, held_out, levers=levers, gated=gated)}
-        write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
-        save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
+        with locked(ensure_dir(args.out)):
+            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated))
+            write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
+            save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import SpecrefineError
-from ..core.runfolder import ensure_dir, write_atomic
+from ..core.runfolder import ensure_dir, locked, write_atomic
 from .grids import SCALING_MAZES
 from .taxonomy import Run, read_runs
 
@@ -215,9 +215,9 @@ def run(args, p) -> int:
         if args.out is None:
             print(text, end="")
             return 0
-        ensure_dir(args.out)
-        write_atomic(args.out / "diagnosis.md", text)
-        write_atomic(args.out / "diagnosis.json", json.dumps(s, indent=1) + "\n")
+        with locked(ensure_dir(args.out)):
+            write_atomic(args.out / "diagnosis.md", text)
+            write_atomic(args.out / "diagnosis.json", json.dumps(s, indent=1) + "\n")
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2

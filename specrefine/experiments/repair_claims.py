@@ -21,7 +21,7 @@ import numpy as np
 from ..core.argtypes import OneLineParser, out_path
 from ..core.errors import SpecrefineError
 from ..core.mazes import benchmark_mazes
-from ..core.runfolder import ensure_dir, save_figure, write_atomic
+from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import GRIDS
@@ -193,17 +193,23 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     try:
         rows = read_checked_table(args.table)
-        ensure_dir(args.out)
+        with locked(ensure_dir(args.out)):
+            print(write_tuned(rows, args) if args.tuned else write_claims(rows, args))
     except SpecrefineError as exc:
         ap.exit(2, f"{ap.prog}: error: {exc}\n")
-    if args.tuned:
-        entries, cost_rows, text = tuned_study(rows)
-        write_atomic(args.out / "tuned_claims.md", text + "\n")
-        write_atomic(args.out / "tuned_claims.json", json.dumps(cmp._jsonable(
-            {"table": str(args.table), "claims": entries, "costs": cost_rows}), indent=1) + "\n")
-        print(f"{len(rows)} rows -> {args.out}: tuned_claims.md, tuned_claims.json "
-              f"({sum(not e['complete'] for e in entries)} of {len(entries)} entries partial)")
-        return 0
+    return 0
+
+
+def write_tuned(rows, args) -> str:
+    entries, cost_rows, text = tuned_study(rows)
+    write_atomic(args.out / "tuned_claims.md", text + "\n")
+    write_atomic(args.out / "tuned_claims.json", json.dumps(cmp._jsonable(
+        {"table": str(args.table), "claims": entries, "costs": cost_rows}), indent=1) + "\n")
+    return (f"{len(rows)} rows -> {args.out}: tuned_claims.md, tuned_claims.json "
+            f"({sum(not e['complete'] for e in entries)} of {len(entries)} entries partial)")
+
+
+def write_claims(rows, args) -> str:
     result = study(rows)
     about = {"table": str(args.table), "note": cmp.OFFLINE_NOTE, "presets": list(PRESETS), "seeds": list(SEEDS),
              "bootstrap_resamples": cmp.BOOTSTRAP_RESAMPLES, "bootstrap_seed": cmp.BOOTSTRAP_SEED}
@@ -215,9 +221,8 @@ def main(argv=None) -> int:
     for name, fig in cmp.comparison_figures(rows, GRID).items():
         save_figure(fig, args.out / f"{name}.png", dpi=110)
     partial = sum(not e["complete"] for e in result.entries)
-    print(f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, summary.md, figures "
-          f"({partial} of {len(result.entries)} entries partial)")
-    return 0
+    return (f"{len(rows)} rows -> {args.out}: claims.md, claims.json, mazes.md, summary.md, figures "
+            f"({partial} of {len(result.entries)} entries partial)")
 
 
 if __name__ == "__main__":

@@ -36,7 +36,7 @@ from pathlib import Path
 from ..core.errors import SpecrefineError
 from ..core.records import read_result
 from ..core.results import wilson_ci
-from ..core.runfolder import ensure_dir, write_atomic
+from ..core.runfolder import ensure_dir, locked, write_atomic
 
 CAUSES = ("budget-spent", "repair-gave-up", "split-declined-dead-legs", "no-split-offered", "estimate-refuted",
           "weak-legs-accepted")
@@ -205,9 +205,9 @@ def run(args, p) -> int:
         if args.out is None:
             print(text, end="")
             return 0
-        ensure_dir(args.out)
-        write_atomic(args.out / "taxonomy.csv", to_csv(rows))
-        write_atomic(args.out / "taxonomy.md", text)
+        with locked(ensure_dir(args.out)):
+            write_atomic(args.out / "taxonomy.csv", to_csv(rows))
+            write_atomic(args.out / "taxonomy.md", text)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
