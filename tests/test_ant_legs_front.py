@@ -78,16 +78,18 @@ def test_front_train_ratio_recomputes():
     assert front("train ratio") == f"{ratios[0]:.2f}-{ratios[-1]:.2f}"
 
 
-def pooled_u_chain_3(table: Path) -> str:
+def pooled_u_chains(table: Path) -> str:
+    """Success pooled over the six cells of check 5 (U-chain 3 and 5, seeds 0-2)."""
     with table.open(newline="") as fh:
-        rows = [r for r in csv.DictReader(fh) if r["maze"] == "u_chain_3" and r["method"] == "ours"
+        rows = [r for r in csv.DictReader(fh) if r["maze"] in ("u_chain_3", "u_chain_5") and r["method"] == "ours"
                 and r["status"] == "ok" and int(r["seed"]) in (0, 1, 2)]
-    assert len(rows) == 3, f"{table}: {len(rows)} U-chain 3 runs"
+    assert len(rows) == 6, f"{table}: {len(rows)} U-chain 3 and 5 runs"
     won = sum(float(r["success_rate"]) * int(r["episodes"]) for r in rows)
     return f"{won / sum(int(r['episodes']) for r in rows):.3f}"
 
 
-def test_front_slow_turn_u_chain_3_recomputes():
-    slow = pooled_u_chain_3(CHECKS / "uchain_slow_turn.csv")
-    at = pooled_u_chain_3(ROOT / "data" / "results" / "ant" / "centre.csv")
-    assert front("slow-turn uchain3") == f"{slow} against {at}"
+def test_front_slow_turn_u_chains_recompute():
+    slow = pooled_u_chains(CHECKS / "uchain_slow_turn.csv")
+    at = pooled_u_chains(ROOT / "data" / "results" / "ant" / "centre.csv")
+    assert front("slow-turn uchains") == f"{slow} against {at}"
+    assert f"Pooled {slow} [" in (CHECKS / "uchain_check.md").read_text()
