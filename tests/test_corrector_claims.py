@@ -109,11 +109,11 @@ def test_the_held_out_grid_is_described_per_maze_and_mix(tmp_path):
 
 def lay_grid(root, name, rate_of, calls_of=lambda m: 3, seeds=None, part=0, drop=0):
     """A grid's part table under ``root``: rate_of(maze, method, proposer) per cell (the last ``drop`` rows left
-    out)."""
+    out), each maze named as a sweep's table names it."""
     g = GRIDS[name]
     p = g.parts[part]
-    rows = [row(maze, m, rate_of(maze, m, pr), s, pr) | {"proposer_calls": calls_of(m), "evaluations": 10,
-                                                          "sim_steps": 1000}
+    cost = {"evaluations": 10, "sim_steps": 1000}
+    rows = [row(cc.table_name(maze), m, rate_of(maze, m, pr), s, pr) | cost | {"proposer_calls": calls_of(m)}
             for maze in (p.mazes or g.mazes) for m in p.methods for pr in p.proposers for s in (p.seeds or g.seeds)]
     path = root / g.part_table(part)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -190,8 +190,9 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
 
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
-    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated"} <= set(marked)
-    expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study())
+    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean"} <= set(marked)
+    expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
+                        lean=cc.lean_study())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -204,3 +205,30 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
                 k = sum(round(float(r["success_rate"]) * int(r["episodes"])) for r in mine)
                 curve.append(f"{k / sum(int(r['episodes']) for r in mine):.3f}")
         assert marked[level].startswith(f"1-5 rooms {', '.join(curve)};")
+
+
+@pytest.mark.parametrize("lean, verdict", [(0.98, "helps"), (0.96, "no worse"), (0.9, "worse")])
+def test_the_lean_corrector_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_path, lean, verdict):
+    lay(tmp_path, rates)
+    for part in (0, 1, 2):
+        lay_grid(tmp_path, "corrector-lean", lambda maze, m, p: lean, calls_of=lambda m: 5, part=part)
+    vs = cc.lean_study(tmp_path)
+    v = {e["rule"]: e for e in cc.variant_verdicts(vs)}
+    paired = v[f"{cc.LEAN} - {cc.METHOD} (paired, U-chains, mild and moderate): helps if the lower end > 0, no worse "
+               "if >= -0.02"]
+    assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
+    severe = v[f"{cc.LEAN}, imperfect:severe: no worse than ours-repair (paired, U-chains)"]
+    assert severe["verdict"] == "no worse" and "+" in severe["value"]  # every lean rate here is above ours-repair's
+    assert [c["proposer"] for c in vs["costs"]] == [*LEVELS, "imperfect:severe"]
+    assert all(e["runs"] == 2 for e in vs["held_out"])  # seeds 0-1 per layout and mix
+    text = cc._lean_text(vs)
+    assert text.startswith(f"{cc.LEAN} - {cc.METHOD} ") and f"({verdict})" in text
+    assert "1.7x the proposer calls of ours" in text
+    md = "\n".join(cc.variant_markdown(vs))
+    assert "Severe (described)" in md and "Held out (descriptive)" in md
+
+
+def test_without_its_table_the_lean_corrector_is_not_run_yet(tmp_path):
+    lay(tmp_path, rates)
+    assert cc.lean_study(tmp_path) is None
+    assert cc.front(cc.point_study(tmp_path), None, tmp_path)["lean"] == "not run yet"

@@ -29,7 +29,9 @@ from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROO
 METHOD = "ours-corrector"
 LEVERS = ("ours-deeprepair", "ours-feasible", "ours-checked")
 GATED = "ours-corrector-gated"
-NON_INFERIORITY = 0.02  # ours-corrector-gated - ours-corrector: the interval's lower end at or above -this
+LEAN = "ours-corrector-lean"
+NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
+VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean"}  # each variant of the corrector and its grid
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -215,48 +217,71 @@ def pooled(rows, mazes, method, proposer, seeds) -> tuple[int, int, int]:
     return tuple(sum(c[i] for c in counts) for i in range(3))
 
 
-def gated_study(root: Path = ROOT) -> dict | None:
-    """ours-corrector-gated by the rules of docs/corrector.md, 'A gate on the correction'."""
-    grid = GRIDS["corrector-gated"]
-    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + (grid.table,), root)
-    if not any(r["method"] == GATED for r in rows):
+def variant_study(method: str, root: Path = ROOT) -> dict | None:
+    """A variant of the corrector (``VARIANT_GRIDS``) by the rules of its docs/corrector.md section: against
+    ours-corrector (paired, U-chains, mild and moderate), the corrector's own rules, its cost beside the corrector's,
+    the held-out cells and, where its grid ran severe, severe against ours-repair."""
+    grid = GRIDS[VARIANT_GRIDS[method]]
+    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + grid.tables, root)
+    if not any(r["method"] == method for r in rows):
         return None
     cells, failed = cmp.table_cells(rows, "point")
     presets = ("imperfect:mild", "imperfect:moderate")
     both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in presets}
     both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in presets}
-    study = {"per_maze": [], "rooms": [], "zero": [], "costs": [], "corrector_costs": [],
-             "versus_corrector": cmp.paired_difference(both, both_failed, "both", GATED, METHOD, POINT_SEEDS,
+    study = {"method": method, "grid": grid.name, "per_maze": [], "rooms": [], "zero": [], "costs": [],
+             "corrector_costs": [],
+             "versus_corrector": cmp.paired_difference(both, both_failed, "both", method, METHOD, POINT_SEEDS,
                                                        [f"{maze} {p}" for p in presets for maze in SCALING_MAZES])}
     for proposer in presets:
-        study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=GATED)
-        study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, GATED, POINT_SEEDS))
-        study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, GATED, proposer, SCALING_MAZES)})
-        study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=GATED))
-        ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == GATED and r["proposer"] == proposer
-               and cmp.is_done(r)}  # the corrector's cost on the cells the gated corrector ran
+        study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=method)
+        study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, method, POINT_SEEDS))
+        study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, method, proposer, SCALING_MAZES)})
+        study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=method))
+        ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == method and r["proposer"] == proposer
+               and cmp.is_done(r)}  # the corrector's cost on the cells the variant ran
         study["corrector_costs"].append(costs([r for r in rows if (r["maze"], r["seed"]) in ran], proposer,
                                               SCALING_MAZES, POINT_SEEDS))
-    study["held_out"] = gated_held_out(root)
-    study["held_out_costs"] = gated_held_out_costs(root)
+    study["held_out"] = variant_held_out(method, root)
+    study["held_out_costs"] = variant_held_out_costs(method, root)
+    if "imperfect:severe" in grid.proposers:
+        study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, method=method)
+        study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, "ours-repair",
+                                                          POINT_SEEDS, SCALING_MAZES)
+        study["severe_vs_corrector"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, METHOD,
+                                                             POINT_SEEDS, SCALING_MAZES)
+        study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     return study
 
 
-def gated_held_out_costs(root: Path = ROOT) -> list[dict]:
-    """Per held-out mix: the gated corrector's and the corrector's mean cost over ours's on the same cells."""
-    rows = load(GRIDS["corrector-held-out"].tables + (GRIDS["corrector-gated"].part_table(1),), root)
+def gated_study(root: Path = ROOT) -> dict | None:
+    return variant_study(GATED, root)
+
+
+def lean_study(root: Path = ROOT) -> dict | None:
+    return variant_study(LEAN, root)
+
+
+def _held_out_rows(method: str, root: Path) -> list[dict]:
+    grid = GRIDS[VARIANT_GRIDS[method]]
+    part = next(i for i, part in enumerate(grid.parts) if set(part.proposers) == set(HELD_OUT_MIXES))
+    return load(GRIDS["corrector-held-out"].tables + (grid.part_table(part),), root)
+
+
+def variant_held_out_costs(method: str, root: Path = ROOT) -> list[dict]:
+    """Per held-out mix: the variant's and the corrector's mean cost over ours's on the same cells."""
+    rows = _held_out_rows(method, root)
     mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
-    return [costs(rows, mix, mazes, HELD_OUT_SEEDS, first=method) | {"proposer": f"mix {MIX_NAMES[mix]}",
-                                                                      "method": method}
-            for mix in HELD_OUT_MIXES for method in (GATED, METHOD)]
+    return [costs(rows, mix, mazes, HELD_OUT_SEEDS, first=m) | {"proposer": f"mix {MIX_NAMES[mix]}", "method": m}
+            for mix in HELD_OUT_MIXES for m in (method, METHOD)]
 
 
-def gated_held_out(root: Path = ROOT) -> list[dict]:
-    rows = load(GRIDS["corrector-held-out"].tables + (GRIDS["corrector-gated"].part_table(1),), root)
+def variant_held_out(method: str, root: Path = ROOT) -> list[dict]:
+    rows = _held_out_rows(method, root)
     mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
     out = []
     for mix in HELD_OUT_MIXES:
-        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=(METHOD, "*"), method=GATED):
+        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=(METHOD, "*"), method=method):
             k, n, _ = episodes_of(rows, e["maze"], "ours", mix, HELD_OUT_SEEDS)
             out.append(e | {"mix": MIX_NAMES[mix], "ours": k / n if n else math.nan})
     return out
@@ -338,7 +363,7 @@ def _verdict(ok: bool, complete: bool) -> str:
 
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
-             gated: dict | None = None) -> str:
+             gated: dict | None = None, lean: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -398,8 +423,9 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
-    if gated:
-        lines += gated_markdown(gated)
+    for variant in (gated, lean):
+        if variant:
+            lines += variant_markdown(variant)
     return "\n".join(lines) + "\n"
 
 
@@ -431,59 +457,86 @@ def levers_markdown(lv: dict) -> list[str]:
     return lines
 
 
-def gated_verdicts(gs: dict) -> list[dict]:
-    """The rules of docs/corrector.md, 'A gate on the correction'."""
-    out = []
-    for c in gs["costs"]:
+def versus_corrector(vs: dict) -> tuple[str, str]:
+    """(rule, verdict) of a variant against ours-corrector, as its section of docs/corrector.md fixed it: the gate
+    is to be no worse (lower end >= -NON_INFERIORITY); the lean judging helps (lower end > 0), is no worse, or is
+    worse."""
+    v, method = vs["versus_corrector"], vs["method"]
+    scope = f"{method} - {METHOD} (paired, U-chains, mild and moderate)"
+    known = not math.isnan(v["estimate"])
+    no_worse = known and v["ci_low"] >= -NON_INFERIORITY
+    if method == GATED:
+        return f"{scope}: lower end >= -{NON_INFERIORITY}", _verdict(no_worse, v["complete"])
+    word = "helps" if known and v["ci_low"] > 0 else "no worse" if no_worse else "worse" if known else "undecided"
+    return (f"{scope}: helps if the lower end > 0, no worse if >= -{NON_INFERIORITY}",
+            word + ("" if v["complete"] else " (partial)"))
+
+
+def variant_verdicts(vs: dict) -> list[dict]:
+    """The rules of the variant's section of docs/corrector.md."""
+    method, out = vs["method"], []
+    for c in vs["costs"]:
         ratios = f"{_num(c['proposer_calls_ratio'], '{:.2f}x')}, {_num(c['evaluations_ratio'], '{:.2f}x')}"
-        out.append({"rule": f"{GATED}, {c['proposer']}: cost at most {COST_CAP}x ours (proposer calls, evaluations)",
+        out.append({"rule": f"{method}, {c['proposer']}: cost at most {COST_CAP}x ours (proposer calls, evaluations)",
                     "value": f"{ratios} over {c['pairs']} pairs", "verdict": _cost_verdict(c)})
-    v = gs["versus_corrector"]
-    ok = not math.isnan(v["estimate"]) and v["ci_low"] >= -NON_INFERIORITY
-    out.append({"rule": f"{GATED} - {METHOD} (paired, U-chains, mild and moderate): lower end >= -{NON_INFERIORITY}",
-                "value": _paired_text(v), "verdict": _verdict(ok, v["complete"])})
+    rule, verdict = versus_corrector(vs)
+    out.append({"rule": rule, "value": _paired_text(vs["versus_corrector"]), "verdict": verdict})
     for proposer in ("imperfect:mild", "imperfect:moderate"):
-        mazes = [e for e in gs["per_maze"] if e["proposer"] == proposer]
+        mazes = [e for e in vs["per_maze"] if e["proposer"] == proposer]
         within = [e for e in mazes if e["runs"] and e["success"] >= e["reference_success"] - TOLERANCE]
         complete = all(e["runs"] == len(POINT_SEEDS) for e in mazes)
-        out.append({"rule": f"{GATED}, {proposer}: within {TOLERANCE} of the oracle on every U-chain",
+        out.append({"rule": f"{method}, {proposer}: within {TOLERANCE} of the oracle on every U-chain",
                     "value": f"{len(within)} of {len(mazes)} mazes", "verdict": _verdict(len(within) == len(mazes),
                                                                                         complete)})
-        rooms = next(e for e in gs["rooms"] if e["proposer"] == proposer)
-        out.append({"rule": f"{GATED}, {proposer}: flat from 1 to 5 rooms", "value": cmp._interval_text(rooms),
+        rooms = next(e for e in vs["rooms"] if e["proposer"] == proposer)
+        out.append({"rule": f"{method}, {proposer}: flat from 1 to 5 rooms", "value": cmp._interval_text(rooms),
                     "verdict": rooms["verdict"] + ("" if rooms["complete"] else " (partial)")})
-        zero = next(z for z in gs["zero"] if z["proposer"] == proposer)["runs"]
-        out.append({"rule": f"{GATED}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
+        zero = next(z for z in vs["zero"] if z["proposer"] == proposer)["runs"]
+        out.append({"rule": f"{method}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
                     "verdict": _verdict(zero[0] == 0, complete)})
+    if "severe_vs_repair" in vs:
+        severe = vs["severe_vs_repair"]
+        out.append({"rule": f"{method}, imperfect:severe: no worse than ours-repair (paired, U-chains)",
+                    "value": _paired_text(severe), "verdict": ("no worse" if severe["verdict"] != "lower" else "worse")
+                    + ("" if severe["complete"] else " (partial)")})
     return out
 
 
-def gated_markdown(gs: dict) -> list[str]:
-    lines = ["", f"`{GATED}` (grid `corrector-gated`; its rules fixed before it ran, docs/corrector.md 'A gate on the "
-             "correction'):", "", "| rule | estimate | verdict |", "|---|---|---|"]
-    lines += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in gated_verdicts(gs)]
+def gated_verdicts(gs: dict) -> list[dict]:
+    return variant_verdicts(gs)
+
+
+def variant_markdown(vs: dict) -> list[str]:
+    method, grid = vs["method"], vs["grid"]
+    short = method.removeprefix(f"{METHOD}-")
+    lines = ["", f"`{method}` (grid `{grid}`; its rules fixed before it ran, docs/corrector.md):", "",
+             "| rule | estimate | verdict |", "|---|---|---|"]
+    lines += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in variant_verdicts(vs)]
     lines += ["", f"Cost beside {METHOD}'s on the same cells (mean over the mean of ours):", "",
               "| proposer | method | pairs | evaluations | proposer calls | simulator steps |",
               "|---|---|---|---|---|---|"]
-    for mine, full in zip(gs["costs"], gs["corrector_costs"]):
-        for name, c in ((GATED, mine), (METHOD, full)):
+    for mine, full in zip(vs["costs"], vs["corrector_costs"]):
+        for name, c in ((method, mine), (METHOD, full)):
             lines.append(f"| {c['proposer']} | {name} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                          f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
-    lines += ["", f"Per U-chain: {GATED} vs the oracle, pooled over seeds (Newcombe 95 %).", "",
-              "| proposer | maze | runs | gated | oracle | difference |", "|---|---|---|---|---|---|"]
+    lines += ["", f"Per U-chain: {method} vs the oracle, pooled over seeds (Newcombe 95 %).", "",
+              f"| proposer | maze | runs | {short} | oracle | difference |", "|---|---|---|---|---|---|"]
     lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
-              f"{_num(e['reference_success'])} | {_diff(e)} |" for e in gs["per_maze"]]
-    if any(e["runs"] for e in gs["held_out"]):
-        lines += ["", f"Held out (descriptive): {GATED} - {METHOD} per layout and mix (Newcombe 95 %), ours beside.",
-                  "", "| mix | maze | runs | gated | ours-corrector | difference | ours |",
+              f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["per_maze"] + vs.get("severe", [])]
+    if "severe_vs_corrector" in vs:
+        lines += ["", f"Severe (described): {method} - {METHOD} {_paired_text(vs['severe_vs_corrector'])}; - "
+                  f"ours-repair {_paired_text(vs['severe_vs_repair'])} (paired, U-chains, 95 % bootstrap)."]
+    if any(e["runs"] for e in vs["held_out"]):
+        lines += ["", f"Held out (descriptive): {method} - {METHOD} per layout and mix (Newcombe 95 %), ours beside.",
+                  "", f"| mix | maze | runs | {short} | ours-corrector | difference | ours |",
                   "|---|---|---|---|---|---|---|"]
         lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])}"
-                  f" | {_diff(e)} | {_num(e['ours'])} |" for e in gs["held_out"]]
+                  f" | {_diff(e)} | {_num(e['ours'])} |" for e in vs["held_out"]]
         lines += ["", "| held-out mix | method | pairs | evaluations | proposer calls | simulator steps |",
                   "|---|---|---|---|---|---|"]
         lines += [f"| {c['proposer']} | {c['method']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                   f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"
-                  for c in gs["held_out_costs"]]
+                  for c in vs["held_out_costs"]]
     return lines
 
 
@@ -498,12 +551,12 @@ def add_arguments(p) -> None:
 def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
-        levers, gated = levers_study(), gated_study()
-        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated,
-                  "rules": verdicts(point, ant) + (gated_verdicts(gated) if gated else []),
-                  "front": front(point, held_out, levers=levers, gated=gated)}
+        levers, gated, lean = levers_study(), gated_study(), lean_study()
+        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated, "lean": lean,
+                  "rules": verdicts(point, ant) + [v for vs in (gated, lean) if vs for v in variant_verdicts(vs)],
+                  "front": front(point, held_out, levers=levers, gated=gated, lean=lean)}
         with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated))
+            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated, lean))
             write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
             save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
@@ -522,10 +575,10 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          gated: dict | None = None) -> dict[str, str]:
+          gated: dict | None = None, lean: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
     counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
-                                                      "corrector-levers", "corrector-gated")}
+                                                      "corrector-levers", "corrector-gated", "corrector-lean")}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -552,6 +605,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
     out["levers"] = _levers_text(levers) if levers else "not run yet"
     out["gated"] = _gated_text(gated) if gated else "not run yet"
+    out["lean"] = _lean_text(lean) if lean else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -589,6 +643,21 @@ def _gated_text(gs: dict) -> str:
     ok = not math.isnan(v["estimate"]) and v["ci_low"] >= -NON_INFERIORITY
     return (f"proposer calls over ours: {costs}; {GATED} - {METHOD} {_signed(v)} over {v['n_cells']} of "
             f"{v['n_expected']} paired cells (no worse by -{NON_INFERIORITY}: {_verdict(ok, v['complete'])})")
+
+
+def _lean_text(vs: dict) -> str:
+    """The lean corrector against ours-corrector, its curve over rooms per preset and its proposer calls."""
+    _, verdict = versus_corrector(vs)
+    v = vs["versus_corrector"]
+    parts = [f"{LEAN} - {METHOD} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells ({verdict})"]
+    for rooms, c in zip(vs["rooms"], vs["costs"]):
+        level = rooms["proposer"].split(":")[1]
+        mazes = [e for e in vs["per_maze"] if e["proposer"] == rooms["proposer"] and e["runs"]]
+        within = sum(1 for e in mazes if e["success"] >= e["reference_success"] - TOLERANCE)
+        parts.append(f"{level}: within {TOLERANCE} of the oracle on {within} of {len(mazes)} U-chains, "
+                     f"{cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)}), "
+                     f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours")
+    return "; ".join(parts)
 
 
 def _cost_text(c: dict) -> str:
