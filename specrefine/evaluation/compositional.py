@@ -10,6 +10,8 @@ goal-switching rule of :meth:`specrefine.evaluation.evaluator.Evaluator.run_comp
 * at every decision the agent's position is checked first: while it lies in the current leg's goal
   region the policy moves on to the next leg (several at once if the regions overlap); then the goal
   policy is fed the current leg's goal point (the last leg's once all are done);
+* a goal policy with look-ahead (``GoalPolicy.lookahead``) is also fed the next leg's goal point (on the last leg,
+  the last leg's own; while the switching rule holds a leg's start, that leg's point), as the evaluator feeds it;
 * ``switching`` names when it is fed that point (:mod:`specrefine.sim.switching`): ``at-region`` (the
   paper's, the default) at once; ``slow-turn`` first holds a leg that starts with the torso moving fast and away
   from its goal point, feeding the agent's own position until the rule lets go (the evaluator's rule and code).
@@ -112,9 +114,14 @@ class CompositionalPolicy:
         """The control for this environment step (a new decision every ``hold`` calls)."""
         if self._calls % self.hold == 0 or self._action is None:
             self.update(observation)
-            goal = self._aim(observation, self.goal_points[min(self.leg, len(self.legs) - 1)])
+            last = len(self.legs) - 1
+            point = self.goal_points[min(self.leg, last)]
+            goal = self._aim(observation, point)
+            after = None
+            if getattr(self.goal_policy, "lookahead", False):  # the next leg's point; braking, its own leg's
+                after = point if self.holding else self.goal_points[min(self.leg + 1, last)]
             obs = policy_observation(self.agent, observation, goal, getattr(self.goal_policy, "observation_frame",
-                                                                            "world"))
+                                                                            "world"), after)
             self._action = self._control(np.asarray(self._act(obs[None]), dtype=np.float64)[0])
             self.decisions_in_leg += 1
         self._calls += 1
@@ -293,23 +300,25 @@ def _finite(observation, key: str) -> np.ndarray:
     return values
 
 
-def policy_observation(agent: str, observation, goal, frame: str = "world") -> np.ndarray:
-    """This package's policy observation (``BatchedSim.observe`` in ``frame``) from a Gymnasium-Robotics maze
-    observation."""
+def policy_observation(agent: str, observation, goal, frame: str = "world", next_goal=None) -> np.ndarray:
+    """This package's policy observation (``BatchedSim.observe`` in ``frame``, with ``next_goal`` its look-ahead
+    inputs) from a Gymnasium-Robotics maze observation."""
     from ..sim.simulator import free_body_observation
 
     spec = get_agent(agent)
     body = _finite(observation, "observation")
-    rel = (np.asarray(goal, dtype=float).reshape(2) - agent_xy(observation))[None]
-    if spec.planar:  # PointMaze: (x, y, vx, vy) -> velocity, goal - xy
+    xy = agent_xy(observation)
+    rel = (np.asarray(goal, dtype=float).reshape(2) - xy)[None]
+    next_rel = None if next_goal is None else (np.asarray(next_goal, dtype=float).reshape(2) - xy)[None]
+    if spec.planar:  # PointMaze: (x, y, vx, vy) -> velocity, goal - xy (, next goal - xy)
         if body.size != 4:
             raise SpecrefineError(f"a PointMaze observation has 4 values (x, y, vx, vy), got {body.size}")
-        return np.concatenate([body[2:4], rel[0]]).astype(np.float32)
+        return np.concatenate([body[2:4], rel[0], *([] if next_rel is None else [next_rel[0]])]).astype(np.float32)
     if body.size != spec.obs_dim - 2:  # AntMaze: qpos[2:] (13) + qvel (14)
         raise SpecrefineError(f"an {agent} observation needs {spec.obs_dim - 2} values (qpos without x, y, and qvel; "
                               f"contact forces off), got {body.size}")
     nq = body.size - spec.act_dim - 6  # qpos without x, y: z, quaternion, joints; then qvel: 6 + joints
-    return free_body_observation(body[None, :nq], body[None, nq:], rel, frame)[0]
+    return free_body_observation(body[None, :nq], body[None, nq:], rel, frame, next_rel)[0]
 
 
 def torso_flipped(agent: str, observation) -> bool:

@@ -153,6 +153,7 @@ class Evaluator:
         self.run_steps = 0  # the same, as a run in one go would have simulated them (cache_dir's earlier work too)
         self._act = policy.act if hasattr(policy, "act") else policy
         self.observation_frame = getattr(policy, "observation_frame", "world")
+        self.lookahead = bool(getattr(policy, "lookahead", False))  # it observes the next leg's goal point too
         self._sims: dict[int, object] = {}
         self._compiled: dict[Region, CompiledRegion] = {}
         self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
@@ -416,7 +417,7 @@ class Evaluator:
             sim.reset(states=np.repeat(sim.get_state()[:1], sim.n - N, axis=0), idx=np.arange(N, sim.n))
         plan = Plan(first, n_legs, goal_pts, goal_id, avoid_id, goals, avoids)
         controls = Controls(self._act, self.observation_frame, self.sim, self.horizon, self.clearance, self.MIN_BATCH,
-                            self.hold)
+                            self.hold, self.lookahead)
         loop = RolloutLoop(plan, sim, controls).run()
         self.sim_steps += loop.sim_steps
         return loop.outputs()

@@ -49,7 +49,8 @@ class Controls:
     """How it runs: ``act(obs)`` the policy, ``frame`` its observation frame, ``sim_of(size)`` the BatchedSim of
     that many rows (for compaction), ``horizon`` control steps per leg, ``clearance`` the avoid test's distance,
     ``hold`` the switching rule's hold at a leg's start (:func:`specrefine.sim.switching.switching_rule`; None:
-    ``at-region``)."""
+    ``at-region``), ``lookahead`` whether the policy also observes the next leg's goal point (the last leg's own on
+    the last leg; a held row's next goal is its leg's point)."""
 
     act: object
     frame: str
@@ -58,6 +59,7 @@ class Controls:
     clearance: float
     min_batch: int
     hold: object = None
+    lookahead: bool = False
 
 
 class RolloutLoop:
@@ -177,10 +179,14 @@ class RolloutLoop:
         sim, episode, p = self.sim, self.episode, self.plan
         live = episode >= 0
         ep = np.where(live, episode, episode[0])
-        goals = p.goal_points[np.minimum(self.leg[ep], self.L_of[ep] - 1), ep]
+        last = self.L_of[ep] - 1
+        goals = p.goal_points[np.minimum(self.leg[ep], last), ep]
+        after = p.goal_points[np.minimum(self.leg[ep] + 1, last), ep] if self.c.lookahead else None
         if self.c.hold is not None:
-            self._hold(goals, ep, live)
-        obs = sim.observe(goals, self.c.frame)
+            held = self._hold(goals, ep, live)
+            if after is not None:  # braking on its own position, it looks ahead to its leg's point
+                after[held] = p.goal_points[np.minimum(self.leg[ep[held]], last[held]), ep[held]]
+        obs = sim.observe(goals, self.c.frame, after)
         act = np.asarray(self.c.act(obs), dtype=np.float64)
         if not np.isfinite(act).all():  # MuJoCo would warn per step and write MUJOCO_LOG.TXT into the cwd
             raise PolicyError("the policy acts with NaN or infinite values on these observations: "
@@ -192,15 +198,17 @@ class RolloutLoop:
         self.xy[episode[live]] = sim.xy[live]
         self.flipped[episode[live]] = sim.flipped[live]
 
-    def _hold(self, goals: np.ndarray, ep: np.ndarray, live: np.ndarray) -> None:
-        """The rows still held at their leg's start (the switching rule) aim at their own position (in ``goals``)."""
+    def _hold(self, goals: np.ndarray, ep: np.ndarray, live: np.ndarray) -> np.ndarray:
+        """The rows still held at their leg's start (the switching rule) aim at their own position (in ``goals``);
+        returns those rows."""
         rows = np.flatnonzero(live & self.holding[ep])
         if not len(rows):
-            return
+            return rows
         xy, episodes = self.sim.xy[rows], ep[rows]
         still = self.c.hold.holding(self.sim.qvel[rows, :2], goals[rows] - xy, self.t_leg[episodes])
         self.holding[episodes] = still
         goals[rows[still]] = xy[still]
+        return rows[still]
 
     def _task_output(self, rows: slice, steps: int) -> dict:
         lengths = self.lengths[rows]

@@ -42,7 +42,7 @@ class BatchCollector:
     @torch.no_grad()
     def collect(self) -> TensorDict:
         env, n, T = self.env, self.env.sim.n, self.steps
-        obs = np.empty((n, T, env.sim.obs_dim), dtype=np.float32)
+        obs = np.empty((n, T, env.obs_dim), dtype=np.float32)
         next_obs = np.empty_like(obs)
         action = np.empty((n, T, env.sim.act_dim), dtype=np.float32)
         log_prob = np.empty((n, T), dtype=np.float32)

@@ -24,6 +24,18 @@ VERSION = 1
 HIDDEN = 256
 POLICY_DIR = data_dir() / "policies"
 OBS_ACT_DIMS = {name: (a.obs_dim, a.act_dim) for name, a in AGENTS.items()}
+LOOKAHEAD_DIM = 2  # the next goal relative to the agent, in the frame of the current goal
+
+
+def observation_dims(agent: str, lookahead: bool = False) -> tuple[int, int]:
+    """(observation, action) sizes of ``agent``'s goal policy, with or without the look-ahead inputs."""
+    obs_dim, act_dim = OBS_ACT_DIMS[agent]
+    return obs_dim + (LOOKAHEAD_DIM if lookahead else 0), act_dim
+
+
+def wants_lookahead(policy) -> bool:
+    """Whether ``policy`` observes the next goal too (a scripted controller or a plain callable does not)."""
+    return bool(getattr(policy, "lookahead", False))
 
 
 def mlp(n_in: int, n_out: int, hidden: int = HIDDEN) -> nn.Sequential:
@@ -59,7 +71,7 @@ class GoalPolicy(nn.Module):
     """``forward(obs) -> (loc, scale)`` of a Gaussian squashed by tanh into [-1, 1]."""
 
     def __init__(self, agent: str, obs_dim: int | None = None, act_dim: int | None = None,
-                 observation_frame: str = "world"):
+                 observation_frame: str = "world", lookahead: bool = False):
         super().__init__()
         if agent not in OBS_ACT_DIMS:
             raise PolicyError(f"unknown agent {agent!r}; expected one of {', '.join(OBS_ACT_DIMS)}")
@@ -69,7 +81,9 @@ class GoalPolicy(nn.Module):
         self.agent = agent
         #: what ``simulator.BatchedSim.observe`` must hand this policy ("world": every policy before the heading frame)
         self.observation_frame = observation_frame
-        self.obs_dim, self.act_dim = (obs_dim, act_dim) if obs_dim else OBS_ACT_DIMS[agent]
+        #: whether it also observes the goal after the current one (``BatchedSim.observe``'s ``next_goals``)
+        self.lookahead = bool(lookahead)
+        self.obs_dim, self.act_dim = (obs_dim, act_dim) if obs_dim else observation_dims(agent, lookahead)
         self.norm = Normalizer(self.obs_dim)
         self.net = mlp(self.obs_dim, 2 * self.act_dim)
         self.min_scale = 1e-3
@@ -91,10 +105,29 @@ class GoalPolicy(nn.Module):
         h = hashlib.sha1(self.agent.encode())
         if self.observation_frame != "world":  # the same weights fed another observation are another policy
             h.update(self.observation_frame.encode())
+        if self.lookahead:  # only when on: every policy before it keeps its fingerprint
+            h.update(b"lookahead")
         for name, t in sorted(self.state_dict().items()):
             h.update(name.encode())
             h.update(t.detach().cpu().float().contiguous().numpy().tobytes())
         return h.hexdigest()[:12]
+
+
+def widened(policy: GoalPolicy) -> GoalPolicy:
+    """``policy`` (without look-ahead) as a look-ahead policy that acts exactly as it does: the first layer gains
+    zero columns for the new inputs, whose normaliser statistics start as those of the current goal's (the next
+    goal lies about as far away)."""
+    if policy.lookahead:
+        return policy
+    wide = GoalPolicy(policy.agent, observation_frame=policy.observation_frame, lookahead=True)
+    state = {k: v.clone() for k, v in policy.state_dict().items()}
+    first = state["net.0.weight"]
+    state["net.0.weight"] = torch.cat([first, torch.zeros(first.shape[0], LOOKAHEAD_DIM)], dim=1)
+    for key in ("norm.mean", "norm.var"):
+        state[key] = torch.cat([state[key], state[key][-LOOKAHEAD_DIM:]])
+    wide.load_state_dict(state)
+    wide.meta = dict(getattr(policy, "meta", {}))
+    return wide.train(policy.training)
 
 
 def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
@@ -104,9 +137,10 @@ def save_policy(policy: GoalPolicy, path, meta: dict | None = None) -> None:
 
     state = {k: v.detach().cpu().float().clone() for k, v in policy.state_dict().items()}
     with replacing(path, "wb") as fh:
+        header = {"lookahead": True} if policy.lookahead else {}  # files without it load as before
         torch.save({"format": FORMAT, "version": VERSION, "agent": policy.agent, "obs_dim": policy.obs_dim,
-                    "act_dim": policy.act_dim, "observation_frame": policy.observation_frame, "state_dict": state,
-                    "meta": dict(meta or {})}, fh)
+                    "act_dim": policy.act_dim, "observation_frame": policy.observation_frame, **header,
+                    "state_dict": state, "meta": dict(meta or {})}, fh)
 
 
 def _resolve(path_or_agent) -> Path:
@@ -137,14 +171,16 @@ def load_policy(path_or_agent) -> GoalPolicy:
         raise PolicyError(f"{path}: not a specrefine policy file")
     if blob.get("version") != VERSION:
         raise PolicyError(f"{path}: policy format version {blob.get('version')}, this code reads {VERSION}")
-    agent = blob.get("agent")
-    if agent not in OBS_ACT_DIMS or (blob.get("obs_dim"), blob.get("act_dim")) != OBS_ACT_DIMS[agent]:
+    agent, lookahead = blob.get("agent"), blob.get("lookahead", False)  # files before the look-ahead carry none
+    if not isinstance(lookahead, bool):
+        raise PolicyError(f"{path}: header field lookahead is {lookahead!r:.40}, expected true or false")
+    if agent not in OBS_ACT_DIMS or (blob.get("obs_dim"), blob.get("act_dim")) != observation_dims(agent, lookahead):
         raise PolicyError(f"{path}: agent/shape header ({agent}, {blob.get('obs_dim')}, {blob.get('act_dim')}) "
                           "does not match a known agent")
     if isinstance(path_or_agent, str) and path_or_agent in OBS_ACT_DIMS and agent != path_or_agent:
         raise PolicyError(f"{path}: holds a {agent} policy, expected {path_or_agent}")
     try:  # files written before the heading frame carry none
-        policy = GoalPolicy(agent, observation_frame=blob.get("observation_frame", "world"))
+        policy = GoalPolicy(agent, observation_frame=blob.get("observation_frame", "world"), lookahead=lookahead)
     except PolicyError as exc:
         raise PolicyError(f"{path}: {exc}") from None
     state = blob.get("state_dict")

@@ -15,13 +15,18 @@ import torch
 
 from ..core.agents import get_agent
 from ..core.results import wilson_ci
-from .policy import GoalPolicy
+from .policy import GoalPolicy, wants_lookahead
 from .simulator import BatchedSim, direction_of_travel, sample_goals, sample_turn_goals
 from .switching import AT_REGION, switching_rule
 
 
 def _frame(policy) -> str:
     return getattr(policy, "observation_frame", "world")  # a scripted controller has none
+
+
+def _observe(sim: BatchedSim, policy, goals: np.ndarray, next_goals: np.ndarray) -> np.ndarray:
+    """The policy's observation; the next goals only for a policy that looks ahead."""
+    return sim.observe(goals, _frame(policy), next_goals if wants_lookahead(policy) else None)
 
 
 def _open_floor(policy: GoalPolicy, episodes: int, lo, hi, seed: int, horizon, nthread=None):
@@ -46,7 +51,7 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
     traj = np.zeros((episodes, horizon + 1, 2))
     traj[:, 0] = sim.xy
     for t in range(horizon):
-        sim.step(np.where(active[:, None], policy.act(sim.observe(goals, _frame(policy))), 0.0))
+        sim.step(np.where(active[:, None], policy.act(_observe(sim, policy, goals, goals)), 0.0))
         xy = sim.xy
         traj[:, t + 1] = np.where(active[:, None], xy, traj[:, t])
         hit = active & (np.linalg.norm(goals - xy, axis=1) < task.success_radius)
@@ -69,7 +74,8 @@ def evaluate_reach(policy: GoalPolicy, episodes: int = 500, lo: float | None = N
 
 def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: float | None = None,
                    hi: float | None = None, seed: int = 0, horizon: int | None = None,
-                   turn: tuple[float, float] | None = None, switching: str = AT_REGION) -> dict:
+                   turn: tuple[float, float] | None = None, switching: str = AT_REGION,
+                   planned: bool | None = None) -> dict:
     """Open floor, ``goals`` goals in a row: each new goal drawn where the last was reached, no reset.
 
     This is how a compositional policy uses the goal policy (the next subtask starts from a moving
@@ -77,17 +83,25 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
     speed at the switches.  ``turn`` = (lo, hi) degrees: every goal after the first turns by that much from the
     direction of travel at the switch (``simulator.sample_turn_goals``); None: any direction.  ``switching``: when
     the policy is fed a new goal (:mod:`specrefine.sim.switching`, as a compositional policy's legs).
+
+    ``planned`` (default: whether the policy looks ahead, ``GoalPolicy.lookahead``): every episode's goals are drawn
+    before it starts, each from the goal before it (turning from the line between the two goals before it), so
+    every policy meets the same goals and a look-ahead policy is fed the next one (the last goal's own on the last).
     """
     hold = switching_rule(switching)
     task, lo, hi, rng, sim, horizon, goal = _open_floor(policy, episodes, lo, hi, seed, horizon)
+    planned = wants_lookahead(policy) if planned is None else planned
+    plan = planned_goals(sim.xy, goal, goals, lo, hi, turn, rng) if planned else None
     index, t = np.zeros(episodes, dtype=np.int64), np.zeros(episodes, dtype=np.int64)
     alive, holding = np.ones(episodes, dtype=bool), np.full(episodes, hold is not None)
     reached, flips, timeouts = np.zeros(goals, np.int64), np.zeros(goals, np.int64), np.zeros(goals, np.int64)
     switch_speeds = []
     with torch.inference_mode():
         while alive.any():
+            after = goal if plan is None else plan[np.minimum(index + 1, goals - 1), np.arange(episodes)]
             aim = goal if hold is None else _held_aim(hold, sim, goal, t, holding)
-            sim.step(np.where(alive[:, None], policy.act(sim.observe(aim, _frame(policy))), 0.0))
+            after = np.where(holding[:, None], goal, after) if hold is not None else after  # braking: the leg's goal
+            sim.step(np.where(alive[:, None], policy.act(_observe(sim, policy, aim, after)), 0.0))
             t += 1
             flip = alive & sim.flipped
             np.add.at(flips, index[flip], 1)
@@ -100,7 +114,9 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             switch = hit & (index < goals)
             velocity = sim.qvel[switch, :2]
             switch_speeds.extend(np.linalg.norm(velocity, axis=1))
-            if turn is None:
+            if plan is not None:
+                goal[switch] = plan[index[switch], np.flatnonzero(switch)]
+            elif turn is None:
                 goal[hit] = sample_goals(sim.xy[hit], lo, hi, rng)
             else:
                 travel = direction_of_travel(velocity, goal[switch] - sim.xy[switch])
@@ -117,7 +133,21 @@ def evaluate_chain(policy: GoalPolicy, episodes: int = 200, goals: int = 8, lo: 
             "flips_per_goal": float(flips.sum() / max(1, reached.sum() + flips.sum() + timeouts.sum())),
             **({} if turn is None else {"turn_degrees": list(turn)}),
             "mean_switch_speed_mps": float(np.mean(switch_speeds)) if switch_speeds else None,
-            **({} if hold is None else {"switching": switching})}
+            **({} if hold is None else {"switching": switching}), **({"planned_goals": True} if planned else {})}
+
+
+def planned_goals(start: np.ndarray, first: np.ndarray, goals: int, lo: float, hi: float,
+                  turn: tuple[float, float] | None, rng: np.random.Generator) -> np.ndarray:
+    """``(goals, n, 2)``: each episode's goals in a row, ``first`` then each drawn from the one before it at [lo, hi]
+    m, in any direction or (``turn``) turning from the direction of the leg before it (from ``start`` for the
+    first)."""
+    plan = np.empty((goals, len(first), 2))
+    plan[0] = first
+    for k in range(1, goals):
+        before = start if k == 1 else plan[k - 2]
+        plan[k] = sample_goals(plan[k - 1], lo, hi, rng) if turn is None else \
+            sample_turn_goals(plan[k - 1], plan[k - 1] - before, lo, hi, turn, rng)
+    return plan
 
 
 def _held_aim(hold, sim: BatchedSim, goal: np.ndarray, t: np.ndarray, holding: np.ndarray) -> np.ndarray:

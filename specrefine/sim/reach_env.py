@@ -44,14 +44,22 @@ class GoalReachEnv(EnvBase):
     ``turn`` = (lo, hi) degrees (open floor only): every chained goal after the first turns by lo-hi degrees from the
     direction the agent travels when it switches (``simulator.sample_turn_goals``), at whatever speed it has: the
     goal switches where the U-chain paths lose most episodes (issue 42).  The first goal of an episode stays uniform.
+
+    ``lookahead`` (open floor only): the observation also carries the goal after the current one
+    (``BatchedSim.observe``'s ``next_goals``; the current one on an episode's last goal). Each goal after the first is
+    then drawn one goal ahead, from the goal before it (with ``turn``: turning from that leg's line, from where it was
+    drawn to the goal), so that the policy sees it before the switch.
     """
 
     def __init__(self, agent: str, n: int, seed: int = 0, nthread: int | None = None, task: ReachTask | None = None,
                  frame: str = "world", maze: Maze | None = None, turn: tuple[float, float] | None = None,
-                 goal_points: str = "centre"):
+                 goal_points: str = "centre", lookahead: bool = False):
         super().__init__(batch_size=torch.Size([n]), device="cpu")
         if turn is not None and maze is not None:
             raise SpecrefineError("turning goals (--turn-goals) are drawn on the open floor: not with --train-maze")
+        if lookahead and maze is not None:
+            raise SpecrefineError("the look-ahead (--lookahead) draws its goals on the open floor: not with "
+                                  "--train-maze")
         if goal_points not in ("centre", "sampled") or (goal_points == "sampled" and maze is None):
             raise SpecrefineError(f"training goal points {goal_points!r}: 'centre', or 'sampled' with --train-maze")
         self.turn, self.goal_points = turn, goal_points
@@ -67,13 +75,17 @@ class GoalReachEnv(EnvBase):
         self.task = task or get_agent(agent).reach_task
         self.rng = np.random.default_rng(seed)
         self.goals = np.zeros((n, 2))
+        self.lookahead = lookahead
+        self.next_goals = np.zeros((n, 2))  # with lookahead: the goal after the current one
+        self.leg_from = np.zeros((n, 2))  # with lookahead: where the current goal was drawn from
+        self.obs_dim = self.sim.obs_dim + (2 if lookahead else 0)
         self.dist = np.zeros(n)
         self.radius = np.full(n, self.task.success_radius)
         self.t = np.zeros(n, dtype=np.int64)
         self.goal_index = np.zeros(n, dtype=np.int64)  # goals reached so far in this episode
         bs = self.batch_size
         self.observation_spec = Composite(
-            observation=Unbounded((*bs, self.sim.obs_dim), dtype=torch.float32),
+            observation=Unbounded((*bs, self.obs_dim), dtype=torch.float32),
             success=Categorical(2, (*bs, 1), dtype=torch.bool), flipped=Categorical(2, (*bs, 1), dtype=torch.bool),
             wall=Categorical(2, (*bs, 1), dtype=torch.bool), shape=bs)
         self.action_spec = Bounded(-1.0, 1.0, (*bs, self.sim.act_dim), dtype=torch.float32)
@@ -107,16 +119,24 @@ class GoalReachEnv(EnvBase):
             self.cell[idx] = self.came_from[idx] = self._free[self.rng.integers(len(self._free), size=len(idx))]
             self.sim.reset(xy=self.maze.cell_to_xy(self.cell[idx, 0], self.cell[idx, 1]).reshape(len(idx), 2),
                            rng=self.rng, idx=idx)
+        self.goal_index[idx] = 0
         self._new_goals(idx, chained=False)
         self.t[idx] = 0
-        self.goal_index[idx] = 0
-        return self.sim.observe(self.goals, self.frame)
+        return self.observe()
+
+    def observe(self) -> np.ndarray:
+        """Every env's policy observation (with the next goals where the policy looks ahead)."""
+        return self.sim.observe(self.goals, self.frame, self.next_goals if self.lookahead else None)
 
     def _new_goals(self, idx: np.ndarray, chained: bool = True) -> None:
         """Draw the next goal (and, with ``task.goal_radius``, its radius) of the envs ``idx``, from where they are;
         ``chained``: a switch within the episode (turning with ``turn``), not its first goal."""
         task = self.task
-        if self.maze is None and chained and self.turn is not None:
+        if self.lookahead:
+            self.leg_from[idx] = self.goals[idx] if chained else self.sim.xy[idx]
+        if self.lookahead and chained:  # drawn a goal ahead
+            self.goals[idx] = self.next_goals[idx]
+        elif self.maze is None and chained and self.turn is not None:
             xy = self.sim.xy[idx]
             travel = direction_of_travel(self.sim.qvel[idx, :2], self.goals[idx] - xy)
             self.goals[idx] = sample_turn_goals(xy, travel, task.goal_min, task.goal_max, self.turn, self.rng)
@@ -132,6 +152,23 @@ class GoalReachEnv(EnvBase):
         self.dist[idx] = np.linalg.norm(self.goals[idx] - self.sim.xy[idx], axis=1)
         if task.goal_radius is not None:
             self.radius[idx] = self.rng.uniform(*task.goal_radius, size=len(idx))
+        if self.lookahead:
+            self._plan_next(idx)
+
+    def _plan_next(self, idx: np.ndarray) -> None:
+        """The goal after the current one of the envs ``idx``: drawn from the current goal, as the next switch will
+        take it; the current goal itself on an episode's last goal."""
+        task = self.task
+        self.next_goals[idx] = self.goals[idx]
+        ahead = idx[self.goal_index[idx] + 1 < task.goals_per_episode]
+        if not len(ahead):
+            return
+        goals = self.goals[ahead]
+        if self.turn is None:
+            self.next_goals[ahead] = sample_goals(goals, task.goal_min, task.goal_max, self.rng)
+        else:
+            self.next_goals[ahead] = sample_turn_goals(goals, goals - self.leg_from[ahead], task.goal_min,
+                                                       task.goal_max, self.turn, self.rng)
 
     def touching(self, xy: np.ndarray) -> np.ndarray:
         """Which positions touch a wall: closer than the evaluator's clearance (none on the open floor)."""
@@ -188,7 +225,7 @@ class GoalReachEnv(EnvBase):
             self._new_goals(np.flatnonzero(more))
         terminated = (success & ~more) | flipped | hit
         truncated = ~terminated & (self.t >= task.max_steps)
-        return Transition(self.sim.observe(self.goals, self.frame), reward.astype(np.float32), success, flipped, hit,
+        return Transition(self.observe(), reward.astype(np.float32), success, flipped, hit,
                           terminated, truncated)
 
 

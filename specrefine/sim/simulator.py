@@ -116,9 +116,11 @@ def _rotated(vec: np.ndarray, yaw: np.ndarray) -> np.ndarray:
     return np.stack([c * vec[:, 0] + s * vec[:, 1], -s * vec[:, 0] + c * vec[:, 1]], axis=1)
 
 
-def free_body_observation(qpos: np.ndarray, qvel: np.ndarray, rel: np.ndarray, frame: str = "world") -> np.ndarray:
+def free_body_observation(qpos: np.ndarray, qvel: np.ndarray, rel: np.ndarray, frame: str = "world",
+                          next_rel: np.ndarray | None = None) -> np.ndarray:
     """A free-joint body's policy observation from its qpos without x, y (z, quaternion, joints), qvel and the goal
-    relative to it, rows alike (``BatchedSim.observe`` and the official environment's policy share it)."""
+    relative to it, rows alike (``BatchedSim.observe`` and the official environment's policy share it); with
+    ``next_rel`` (the goal after it, relative to the body) the look-ahead inputs last, in the goal's frame."""
     if frame not in OBSERVATION_FRAMES:
         raise SpecrefineError(f"observation frame must be one of {', '.join(OBSERVATION_FRAMES)}, got {frame!r}")
     qpos, qvel = np.array(qpos, dtype=float), np.array(qvel, dtype=float)
@@ -126,7 +128,8 @@ def free_body_observation(qpos: np.ndarray, qvel: np.ndarray, rel: np.ndarray, f
     if frame == "heading":
         qpos[:, 1:5] = _without_yaw(qpos[:, 1:5], yaw)
         qvel[:, 0:2] = _rotated(qvel[:, 0:2], yaw)
-    return np.concatenate([qpos, qvel, _rotated(np.asarray(rel, dtype=float), yaw)], axis=1).astype(np.float32)
+    goals = [_rotated(np.asarray(r, dtype=float), yaw) for r in (rel, next_rel) if r is not None]
+    return np.concatenate([qpos, qvel, *goals], axis=1).astype(np.float32)
 
 
 class BatchedSim:
@@ -224,7 +227,7 @@ class BatchedSim:
         return self.up < 0.0
 
     # --- observe / step --------------------------------------------------------------------
-    def observe(self, goals: np.ndarray, frame: str = "world") -> np.ndarray:
+    def observe(self, goals: np.ndarray, frame: str = "world", next_goals: np.ndarray | None = None) -> np.ndarray:
         """The policy's observation of reaching ``goals`` (one per row).
 
         ``frame="world"`` (the shipped policies): the torso's quaternion and linear velocity as MuJoCo holds them,
@@ -232,13 +235,18 @@ class BatchedSim:
         of roll and pitch alone, the velocity in the heading frame), so behaviour cannot depend on the compass
         direction of travel.  The goal is in the heading frame and the angular velocity in the body frame in both;
         at heading 0 the two observations are equal.  The point mass has no heading: both frames are the same.
+        ``next_goals`` (a look-ahead policy's, ``GoalPolicy.lookahead``): the goal after each row's current one,
+        appended relative to the agent in the current goal's frame (no next goal: pass the current one).
         """
         if frame not in OBSERVATION_FRAMES:
             raise SpecrefineError(f"observation frame must be one of {', '.join(OBSERVATION_FRAMES)}, got {frame!r}")
         rel = np.asarray(goals, dtype=float).reshape(self.n, 2) - self._state[:, 1:3]
+        next_rel = None if next_goals is None else np.asarray(next_goals, dtype=float).reshape(self.n, 2) - \
+            self._state[:, 1:3]
         if self._spec.planar:
-            return np.concatenate([self.qvel, rel], axis=1).astype(np.float32)
-        return free_body_observation(self.qpos[:, 2:], self.qvel, rel, frame)
+            return np.concatenate([self.qvel, rel, *([] if next_rel is None else [next_rel])], axis=1).astype(
+                np.float32)
+        return free_body_observation(self.qpos[:, 2:], self.qvel, rel, frame, next_rel)
 
     def step(self, actions: np.ndarray) -> None:
         ctrl = np.clip(np.asarray(actions, dtype=float).reshape(self.n, 1, self.act_dim), -1.0, 1.0)

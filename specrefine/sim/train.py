@@ -37,7 +37,7 @@ from ..core.errors import SpecrefineError
 from ..core.runfolder import open_append
 from .collect import BatchCollector
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
-from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy
+from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy, widened
 from .policy_eval import evaluate_chain, evaluate_reach, success_by_distance, summary
 from .ppo import ClipPPO, add_advantages
 from .reach_env import GoalReachEnv
@@ -104,6 +104,9 @@ class Config:
                                                         "first turns by LO-HI degrees (either side) from the "
                                                         "direction of travel at the switch; with --evaluate --chain: "
                                                         "the same for the evaluated goals (default: any direction)")
+    lookahead: bool = knob(False, "the policy also observes the goal after the current one (open floor; chained "
+                                  "goals are then drawn one ahead); --init from a policy without it widens its first "
+                                  "layer with zero weights, so training starts from that policy's behaviour")
 
     @property
     def frames_per_batch(self) -> int:
@@ -166,6 +169,8 @@ def make_config(agent: str, **overrides) -> Config:
         cfg = replace(cfg, turn_goals=turn_range(cfg.turn_goals))
         if cfg.train_maze is not None:
             raise SpecrefineError("--turn-goals draws goals on the open floor: not with --train-maze")
+    if cfg.lookahead and cfg.train_maze is not None:
+        raise SpecrefineError("--lookahead draws its goals on the open floor: not with --train-maze")
     return cfg
 
 
@@ -232,10 +237,10 @@ class Trainer:
             optional["goal_radius"] = _radius_range(cfg.switch_radius)
         task = replace(get_agent(cfg.agent).reach_task, goals_per_episode=cfg.goals_per_episode, **optional)
         # the policy first: a bad --observation-frame is one line before the simulator is built
-        self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame)
+        self.policy = GoalPolicy(cfg.agent, observation_frame=cfg.observation_frame, lookahead=cfg.lookahead)
         self.env = GoalReachEnv(cfg.agent, cfg.num_envs, seed=cfg.seed, nthread=cfg.sim_threads, task=task,
                                 frame=cfg.observation_frame, maze=training_maze(cfg.train_maze), turn=cfg.turn_goals,
-                                goal_points=cfg.train_goal_points)
+                                goal_points=cfg.train_goal_points, lookahead=cfg.lookahead)
         self.actor, self.critic = make_modules(self.policy, self.env)
         # TorchRL's loss holds the actor's and critic's parameters: its state_dict is a checkpoint's "loss" (every
         # checkpoint so far); the update computes the same loss with ppo.ClipPPO, without its per-call machinery
@@ -280,7 +285,9 @@ class Trainer:
         if shipped is not None:
             if shipped.agent != self.cfg.agent:
                 raise SpecrefineError(f"--init {init}: a {shipped.agent} policy, not one for the {self.cfg.agent}")
-            self.policy.load_state_dict(shipped.state_dict())
+            if shipped.lookahead and not self.cfg.lookahead:
+                raise SpecrefineError(f"--init {init}: a look-ahead policy; train it on with --lookahead")
+            self.policy.load_state_dict((widened(shipped) if self.cfg.lookahead else shipped).state_dict())
             return
         ck = read_checkpoint(path, "--init")
         try:
@@ -410,6 +417,10 @@ def add_arguments(ap) -> None:
                     help="with --evaluate --chain: when the policy is fed the next goal: at-region (at once) or "
                          "slow-turn (a fast, turned start brakes first; specrefine.sim.switching) (default: "
                          "at-region)")
+    ap.add_argument("--planned-goals", action=argparse.BooleanOptionalAction, default=None,
+                    help="with --evaluate --chain: draw each episode's goals before it starts, each from the goal "
+                         "before it, so every policy meets the same goals and a look-ahead policy sees the next "
+                         "(default: on for a look-ahead policy, else off: each goal drawn where the last was reached)")
     config_arguments(ap)
 
 
@@ -426,7 +437,7 @@ def run(args, ap) -> int:
             lo, hi = args.goal_range or (None, None)
             turn = None if args.turn_goals is None else turn_range(args.turn_goals)
             res = evaluate_chain(load_policy(args.evaluate), args.episodes, args.chain, lo, hi, seed=seed, turn=turn,
-                                 switching=args.switching)
+                                 switching=args.switching, planned=args.planned_goals)
             print(json.dumps(res))
             return 0
         if args.evaluate:
