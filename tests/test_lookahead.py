@@ -217,3 +217,19 @@ def test_init_from_stage5_widens_and_starts_as_stage5(tmp_path, capsys):
                  "--frames", "64"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--lookahead" in err
+
+
+def test_a_look_ahead_run_resumes_with_the_same_flags(tmp_path, capsys):
+    from specrefine.sim.curves import read_log
+
+    run = tmp_path / "run"
+    flags = dict(seed=0, goals_per_episode=3, turn_goals=(45.0, 180.0), lookahead=True, num_envs=8, steps_per_env=64,
+                 checkpoint_every_s=1e9)
+    Trainer(make_config("point", frames=1024, **flags), run, progress=False).train()
+    trainer = Trainer(make_config("point", frames=2048, **flags), run, resume=True, progress=False)
+    assert trainer.frames == 1024 and trainer.policy.lookahead
+    trainer.train()
+    assert read_log(run / "log.jsonl")[-1]["frames"] == 2048 and load_policy(run / "policy.pt").lookahead
+    assert main(["--agent", "point", "--out", str(run), "--resume", "--frames", "4096"]) == 2  # --lookahead left out
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--resume" in err
