@@ -190,9 +190,9 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
 
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
-    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean"} <= set(marked)
+    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
-                        lean=cc.lean_study())
+                        lean=cc.lean_study(), precise=cc.precise_study())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -207,28 +207,30 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
         assert marked[level].startswith(f"1-5 rooms {', '.join(curve)};")
 
 
-@pytest.mark.parametrize("lean, verdict", [(0.98, "helps"), (0.96, "no worse"), (0.9, "worse")])
-def test_the_lean_corrector_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_path, lean, verdict):
+@pytest.mark.parametrize("method", [cc.LEAN, cc.PRECISE])
+@pytest.mark.parametrize("rate, verdict", [(0.98, "helps"), (0.96, "no worse"), (0.9, "worse")])
+def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_path, method, rate, verdict):
     lay(tmp_path, rates)
     for part in (0, 1, 2):
-        lay_grid(tmp_path, "corrector-lean", lambda maze, m, p: lean, calls_of=lambda m: 5, part=part)
-    vs = cc.lean_study(tmp_path)
+        lay_grid(tmp_path, cc.VARIANT_GRIDS[method], lambda maze, m, p: rate, calls_of=lambda m: 5, part=part)
+    vs = cc.variant_study(method, tmp_path)
     v = {e["rule"]: e for e in cc.variant_verdicts(vs)}
-    paired = v[f"{cc.LEAN} - {cc.METHOD} (paired, U-chains, mild and moderate): helps if the lower end > 0, no worse "
+    paired = v[f"{method} - {cc.METHOD} (paired, U-chains, mild and moderate): helps if the lower end > 0, no worse "
                "if >= -0.02"]
     assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
-    severe = v[f"{cc.LEAN}, imperfect:severe: no worse than ours-repair (paired, U-chains)"]
-    assert severe["verdict"] == "no worse" and "+" in severe["value"]  # every lean rate here is above ours-repair's
+    severe = v[f"{method}, imperfect:severe: no worse than ours-repair (paired, U-chains)"]
+    assert severe["verdict"] == "no worse" and "+" in severe["value"]  # every rate here is above ours-repair's
     assert [c["proposer"] for c in vs["costs"]] == [*LEVELS, "imperfect:severe"]
     assert all(e["runs"] == 2 for e in vs["held_out"])  # seeds 0-1 per layout and mix
-    text = cc._lean_text(vs)
-    assert text.startswith(f"{cc.LEAN} - {cc.METHOD} ") and f"({verdict})" in text
+    text = cc._variant_text(vs)
+    assert text.startswith(f"{method} - {cc.METHOD} ") and f"({verdict})" in text
     assert "1.7x the proposer calls of ours" in text
     md = "\n".join(cc.variant_markdown(vs))
     assert "Severe (described)" in md and "Held out (descriptive)" in md
 
 
-def test_without_its_table_the_lean_corrector_is_not_run_yet(tmp_path):
+def test_without_their_tables_the_later_variants_are_not_run_yet(tmp_path):
     lay(tmp_path, rates)
-    assert cc.lean_study(tmp_path) is None
-    assert cc.front(cc.point_study(tmp_path), None, tmp_path)["lean"] == "not run yet"
+    assert cc.lean_study(tmp_path) is None and cc.precise_study(tmp_path) is None
+    text = cc.front(cc.point_study(tmp_path), None, tmp_path)
+    assert text["lean"] == text["precise"] == "not run yet"

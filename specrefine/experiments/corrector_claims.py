@@ -30,8 +30,10 @@ METHOD = "ours-corrector"
 LEVERS = ("ours-deeprepair", "ours-feasible", "ours-checked")
 GATED = "ours-corrector-gated"
 LEAN = "ours-corrector-lean"
+PRECISE = "ours-corrector-precise"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
-VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean"}  # each variant of the corrector and its grid
+#: each variant of the corrector and its grid
+VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise"}
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -262,6 +264,10 @@ def lean_study(root: Path = ROOT) -> dict | None:
     return variant_study(LEAN, root)
 
 
+def precise_study(root: Path = ROOT) -> dict | None:
+    return variant_study(PRECISE, root)
+
+
 def _held_out_rows(method: str, root: Path) -> list[dict]:
     grid = GRIDS[VARIANT_GRIDS[method]]
     part = next(i for i, part in enumerate(grid.parts) if set(part.proposers) == set(HELD_OUT_MIXES))
@@ -363,7 +369,7 @@ def _verdict(ok: bool, complete: bool) -> str:
 
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
-             gated: dict | None = None, lean: dict | None = None) -> str:
+             gated: dict | None = None, lean: dict | None = None, precise: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -423,7 +429,7 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
-    for variant in (gated, lean):
+    for variant in (gated, lean, precise):
         if variant:
             lines += variant_markdown(variant)
     return "\n".join(lines) + "\n"
@@ -459,7 +465,7 @@ def levers_markdown(lv: dict) -> list[str]:
 
 def versus_corrector(vs: dict) -> tuple[str, str]:
     """(rule, verdict) of a variant against ours-corrector, as its section of docs/corrector.md fixed it: the gate
-    is to be no worse (lower end >= -NON_INFERIORITY); the lean judging helps (lower end > 0), is no worse, or is
+    is to be no worse (lower end >= -NON_INFERIORITY); the later variants help (lower end > 0), are no worse, or are
     worse."""
     v, method = vs["versus_corrector"], vs["method"]
     scope = f"{method} - {METHOD} (paired, U-chains, mild and moderate)"
@@ -551,12 +557,13 @@ def add_arguments(p) -> None:
 def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
-        levers, gated, lean = levers_study(), gated_study(), lean_study()
-        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "gated": gated, "lean": lean,
-                  "rules": verdicts(point, ant) + [v for vs in (gated, lean) if vs for v in variant_verdicts(vs)],
-                  "front": front(point, held_out, levers=levers, gated=gated, lean=lean)}
+        levers, gated, lean, precise = levers_study(), gated_study(), lean_study(), precise_study()
+        variants = {"gated": gated, "lean": lean, "precise": precise}
+        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
+                  "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
+                  "front": front(point, held_out, levers=levers, **variants)}
         with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, gated, lean))
+            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
             write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
             save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
@@ -575,10 +582,11 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          gated: dict | None = None, lean: dict | None = None) -> dict[str, str]:
+          gated: dict | None = None, lean: dict | None = None, precise: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
     counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
-                                                      "corrector-levers", "corrector-gated", "corrector-lean")}
+                                                      "corrector-levers", "corrector-gated", "corrector-lean",
+                                                      "corrector-precise")}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -605,7 +613,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
     out["levers"] = _levers_text(levers) if levers else "not run yet"
     out["gated"] = _gated_text(gated) if gated else "not run yet"
-    out["lean"] = _lean_text(lean) if lean else "not run yet"
+    out["lean"] = _variant_text(lean) if lean else "not run yet"
+    out["precise"] = _variant_text(precise) if precise else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -645,11 +654,12 @@ def _gated_text(gs: dict) -> str:
             f"{v['n_expected']} paired cells (no worse by -{NON_INFERIORITY}: {_verdict(ok, v['complete'])})")
 
 
-def _lean_text(vs: dict) -> str:
-    """The lean corrector against ours-corrector, its curve over rooms per preset and its proposer calls."""
+def _variant_text(vs: dict) -> str:
+    """A variant against ours-corrector, its change over rooms per preset and its proposer calls."""
     _, verdict = versus_corrector(vs)
     v = vs["versus_corrector"]
-    parts = [f"{LEAN} - {METHOD} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells ({verdict})"]
+    parts = [f"{vs['method']} - {METHOD} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells "
+             f"({verdict})"]
     for rooms, c in zip(vs["rooms"], vs["costs"]):
         level = rooms["proposer"].split(":")[1]
         mazes = [e for e in vs["per_maze"] if e["proposer"] == rooms["proposer"] and e["runs"]]

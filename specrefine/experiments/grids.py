@@ -382,6 +382,17 @@ GRIDS = {g.name: g for g in (
         seeds=(0, 1, 2, 3), workers=1, code="4a9804f", table="data/results/corrector/lean.csv",
         out="runs/corrector_lean"),
     ExperimentGrid(
+        "corrector-precise", "docs/corrector.md, 'A gate on a larger check' (issue 39; fixed 2026-11-27 before it "
+        "ran)", "point",
+        parts=(Part(("ours-corrector-precise",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                    split="seeds"),
+               Part(("ours-corrector-precise",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
+                    table="data/results/corrector/precise_held_out.csv", out="held_out"),
+               Part(("ours-corrector-precise",), ("imperfect:severe",), mazes=SCALING_MAZES,
+                    table="data/results/corrector/precise_severe.csv", out="severe")),
+        seeds=(0, 1, 2, 3), workers=1, code="2cda42b", table="data/results/corrector/precise.csv",
+        out="runs/corrector_precise"),
+    ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
         mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",

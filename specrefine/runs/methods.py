@@ -211,6 +211,12 @@ register_method("ours-corrector-lean", ours_variant(repair=True, repair_depth=3,
                 "beyond the paper: ours-corrector whose legs must earn their place: alternatives judged by the "
                 "product of the legs' posterior means, and every waypoint of the corrected path offered its bypass",
                 colour="#ff7043")
+register_method("ours-corrector-precise", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
+                                                       correct_rollouts=16, correct_reach="policy",
+                                                       correct_min_failures=3),
+                "beyond the paper: ours-corrector-gated with the found path checked on 16n fresh rollouts per leg "
+                "instead of 4n, so that the gate (3 fresh failures) finds legs losing about 1 % and their "
+                "alternatives are judged on four times the rollouts", colour="#4e342e")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
