@@ -36,7 +36,9 @@ for points in centre sampled; do
     for tag in "$base_tag" "$new_tag"; do
         pol=$(policy_of "$tag")
         for s in 0 1 2; do
-            file="$out/u_chain_2_s${s}_$([ "$points" = centre ] && echo centre_)$tag.json"
+            prefix=""
+            [ "$points" = centre ] && prefix=centre_
+            file="$out/u_chain_2_s${s}_$prefix$tag.json"
             [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
                 --episodes 300 --seed 77 --policy "$pol" --goal-points "$points" --walls-only --out "$file" > /dev/null
         done
