@@ -404,6 +404,12 @@ GRIDS = {g.name: g for g in (
         policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", switching="slow-turn",
         workers=1, code="b6cb752", table="data/results/ant/switching_checks/uchain_slow_turn.csv",
         out="runs/ant_switching"),
+    ExperimentGrid(
+        "ant-stage8", "docs/ant_experiments.md, 'Issue 42, lever 2', check 6 (fixed 2026-11-27 before its first cell "
+        "ran)", "ant",
+        parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2), mazes=("u_chain_3", "u_chain_5"),
+        policy="data/policies/ant_stage8.pt", evaluation="adaptive", goal_points="centre", workers=1, code="fb28c48",
+        table="data/results/ant/stage8_checks/uchain_stage8.csv", out="runs/ant_stage8_uchain"),
 )}
 
 
