@@ -93,3 +93,28 @@ def test_front_slow_turn_u_chains_recompute():
     at = pooled_u_chains(ROOT / "data" / "results" / "ant" / "centre.csv")
     assert front("slow-turn uchains") == f"{slow} against {at}"
     assert f"Pooled {slow} [" in (CHECKS / "uchain_check.md").read_text()
+
+
+STAGE8 = ROOT / "data" / "results" / "ant" / "stage8_checks"
+
+
+def held_out_count(tag: str, points: str) -> tuple[int, int]:
+    """Successes and episodes over the three held-out U-chain 2 paths (check 3: centre, check 5: sampled)."""
+    infix = "_centre" if points == "centre" else ""
+    reports = [json.loads(p.read_text()) for p in sorted(STAGE8.glob(f"u_chain_2_s?{infix}_{tag}.json"))]
+    assert len(reports) == 3, f"{tag} {points}: {len(reports)} held-out reports"
+    return sum(r["walls"]["success"] for r in reports), sum(r["episodes"] for r in reports)
+
+
+def test_front_stage8_recomputes():
+    eight, five = held_out_count("stage8", "centre"), held_out_count("stage5", "centre")
+    expected = f"{eight[0]} of {eight[1]} against {five[0]} of {five[1]}, {difference_text(*eight, *five)}"
+    assert front("stage8") == expected
+    sampled = {tag: held_out_count(tag, "sampled") for tag in ("stage8", "stage5")}
+    assert front("stage8 sampled") == (f"{sampled['stage8'][0]} against {sampled['stage5'][0]} of "
+                                       f"{sampled['stage5'][1]}")
+    chains = {tag: json.loads((STAGE8 / f"turn_chain8_{tag}.json").read_text()) for tag in ("stage8", "stage5")}
+    won = {tag: round(c["success_rate"] * c["episodes"]) for tag, c in chains.items()}
+    flips = {tag: int(sum(c["flipped"])) for tag, c in chains.items()}
+    assert front("stage8 turning") == (f"{won['stage8']} against {won['stage5']} of {chains['stage5']['episodes']}, "
+                                       f"flips {flips['stage8']} against {flips['stage5']}")
