@@ -224,7 +224,8 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     assert all(e["runs"] == 2 for e in vs["held_out"])  # seeds 0-1 per layout and mix
     text = cc._variant_text(vs)
     assert text.startswith(f"{method} - {cc.METHOD} ") and f"({verdict})" in text
-    assert "1.7x the proposer calls of ours" in text
+    assert "1.7x the proposer calls of ours" in text and "one-shot ratio" in text
+    assert v[f"{method}, imperfect:moderate: >= 2x the one-shot on multi-room (point)"]["verdict"] == "holds"
     md = "\n".join(cc.variant_markdown(vs))
     assert "Severe (described)" in md and "Held out (descriptive)" in md
 

@@ -232,12 +232,14 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in presets}
     both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in presets}
     study = {"method": method, "grid": grid.name, "per_maze": [], "rooms": [], "zero": [], "costs": [],
-             "corrector_costs": [],
+             "corrector_costs": [], "ratio": [],
              "versus_corrector": cmp.paired_difference(both, both_failed, "both", method, METHOD, POINT_SEEDS,
                                                        [f"{maze} {p}" for p in presets for maze in SCALING_MAZES])}
     for proposer in presets:
         study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=method)
         study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, method, POINT_SEEDS))
+        study["ratio"].append(cmp.ratio_claim(as_ours(cells, method), set(as_ours(dict.fromkeys(failed), method)),
+                                              proposer, POINT_SEEDS) | {"method": f"{method} / vlm-oneshot"})
         study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, method, proposer, SCALING_MAZES)})
         study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=method))
         ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == method and r["proposer"] == proposer
@@ -500,6 +502,11 @@ def variant_verdicts(vs: dict) -> list[dict]:
         zero = next(z for z in vs["zero"] if z["proposer"] == proposer)["runs"]
         out.append({"rule": f"{method}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
                     "verdict": _verdict(zero[0] == 0, complete)})
+        ratio = next((e for e in vs.get("ratio", []) if e["proposer"] == proposer), None)
+        if ratio is not None:
+            out.append({"rule": f"{method}, {proposer}: >= 2x the one-shot on multi-room (point)",
+                        "value": cmp._interval_text(ratio),
+                        "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
     if "severe_vs_repair" in vs:
         severe = vs["severe_vs_repair"]
         out.append({"rule": f"{method}, imperfect:severe: no worse than ours-repair (paired, U-chains)",
@@ -660,13 +667,16 @@ def _variant_text(vs: dict) -> str:
     v = vs["versus_corrector"]
     parts = [f"{vs['method']} - {METHOD} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells "
              f"({verdict})"]
-    for rooms, c in zip(vs["rooms"], vs["costs"]):
+    for rooms, c, zero in zip(vs["rooms"], vs["costs"], vs["zero"]):
         level = rooms["proposer"].split(":")[1]
         mazes = [e for e in vs["per_maze"] if e["proposer"] == rooms["proposer"] and e["runs"]]
         within = sum(1 for e in mazes if e["success"] >= e["reference_success"] - TOLERANCE)
         parts.append(f"{level}: within {TOLERANCE} of the oracle on {within} of {len(mazes)} U-chains, "
-                     f"{cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)}), "
-                     f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours")
+                     f"{cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)}), runs at 0: "
+                     f"{zero['runs'][0]} of {zero['runs'][1]}, "
+                     f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
+                     + "".join(f", one-shot {cmp._interval_text(r)} ({r['verdict']}{_partial(r)})"
+                               for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
     return "; ".join(parts)
 
 
