@@ -213,6 +213,7 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     lay(tmp_path, rates)
     for part in (0, 1, 2):
         lay_grid(tmp_path, cc.VARIANT_GRIDS[method], lambda maze, m, p: rate, calls_of=lambda m: 5, part=part)
+    lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
     vs = cc.variant_study(method, tmp_path)
     v = {e["rule"]: e for e in cc.variant_verdicts(vs)}
     paired = v[f"{method} - {cc.METHOD} (paired, U-chains, mild and moderate): helps if the lower end > 0, no worse "
@@ -225,6 +226,9 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     text = cc._variant_text(vs)
     assert text.startswith(f"{method} - {cc.METHOD} ") and f"({verdict})" in text
     assert "1.7x the proposer calls of ours" in text and "one-shot ratio" in text
+    higher = 12 if rate > 0.97 else 0
+    assert text.endswith(f"held out: {rate:.3f}-{rate:.3f} per layout and mix (ours-corrector 0.970-0.970; higher on "
+                         f"{higher}, lower on {12 - higher} of 12)")
     assert v[f"{method}, imperfect:moderate: >= 2x the one-shot on multi-room (point)"]["verdict"] == "holds"
     md = "\n".join(cc.variant_markdown(vs))
     assert "Severe (described)" in md and "Held out (descriptive)" in md

@@ -677,6 +677,13 @@ def _variant_text(vs: dict) -> str:
                      f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
                      + "".join(f", one-shot {cmp._interval_text(r)} ({r['verdict']}{_partial(r)})"
                                for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
+    held = [e for e in vs["held_out"] if e["runs"]]
+    if held:
+        parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
+                     f"layout and mix ({METHOD} {min(e['reference_success'] for e in held):.3f}-"
+                     f"{max(e['reference_success'] for e in held):.3f}; higher on "
+                     f"{sum(e['success'] > e['reference_success'] for e in held)}, lower on "
+                     f"{sum(e['success'] < e['reference_success'] for e in held)} of {len(held)})")
     return "; ".join(parts)
 
 
