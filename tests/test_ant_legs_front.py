@@ -118,3 +118,12 @@ def test_front_stage8_recomputes():
     flips = {tag: int(sum(c["flipped"])) for tag, c in chains.items()}
     assert front("stage8 turning") == (f"{won['stage8']} against {won['stage5']} of {chains['stage5']['episodes']}, "
                                        f"flips {flips['stage8']} against {flips['stage5']}")
+
+
+def test_front_stage8_u_chains_recompute():
+    eight = pooled_u_chains(STAGE8 / "uchain_stage8.csv")
+    five = pooled_u_chains(ROOT / "data" / "results" / "ant" / "centre.csv")
+    check = (STAGE8 / "uchain_check.md").read_text()
+    assert f"Pooled {eight} [" in check and f"against {five} [" in check
+    difference = re.search(r"difference ([+-][0-9.]+ \[[+-][0-9.]+, [+-][0-9.]+\])", check).group(1)
+    assert front("stage8 uchains") == f"{eight} against {five} over the six cells, {difference}"

@@ -73,3 +73,13 @@ def test_a_layout_is_paired_with_another_maze_of_the_baseline_seed_by_seed(tmp_p
     with pytest.raises(SystemExit) as exit_:
         levers.main([*common, "--baseline-mazes", "u_chain_3", "u_chain_5"])
     assert exit_.value.code == 2 and "names 2 mazes for the 1" in capsys.readouterr().err
+
+
+def test_each_side_is_named_by_its_policy_only_when_they_differ(tmp_path):
+    _write(tmp_path / "t.csv", "ours", {("u_chain_3", 0): 0.9})
+    rows = levers._by_cell(tmp_path / "t.csv", "ours", None)
+    eight = {k: {**r, "policy": "/x/code_abc/data/policies/ant_stage8.pt"} for k, r in rows.items()}
+    five = {k: {**r, "policy": "data/policies/ant_stage5.pt"} for k, r in rows.items()}
+    assert levers.policies(eight) == ["ant_stage8"] and levers.policies(rows) == []
+    assert levers.label("ours", eight, policy=True) == "ours (policy ant_stage8)"
+    assert levers.label("ours", five) == "ours"  # the same policy on both sides: not named

@@ -29,14 +29,21 @@ def _by_cell(table, method: str, proposer: str | None) -> dict[tuple[str, int], 
             if is_done(r) and r["method"] == method and proposer in (None, r["proposer"])}
 
 
-def label(method: str, rows: dict) -> str:
-    """The method's name, with its goal-point rule when its runs aimed at the sets' centres and its switching rule
-    when not the paper's (the table has no column for it: a cell id ends in ``__switching-RULE``)."""
+def label(method: str, rows: dict, policy: bool = False) -> str:
+    """The method's name, with its goal-point rule when its runs aimed at the sets' centres, its switching rule
+    when not the paper's (the table has no column for it: a cell id ends in ``__switching-RULE``) and, with
+    ``policy``, its policy file's name."""
     rules = sorted({goal_points_of(r) for r in rows.values()})
     switching = sorted({r["cell"].split("__switching-")[1] for r in rows.values() if "__switching-" in r["cell"]})
     notes = ([] if rules in ([], [PAPER.goal_points]) else [f"{', '.join(rules)} goal points"]) + \
-        [f"{', '.join(switching)} switching"] * bool(switching)
+        [f"{', '.join(switching)} switching"] * bool(switching) + \
+        [f"policy {', '.join(policies(rows))}"] * (policy and bool(policies(rows)))
     return f"{method} ({'; '.join(notes)})" if notes else method
+
+
+def policies(rows: dict) -> list[str]:
+    """The stems of the policy files the rows ran (a table from before the column: none)."""
+    return sorted({Path(r["policy"]).stem for r in rows.values() if r.get("policy")})
 
 
 def lever_check(lever: dict, baseline: dict, cells: list[tuple[str, int]]) -> dict:
@@ -99,8 +106,9 @@ def main(argv=None) -> int:
     baseline = {(m, s): by_maze[(b, s)] for m, b in pairs.items() for s in args.seeds if (b, s) in by_maze}
     cells = [(m, s) for m in args.mazes for s in args.seeds]
     other = sorted({shown(b) for m, b in pairs.items() if b != m})
-    text = markdown(lever_check(lever, baseline, cells), label(args.method, lever),
-                    label(args.baseline_method, baseline) + (f" on {', '.join(other)}" if other else ""))
+    named = policies(lever) != policies(baseline)  # a policy lever: name each side's
+    text = markdown(lever_check(lever, baseline, cells), label(args.method, lever, named),
+                    label(args.baseline_method, baseline, named) + (f" on {', '.join(other)}" if other else ""))
     if args.out is not None:
         write_atomic(args.out, text)
     print(text, end="")
