@@ -226,6 +226,7 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     text = cc._variant_text(vs)
     assert text.startswith(f"{method} - {cc.METHOD} ") and f"({verdict})" in text
     assert "1.7x the proposer calls of ours" in text and "one-shot ratio" in text
+    assert "severe: runs at 0 0 of 36 (ours-corrector 0 of 36), - ours-corrector " in text
     higher = 12 if rate > 0.97 else 0
     assert text.endswith(f"held out: {rate:.3f}-{rate:.3f} per layout and mix (ours-corrector 0.970-0.970; higher on "
                          f"{higher}, lower on {12 - higher} of 12)")

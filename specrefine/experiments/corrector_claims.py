@@ -254,6 +254,7 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                           POINT_SEEDS, SCALING_MAZES)
         study["severe_vs_corrector"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, METHOD,
                                                              POINT_SEEDS, SCALING_MAZES)
+        study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, METHOD)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     return study
 
@@ -677,6 +678,11 @@ def _variant_text(vs: dict) -> str:
                      f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
                      + "".join(f", one-shot {cmp._interval_text(r)} ({r['verdict']}{_partial(r)})"
                                for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
+    if "severe_zero" in vs:
+        zero = vs["severe_zero"]
+        parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({METHOD} "
+                     f"{zero[METHOD][0]} of {zero[METHOD][1]}), - {METHOD} {_signed(vs['severe_vs_corrector'])}, - "
+                     f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
     held = [e for e in vs["held_out"] if e["runs"]]
     if held:
         parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
