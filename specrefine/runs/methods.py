@@ -195,25 +195,22 @@ register_method("ours-polish", ours_variant(polish_rollouts=128),
 register_method("ours-shortcut", ours_variant(shortcut_reach="policy"),
                 "beyond the paper: ours, then shortcut edges over the found path's waypoints (one long leg where it "
                 "beats several short ones; refine/shortcut.py)", colour="#283593")
-register_method("ours-corrector", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
-                                               correct_rollouts=4, correct_reach="policy"),
+#: ours-corrector's settings; each variant of it changes one or two of them
+CORRECTOR = dict(repair=True, repair_depth=3, dead_weight=100.0, correct_rollouts=4, correct_reach="policy")
+register_method("ours-corrector", ours_variant(**CORRECTOR),
                 "beyond the paper: ours with repair to three levels and any feasible chain preferred to a dead "
                 "edge, then the found path's legs estimated again on 4x fresh rollouts and its weak legs split, "
                 "split over or bypassed while the path gains (refine/correct.py)",
                 colour="#c62828")
-register_method("ours-corrector-gated", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
-                                                     correct_rollouts=4, correct_reach="policy",
-                                                     correct_min_failures=3),
+register_method("ours-corrector-gated", ours_variant(**CORRECTOR | dict(correct_min_failures=3)),
                 "beyond the paper: ours-corrector asking the proposer about a leg of the found path only when at "
                 "least 3 of its 4n fresh rollouts failed (a leg with fewer is only bypassed)", colour="#7f0000")
-register_method("ours-corrector-lean", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
-                                                    correct_rollouts=4, correct_reach="policy", correct_lean=True),
+register_method("ours-corrector-lean", ours_variant(**CORRECTOR | dict(correct_lean=True)),
                 "beyond the paper: ours-corrector whose legs must earn their place: alternatives judged by the "
                 "product of the legs' posterior means, and every waypoint of the corrected path offered its bypass",
                 colour="#ff7043")
-register_method("ours-corrector-precise", ours_variant(repair=True, repair_depth=3, dead_weight=100.0,
-                                                       correct_rollouts=16, correct_reach="policy",
-                                                       correct_min_failures=3),
+register_method("ours-corrector-precise", ours_variant(**CORRECTOR | dict(correct_rollouts=16,
+                                                                          correct_min_failures=3)),
                 "beyond the paper: ours-corrector-gated with the found path checked on 16n fresh rollouts per leg "
                 "instead of 4n, so that the gate (3 fresh failures) finds legs losing about 1 % and their "
                 "alternatives are judged on four times the rollouts", colour="#4e342e")
