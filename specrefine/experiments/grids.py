@@ -216,6 +216,21 @@ def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGri
                           evaluation="adaptive", **grid)
 
 
+
+def corrector_variant_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
+    """A variant of the corrector (issue 39) on the point mass: the U-chains at mild and moderate, seeds 0-3, seed by
+    seed, into data/results/corrector/STEM.csv; then the held-out layouts and mixes (seeds 0-1) into
+    STEM_held_out.csv; then severe on the U-chains into STEM_severe.csv."""
+    table = f"data/results/corrector/{stem}"
+    return ExperimentGrid(
+        name, f"docs/corrector.md, '{section}' (issue 39; fixed 2026-11-27 before it ran)", "point",
+        parts=(Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES, split="seeds"),
+               Part((method,), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES, table=f"{table}_held_out.csv",
+                    out="held_out"),
+               Part((method,), ("imperfect:severe",), mazes=SCALING_MAZES, table=f"{table}_severe.csv",
+                    out="severe")),
+        seeds=(0, 1, 2, 3), workers=1, code=code, table=f"{table}.csv", out=f"runs/corrector_{stem}")
+
 GRIDS = {g.name: g for g in (
     ExperimentGrid(
         "paper-sweep", "data/results/README.md, the point sweep (the paper's Figures 4-6)", "point",
@@ -370,28 +385,10 @@ GRIDS = {g.name: g for g in (
                              table="data/results/corrector/gated_held_out.csv", out="held_out")),
         seeds=(0, 1, 2, 3), workers=1, code="3e309b5", table="data/results/corrector/gated.csv",
         out="runs/corrector_gated"),
-    ExperimentGrid(
-        "corrector-lean", "docs/corrector.md, 'Legs that earn their place' (issue 39; fixed 2026-11-27 before it "
-        "ran)", "point",
-        parts=(Part(("ours-corrector-lean",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
-                    split="seeds"),
-               Part(("ours-corrector-lean",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
-                    table="data/results/corrector/lean_held_out.csv", out="held_out"),
-               Part(("ours-corrector-lean",), ("imperfect:severe",), mazes=SCALING_MAZES,
-                    table="data/results/corrector/lean_severe.csv", out="severe")),
-        seeds=(0, 1, 2, 3), workers=1, code="4a9804f", table="data/results/corrector/lean.csv",
-        out="runs/corrector_lean"),
-    ExperimentGrid(
-        "corrector-precise", "docs/corrector.md, 'A gate on a larger check' (issue 39; fixed 2026-11-27 before it "
-        "ran)", "point",
-        parts=(Part(("ours-corrector-precise",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
-                    split="seeds"),
-               Part(("ours-corrector-precise",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
-                    table="data/results/corrector/precise_held_out.csv", out="held_out"),
-               Part(("ours-corrector-precise",), ("imperfect:severe",), mazes=SCALING_MAZES,
-                    table="data/results/corrector/precise_severe.csv", out="severe")),
-        seeds=(0, 1, 2, 3), workers=1, code="2cda42b", table="data/results/corrector/precise.csv",
-        out="runs/corrector_precise"),
+    corrector_variant_grid("corrector-lean", "Legs that earn their place", "ours-corrector-lean", "lean",
+                           code="4a9804f"),
+    corrector_variant_grid("corrector-precise", "A gate on a larger check", "ours-corrector-precise", "precise",
+                           code="2cda42b"),
     ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
