@@ -41,18 +41,23 @@ def held_out(folder: Path, tag: str, points: str = "") -> tuple[list[str], int, 
     return cells, ok, n
 
 
-def main(folder="data/results/ant/stage7_checks", new="stage7", base="stage5") -> None:
-    folder = Path(folder)
-    rows, verdicts = [f"| check | {base} | {new} | rule |", "| --- | --- | --- | --- |"], {}
+def open_floor_row(folder: Path, base: str, new: str, verdicts: dict) -> list[str]:
+    """Check 1's row (at least 0.98 on the open floor), when both files are there."""
     of = {t: load(folder, f"open_floor_{t}.json") for t in (base, new)}
-    if all(of.values()):
-        verdicts[1] = of[new]["success_rate"] >= 0.98
-        cells = [f"{rate(round(d['success_rate'] * d['episodes']), d['episodes'])}, flips {d['flip_rate']:.1%}"
-                 for d in (of[base], of[new])]
-        rows.append(f"| 1. open floor, 500 episodes | {cells[0]} | {cells[1]} | at least 0.98: "
-                    f"{'holds' if verdicts[1] else 'fails'} |")
-    for number, name, label in ((2, "chain8", "eight goals in a row, 200"), (4, "turn_chain8",
-                                                                          "eight turning goals (90-180 deg), 500")):
+    if not all(of.values()):
+        return []
+    verdicts[1] = of[new]["success_rate"] >= 0.98
+    cells = [f"{rate(round(d['success_rate'] * d['episodes']), d['episodes'])}, flips {d['flip_rate']:.1%}"
+             for d in (of[base], of[new])]
+    return [f"| 1. open floor, 500 episodes | {cells[0]} | {cells[1]} | at least 0.98: "
+            f"{'holds' if verdicts[1] else 'fails'} |"]
+
+
+def chain_rows(folder: Path, base: str, new: str, labels: dict, verdicts: dict) -> list[str]:
+    """Checks 2 (eight goals: the intervals overlap or the new one lies above) and 4 (turning goals: success not
+    below, flips not above); ``labels``: check number -> its label in the table."""
+    rows = []
+    for number, name in ((2, "chain8"), (4, "turn_chain8")):
         d = {t: load(folder, f"{name}_{t}.json") for t in (base, new)}
         if not all(d.values()):
             continue
@@ -65,23 +70,42 @@ def main(folder="data/results/ant/stage7_checks", new="stage7", base="stage5") -
             lo, hi = newcombe_ci(kn, nn, kb, nb)
             rule = (f"success not below, flips not above: {'holds' if verdicts[4] else 'fails'}; difference "
                     f"{kn / nn - kb / nb:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe)")
-        rows.append(f"| {number}. {label} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
-    for points, label in (("", "3. held out U-chain 2"), ("centre_", "5. held out U-chain 2, centre points")):
-        h = {t: held_out(folder, t, points) for t in (base, new)}
-        if not all(h.values()):
-            continue
-        for s in range(3):
-            rows.append(f"| {label} s{s}, 300 | {h[base][0][s]} | {h[new][0][s]} | |")
-        (_, kb, nb), (_, kn, nn) = h[base], h[new]
-        if points == "":
-            verdicts[3] = kn >= kb
-        rule = f"not below {kb}: {'holds' if kn >= kb else 'fails'}" if points == "" else "descriptive"
-        rows.append(f"| {label} pooled, 900 | {rate(kb, nb)} | {rate(kn, nn)} | {rule} |")
-    print("\n".join(rows))
-    missing = [c for c in (1, 2, 3, 4) if c not in verdicts]
-    print("\n" + (f"checks not yet run: {missing}" if missing else
-                  f"adopted by the rule: {'yes' if all(verdicts.values()) else 'no'}"))
+        rows.append(f"| {number}. {labels[number]} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
+    return rows
 
+
+def held_out_rows(folder: Path, base: str, new: str, points: str, label: str, rule) -> list[str]:
+    """The held-out paths' rows (per seed, then pooled); ``rule(kb, nb, kn, nn)`` -> the pooled row's last cell."""
+    h = {t: held_out(folder, t, points) for t in (base, new)}
+    if not all(h.values()):
+        return []
+    rows = [f"| {label} s{s}, 300 | {h[base][0][s]} | {h[new][0][s]} | |" for s in range(3)]
+    (_, kb, nb), (_, kn, nn) = h[base], h[new]
+    return rows + [f"| {label} pooled, 900 | {rate(kb, nb)} | {rate(kn, nn)} | {rule(kb, nb, kn, nn)} |"]
+
+
+def verdict_line(verdicts: dict) -> str:
+    missing = [c for c in (1, 2, 3, 4) if c not in verdicts]
+    return f"checks not yet run: {missing}" if missing else \
+        f"adopted by the rule: {'yes' if all(verdicts.values()) else 'no'}"
+
+
+def main(folder="data/results/ant/stage7_checks", new="stage7", base="stage5") -> None:
+    folder, verdicts = Path(folder), {}
+
+    def not_below(kb, nb, kn, nn):
+        verdicts[3] = kn >= kb
+        return f"not below {kb}: {'holds' if verdicts[3] else 'fails'}"
+
+    rows = [f"| check | {base} | {new} | rule |", "| --- | --- | --- | --- |"]
+    rows += open_floor_row(folder, base, new, verdicts)
+    rows += chain_rows(folder, base, new, {2: "eight goals in a row, 200", 4: "eight turning goals (90-180 deg), 500"},
+                       verdicts)
+    rows += held_out_rows(folder, base, new, "", "3. held out U-chain 2", not_below)
+    rows += held_out_rows(folder, base, new, "centre_", "5. held out U-chain 2, centre points",
+                          lambda *counts: "descriptive")
+    print("\n".join(rows))
+    print("\n" + verdict_line(verdicts))
 
 if __name__ == "__main__":
     main(*sys.argv[1:])
