@@ -214,6 +214,11 @@ register_method("ours-corrector-precise", ours_variant(**CORRECTOR | dict(correc
                 "beyond the paper: ours-corrector-gated with the found path checked on 16n fresh rollouts per leg "
                 "instead of 4n, so that the gate (3 fresh failures) finds legs losing about 1 % and their "
                 "alternatives are judged on four times the rollouts", colour="#4e342e")
+register_method("ours-corrector-trim", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
+                                                                       correct_lean=True)),
+                "beyond the paper: ours-corrector-precise judging the correction by the legs' posterior means and "
+                "offering every waypoint of the corrected path its bypass (ours-corrector-lean's rule on the "
+                "512-rollout check)", colour="#3e2723")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
