@@ -389,6 +389,8 @@ GRIDS = {g.name: g for g in (
                            code="4a9804f"),
     corrector_variant_grid("corrector-precise", "A gate on a larger check", "ours-corrector-precise", "precise",
                            code="2cda42b"),
+    corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
+                           "trim", code="57aa840"),
     ExperimentGrid(
         "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
         parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
