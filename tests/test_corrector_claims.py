@@ -190,9 +190,10 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
 
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
-    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise"} <= set(marked)
+    assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
+            "trim"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
-                        lean=cc.lean_study(), precise=cc.precise_study())
+                        lean=cc.lean_study(), precise=cc.precise_study(), trim=cc.variant_study(cc.TRIM))
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -240,3 +241,27 @@ def test_without_their_tables_the_later_variants_are_not_run_yet(tmp_path):
     assert cc.lean_study(tmp_path) is None and cc.precise_study(tmp_path) is None
     text = cc.front(cc.point_study(tmp_path), None, tmp_path)
     assert text["lean"] == text["precise"] == "not run yet"
+
+
+@pytest.mark.parametrize("rate, verdict", [(0.99, "helps"), (0.975, "no worse"), (0.9, "worse")])
+def test_trim_is_judged_against_precise_not_the_corrector(tmp_path, rate, verdict):
+    """ours-corrector-trim's section names ours-corrector-precise as its reference: the paired rule, the cost, the
+    severe and the held-out cells compare with precise's tables (0.98 here; ours-corrector is at 0.97)."""
+    lay(tmp_path, rates)
+    for part in (0, 1, 2):
+        lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.98, calls_of=lambda m: 8, part=part)
+        lay_grid(tmp_path, "corrector-trim", lambda maze, m, p: rate, calls_of=lambda m: 8, part=part)
+    lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
+    vs = cc.variant_study(cc.TRIM, tmp_path)
+    assert vs["reference"] == cc.PRECISE and vs["versus_corrector"]["estimate"] == pytest.approx(rate - 0.98)
+    v = {e["rule"]: e for e in cc.variant_verdicts(vs)}
+    paired = v[f"{cc.TRIM} - {cc.PRECISE} (paired, U-chains, mild and moderate): helps if the lower end > 0, no "
+               "worse if >= -0.02"]
+    assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
+    assert [c["proposer_calls_ratio"] for c in vs["corrector_costs"]] == pytest.approx([8 / 3] * 2)
+    text = cc._variant_text(vs)
+    assert text.startswith(f"{cc.TRIM} - {cc.PRECISE} ") and f"({verdict})" in text
+    assert f"({cc.PRECISE} 0 of 36), - {cc.PRECISE} " in text
+    assert "per layout and mix (ours-corrector-precise 0.980-0.980;" in text
+    md = "\n".join(cc.variant_markdown(vs))
+    assert f"Cost beside {cc.PRECISE}'s on the same cells" in md and f"| trim | {cc.PRECISE} | difference |" in md

@@ -31,9 +31,13 @@ LEVERS = ("ours-deeprepair", "ours-feasible", "ours-checked")
 GATED = "ours-corrector-gated"
 LEAN = "ours-corrector-lean"
 PRECISE = "ours-corrector-precise"
+TRIM = "ours-corrector-trim"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
-VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise"}
+VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
+                 TRIM: "corrector-trim"}
+#: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
+VARIANT_REFERENCE = {TRIM: PRECISE}
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -220,20 +224,21 @@ def pooled(rows, mazes, method, proposer, seeds) -> tuple[int, int, int]:
 
 
 def variant_study(method: str, root: Path = ROOT) -> dict | None:
-    """A variant of the corrector (``VARIANT_GRIDS``) by the rules of its docs/corrector.md section: against
-    ours-corrector (paired, U-chains, mild and moderate), the corrector's own rules, its cost beside the corrector's,
-    the held-out cells and, where its grid ran severe, severe against ours-repair."""
-    grid = GRIDS[VARIANT_GRIDS[method]]
-    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + grid.tables, root)
+    """A variant of the corrector (``VARIANT_GRIDS``) by the rules of its docs/corrector.md section: against its
+    reference (``VARIANT_REFERENCE``, else ours-corrector; paired, U-chains, mild and moderate), the corrector's own
+    rules, its cost beside the reference's, the held-out cells and, where its grid ran severe, severe against
+    ours-repair."""
+    grid, ref = GRIDS[VARIANT_GRIDS[method]], reference_of(method)
+    rows = load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + _reference_tables(method) + grid.tables, root)
     if not any(r["method"] == method for r in rows):
         return None
     cells, failed = cmp.table_cells(rows, "point")
     presets = ("imperfect:mild", "imperfect:moderate")
     both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in presets}
     both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in presets}
-    study = {"method": method, "grid": grid.name, "per_maze": [], "rooms": [], "zero": [], "costs": [],
-             "corrector_costs": [], "ratio": [],
-             "versus_corrector": cmp.paired_difference(both, both_failed, "both", method, METHOD, POINT_SEEDS,
+    study = {"method": method, "grid": grid.name, "reference": ref, "per_maze": [], "rooms": [], "zero": [],
+             "costs": [], "corrector_costs": [], "ratio": [],
+             "versus_corrector": cmp.paired_difference(both, both_failed, "both", method, ref, POINT_SEEDS,
                                                        [f"{maze} {p}" for p in presets for maze in SCALING_MAZES])}
     for proposer in presets:
         study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=method)
@@ -243,18 +248,18 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["zero"].append({"proposer": proposer, "runs": zero_runs(rows, method, proposer, SCALING_MAZES)})
         study["costs"].append(costs(rows, proposer, SCALING_MAZES, POINT_SEEDS, first=method))
         ran = {(r["maze"], r["seed"]) for r in rows if r["method"] == method and r["proposer"] == proposer
-               and cmp.is_done(r)}  # the corrector's cost on the cells the variant ran
+               and cmp.is_done(r)}  # the reference's cost on the cells the variant ran
         study["corrector_costs"].append(costs([r for r in rows if (r["maze"], r["seed"]) in ran], proposer,
-                                              SCALING_MAZES, POINT_SEEDS))
+                                              SCALING_MAZES, POINT_SEEDS, first=ref))
     study["held_out"] = variant_held_out(method, root)
     study["held_out_costs"] = variant_held_out_costs(method, root)
     if "imperfect:severe" in grid.proposers:
         study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, method=method)
         study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, "ours-repair",
                                                           POINT_SEEDS, SCALING_MAZES)
-        study["severe_vs_corrector"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, METHOD,
+        study["severe_vs_corrector"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, ref,
                                                              POINT_SEEDS, SCALING_MAZES)
-        study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, METHOD)}
+        study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     return study
 
@@ -271,18 +276,32 @@ def precise_study(root: Path = ROOT) -> dict | None:
     return variant_study(PRECISE, root)
 
 
+def reference_of(method: str) -> str:
+    """The method a variant is judged against: ours-corrector unless its section names another."""
+    return VARIANT_REFERENCE.get(method, METHOD)
+
+
+def _reference_tables(method: str, part: int | None = None) -> tuple:
+    """The shipped tables of the variant's reference where that is another variant (``part``: one part's only)."""
+    ref = reference_of(method)
+    if ref == METHOD:
+        return ()
+    grid = GRIDS[VARIANT_GRIDS[ref]]
+    return grid.tables if part is None else (grid.part_table(part),)
+
+
 def _held_out_rows(method: str, root: Path) -> list[dict]:
     grid = GRIDS[VARIANT_GRIDS[method]]
     part = next(i for i, part in enumerate(grid.parts) if set(part.proposers) == set(HELD_OUT_MIXES))
-    return load(GRIDS["corrector-held-out"].tables + (grid.part_table(part),), root)
+    return load(GRIDS["corrector-held-out"].tables + _reference_tables(method, part) + (grid.part_table(part),), root)
 
 
 def variant_held_out_costs(method: str, root: Path = ROOT) -> list[dict]:
-    """Per held-out mix: the variant's and the corrector's mean cost over ours's on the same cells."""
+    """Per held-out mix: the variant's and its reference's mean cost over ours's on the same cells."""
     rows = _held_out_rows(method, root)
     mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
     return [costs(rows, mix, mazes, HELD_OUT_SEEDS, first=m) | {"proposer": f"mix {MIX_NAMES[mix]}", "method": m}
-            for mix in HELD_OUT_MIXES for m in (method, METHOD)]
+            for mix in HELD_OUT_MIXES for m in (method, reference_of(method))]
 
 
 def variant_held_out(method: str, root: Path = ROOT) -> list[dict]:
@@ -290,7 +309,7 @@ def variant_held_out(method: str, root: Path = ROOT) -> list[dict]:
     mazes = tuple(table_name(m) for m in HELD_OUT_MAZES)
     out = []
     for mix in HELD_OUT_MIXES:
-        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=(METHOD, "*"), method=method):
+        for e in per_maze(rows, mix, mazes, HELD_OUT_SEEDS, reference=(reference_of(method), "*"), method=method):
             k, n, _ = episodes_of(rows, e["maze"], "ours", mix, HELD_OUT_SEEDS)
             out.append(e | {"mix": MIX_NAMES[mix], "ours": k / n if n else math.nan})
     return out
@@ -372,7 +391,8 @@ def _verdict(ok: bool, complete: bool) -> str:
 
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
-             gated: dict | None = None, lean: dict | None = None, precise: dict | None = None) -> str:
+             gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
+             trim: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -432,7 +452,7 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
-    for variant in (gated, lean, precise):
+    for variant in (gated, lean, precise, trim):
         if variant:
             lines += variant_markdown(variant)
     return "\n".join(lines) + "\n"
@@ -467,11 +487,11 @@ def levers_markdown(lv: dict) -> list[str]:
 
 
 def versus_corrector(vs: dict) -> tuple[str, str]:
-    """(rule, verdict) of a variant against ours-corrector, as its section of docs/corrector.md fixed it: the gate
+    """(rule, verdict) of a variant against its reference, as its section of docs/corrector.md fixed it: the gate
     is to be no worse (lower end >= -NON_INFERIORITY); the later variants help (lower end > 0), are no worse, or are
     worse."""
     v, method = vs["versus_corrector"], vs["method"]
-    scope = f"{method} - {METHOD} (paired, U-chains, mild and moderate)"
+    scope = f"{method} - {vs['reference']} (paired, U-chains, mild and moderate)"
     known = not math.isnan(v["estimate"])
     no_worse = known and v["ci_low"] >= -NON_INFERIORITY
     if method == GATED:
@@ -521,16 +541,16 @@ def gated_verdicts(gs: dict) -> list[dict]:
 
 
 def variant_markdown(vs: dict) -> list[str]:
-    method, grid = vs["method"], vs["grid"]
+    method, grid, ref = vs["method"], vs["grid"], vs["reference"]
     short = method.removeprefix(f"{METHOD}-")
     lines = ["", f"`{method}` (grid `{grid}`; its rules fixed before it ran, docs/corrector.md):", "",
              "| rule | estimate | verdict |", "|---|---|---|"]
     lines += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in variant_verdicts(vs)]
-    lines += ["", f"Cost beside {METHOD}'s on the same cells (mean over the mean of ours):", "",
+    lines += ["", f"Cost beside {ref}'s on the same cells (mean over the mean of ours):", "",
               "| proposer | method | pairs | evaluations | proposer calls | simulator steps |",
               "|---|---|---|---|---|---|"]
     for mine, full in zip(vs["costs"], vs["corrector_costs"]):
-        for name, c in ((method, mine), (METHOD, full)):
+        for name, c in ((method, mine), (ref, full)):
             lines.append(f"| {c['proposer']} | {name} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                          f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
     lines += ["", f"Per U-chain: {method} vs the oracle, pooled over seeds (Newcombe 95 %).", "",
@@ -538,11 +558,11 @@ def variant_markdown(vs: dict) -> list[str]:
     lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
               f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["per_maze"] + vs.get("severe", [])]
     if "severe_vs_corrector" in vs:
-        lines += ["", f"Severe (described): {method} - {METHOD} {_paired_text(vs['severe_vs_corrector'])}; - "
+        lines += ["", f"Severe (described): {method} - {ref} {_paired_text(vs['severe_vs_corrector'])}; - "
                   f"ours-repair {_paired_text(vs['severe_vs_repair'])} (paired, U-chains, 95 % bootstrap)."]
     if any(e["runs"] for e in vs["held_out"]):
-        lines += ["", f"Held out (descriptive): {method} - {METHOD} per layout and mix (Newcombe 95 %), ours beside.",
-                  "", f"| mix | maze | runs | {short} | ours-corrector | difference | ours |",
+        lines += ["", f"Held out (descriptive): {method} - {ref} per layout and mix (Newcombe 95 %), ours beside.",
+                  "", f"| mix | maze | runs | {short} | {ref} | difference | ours |",
                   "|---|---|---|---|---|---|---|"]
         lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])}"
                   f" | {_diff(e)} | {_num(e['ours'])} |" for e in vs["held_out"]]
@@ -565,8 +585,9 @@ def add_arguments(p) -> None:
 def run(args, p) -> int:
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
-        levers, gated, lean, precise = levers_study(), gated_study(), lean_study(), precise_study()
-        variants = {"gated": gated, "lean": lean, "precise": precise}
+        levers = levers_study()
+        variants = {"gated": gated_study(), "lean": lean_study(), "precise": precise_study(),
+                    "trim": variant_study(TRIM)}
         record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
                   "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
                   "front": front(point, held_out, levers=levers, **variants)}
@@ -590,11 +611,12 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          gated: dict | None = None, lean: dict | None = None, precise: dict | None = None) -> dict[str, str]:
+          gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
+          trim: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
     counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
                                                       "corrector-levers", "corrector-gated", "corrector-lean",
-                                                      "corrector-precise")}
+                                                      "corrector-precise", "corrector-trim")}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -623,6 +645,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["gated"] = _gated_text(gated) if gated else "not run yet"
     out["lean"] = _variant_text(lean) if lean else "not run yet"
     out["precise"] = _variant_text(precise) if precise else "not run yet"
+    out["trim"] = _variant_text(trim) if trim else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -663,10 +686,10 @@ def _gated_text(gs: dict) -> str:
 
 
 def _variant_text(vs: dict) -> str:
-    """A variant against ours-corrector, its change over rooms per preset and its proposer calls."""
+    """A variant against its reference, its change over rooms per preset and its proposer calls."""
     _, verdict = versus_corrector(vs)
-    v = vs["versus_corrector"]
-    parts = [f"{vs['method']} - {METHOD} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells "
+    v, ref = vs["versus_corrector"], vs["reference"]
+    parts = [f"{vs['method']} - {ref} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells "
              f"({verdict})"]
     for rooms, c, zero in zip(vs["rooms"], vs["costs"], vs["zero"]):
         level = rooms["proposer"].split(":")[1]
@@ -680,13 +703,13 @@ def _variant_text(vs: dict) -> str:
                                for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
     if "severe_zero" in vs:
         zero = vs["severe_zero"]
-        parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({METHOD} "
-                     f"{zero[METHOD][0]} of {zero[METHOD][1]}), - {METHOD} {_signed(vs['severe_vs_corrector'])}, - "
+        parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({ref} "
+                     f"{zero[ref][0]} of {zero[ref][1]}), - {ref} {_signed(vs['severe_vs_corrector'])}, - "
                      f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
     held = [e for e in vs["held_out"] if e["runs"]]
     if held:
         parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
-                     f"layout and mix ({METHOD} {min(e['reference_success'] for e in held):.3f}-"
+                     f"layout and mix ({ref} {min(e['reference_success'] for e in held):.3f}-"
                      f"{max(e['reference_success'] for e in held):.3f}; higher on "
                      f"{sum(e['success'] > e['reference_success'] for e in held)}, lower on "
                      f"{sum(e['success'] < e['reference_success'] for e in held)} of {len(held)})")
