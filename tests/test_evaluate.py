@@ -10,7 +10,7 @@ from specrefine.core.mazes import load_maze
 from specrefine.core.regions import Box, CompiledRegion, Disc, union
 from specrefine.core.results import AVOID, SUCCESS, StartStates, wilson_ci
 from specrefine.core.spec import maze_task
-from specrefine.evaluation.evaluator import Evaluator, path_legs
+from specrefine.evaluation.evaluator import Evaluator, path_legs, spread_draw
 from specrefine.evaluation.monitor import satisfies
 from specrefine.sim.policy import PointController
 
@@ -100,9 +100,10 @@ def test_start_state_propagation(maze):
     assert first.successes > 0 and len(first.end_states) == first.successes
     second = ev.evaluate(first.end_states, maze.cell_box(1, 3), maze.walls)
     starts = second.trajectories[:, 0].astype(float)
-    # every start of the second edge is one of the first edge's end states (resampled with replacement)
+    # every start of the second edge is one of the first edge's end states, each used once or twice (spread_draw)
     d = np.linalg.norm(starts[:, None, :] - first.end_states.xy[None, :, :], axis=-1).min(axis=1)
     assert np.all(d < 1e-5)
+    assert len(np.unique(starts.round(5), axis=0)) == len(np.unique(first.end_states.xy.round(5), axis=0))
     assert np.all(maze.cell_box(3, 3).contains(starts))
     # full physics states: the velocity at the end of edge 1 is carried into edge 2
     sim = ev.sim(first.successes)
@@ -313,3 +314,28 @@ def test_evaluate_many_equals_one_evaluate_per_subtask(maze):
     assert got[4].cached and got[4].p == got[0].p  # asked twice: simulated once
     assert together.evaluations == 4 and together.cache_hits == 1
     assert [r.cached for r in together.evaluate_many(subtasks)] == [True] * 5 and together.evaluations == 4
+
+
+@pytest.mark.parametrize("m, n", [(5, 5), (5, 12), (7, 3), (128, 128), (127, 128), (40, 128)])
+def test_spread_draw_uses_every_start_state_as_evenly_as_n_allows(m, n):
+    """A chained estimate's n rollouts stay as many distinct ones as the previous leg's successes: with replacement,
+    leg after leg, they would descend from ever fewer states (deterministic policy and physics)."""
+    idx = spread_draw(m, n, np.random.default_rng(3))
+    counts = np.bincount(idx, minlength=m)
+    assert len(idx) == n and counts.sum() == n
+    assert set(np.unique(counts)) <= {n // m, n // m + 1}
+    assert (counts > 0).sum() == min(m, n)
+
+
+def test_a_chain_of_spread_draws_keeps_its_rollouts_distinct():
+    """Twenty legs that every rollout survives: drawn with replacement, 64 rollouts would descend from about
+    2 * 64 / 20 first states; spread, from all 64."""
+    rng = np.random.default_rng(0)
+    lineage = np.arange(64)
+    for _ in range(20):
+        lineage = lineage[spread_draw(len(lineage), 64, rng)]
+    assert len(np.unique(lineage)) == 64
+    lineage = np.arange(64)
+    for _ in range(20):
+        lineage = lineage[rng.integers(len(lineage), size=64)]
+    assert len(np.unique(lineage)) < 20

@@ -19,7 +19,7 @@ OUTCOMES = ("success", "avoid", "flipped", "timeout", "unfinished")
 
 @dataclass
 class StartStates:
-    """A start distribution given by full physics states (resampled with replacement)."""
+    """A start distribution given by full physics states (drawn by ``evaluation.evaluator.spread_draw``)."""
 
     states: np.ndarray  # (m, state_dim)
     xy: np.ndarray  # (m, 2)
