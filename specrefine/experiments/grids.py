@@ -397,6 +397,12 @@ GRIDS = {g.name: g for g in (
         mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
         workers=1, code="5356175", table="data/results/corrector/ant.csv", out="runs/ant_corrector"),
     ExperimentGrid(
+        "ant-corrector-spread", "docs/corrector.md, 'Chained estimates' (issue 39; fixed 2026-11-27 before its first "
+        "cell ran): ant-corrector's cells at the code with spread start states", "ant",
+        parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
+        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
+        workers=1, code="1d06a16", table="data/results/corrector/ant_spread.csv", out="runs/ant_corrector_spread"),
+    ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
         parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2), mazes=("u_chain_3", "u_chain_5"),
