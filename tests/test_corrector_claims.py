@@ -191,9 +191,10 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
     assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
-            "trim"} <= set(marked)
+            "trim", "ant"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
-                        lean=cc.lean_study(), precise=cc.precise_study(), trim=cc.variant_study(cc.TRIM))
+                        lean=cc.lean_study(), precise=cc.precise_study(), trim=cc.variant_study(cc.TRIM),
+                        ant=cc.ant_study())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -265,3 +266,23 @@ def test_trim_is_judged_against_precise_not_the_corrector(tmp_path, rate, verdic
     assert "per layout and mix (ours-corrector-precise 0.980-0.980;" in text
     md = "\n".join(cc.variant_markdown(vs))
     assert f"Cost beside {cc.PRECISE}'s on the same cells" in md and f"| trim | {cc.PRECISE} | difference |" in md
+
+
+def test_the_ants_rules_read_the_spread_grid_with_the_cells_before_the_fix_beside(tmp_path):
+    lay(tmp_path, rates)
+    assert cc.ant_study(tmp_path) is None  # neither Ant grid has a cell
+    lay_grid(tmp_path, cc.ANT_BEFORE, lambda maze, m, p: 0.8, drop=20)  # 7 cells of seed 0 ... as it stopped
+    ant = cc.ant_study(tmp_path)
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant, "))
+    assert rule["verdict"] == "not run yet" and cc.ANT_GRID in rule["value"]
+    assert cc._ant_text(ant) == (f"{cc.ANT_GRID}: no cell yet. {cc.ANT_BEFORE} (before the fix): u_chain_1 0.800 "
+                                 "(3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals 0.800 (1 run); below 0.85 on "
+                                 "3 of 3 mazes run")
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
+    ant = cc.ant_study(tmp_path)
+    assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant, "))
+    assert rule["verdict"] == "does not hold" and rule["value"].endswith(": u_chain_5")
+    md = cc.markdown(cc.point_study(tmp_path), ant)
+    assert "| u_chain_5 | 3 | 0.840 [" in md and "| 1 | 0.800 |" in md and "| 0 | — |" in md
+    assert "below 0.85 on 1 of 9 mazes run" in cc._ant_text(ant)

@@ -4,7 +4,8 @@
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
 and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
-alone), ``corrector-gated`` (ours-corrector-gated) and ``ant-corrector`` with the Ant scaling grid's one-shot;
+alone), the corrector variants' grids and ``ant-corrector-spread`` (``ant-corrector`` beside it) with the Ant
+scaling grid's one-shot;
 writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
 rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
 marked partial.
@@ -43,7 +44,9 @@ TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
 COST_CAP = 3.0
 POINT_SEEDS = GRIDS["corrector"].seeds
-ANT_SEEDS = GRIDS["ant-corrector"].seeds
+ANT_GRID = "ant-corrector-spread"  # the Ant's rules read this grid (docs/corrector.md, "Chained estimates")
+ANT_BEFORE = "ant-corrector"  # the same cells before spread start states (stopped at 10 of 27): shown beside
+ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
 ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
@@ -169,9 +172,16 @@ def table_name(maze: str) -> str:
 
 
 def ant_study(root: Path = ROOT) -> dict | None:
-    rows = load(GRIDS["ant-corrector"].tables + (ANT_ONESHOT, ANT_ORACLE, ANT_ERRING), root)
-    if not any(r["method"] == METHOD for r in rows):
+    """The Ant's rules on ``ANT_GRID``, with ``ANT_BEFORE``'s cells (chained estimates drawn with replacement)
+    beside; None while neither has a cell."""
+    now, before = _ant_grid_study(ANT_GRID, root), _ant_grid_study(ANT_BEFORE, root)
+    if not any(e["runs"] for e in now["per_maze"] + before["per_maze"]):
         return None
+    return now | {"grid": ANT_GRID, "before": before["per_maze"]}
+
+
+def _ant_grid_study(grid: str, root: Path) -> dict:
+    rows = load(GRIDS[grid].tables + (ANT_ONESHOT, ANT_ORACLE, ANT_ERRING), root)
     proposer = "imperfect:moderate"
     maze_rows = []
     for maze in SCALING_MAZES:
@@ -360,7 +370,10 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                     "value": f"{_num(c['evaluations_ratio'], '{:.2f}x')}, {_num(c['proposer_calls_ratio'], '{:.2f}x')}"
                              f" over {c['pairs']} pairs",
                     "verdict": _cost_verdict(c)})
-    if ant:
+    if ant and not any(e["runs"] for e in ant["per_maze"]):
+        out.append({"rule": f"Ant, imperfect:moderate: at least {ANT_FLOOR} on every maze",
+                    "value": f"{ANT_GRID}: no cell yet", "verdict": "not run yet"})
+    elif ant:
         complete = all(e["runs"] == len(ANT_SEEDS) for e in ant["per_maze"])
         ran = [e for e in ant["per_maze"] if e["runs"]]
         low = [e["maze"] for e in ran if e["success"] < ANT_FLOOR]
@@ -443,11 +456,15 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
             lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                          f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
     if ant:
-        lines += ["", "The Ant (imperfect:moderate, stage 5, centre goal points): ours-corrector pooled per maze "
-                  "(Wilson 95 %).", "", "| maze | runs | success [95 % CI] |", "|---|---|---|"]
-        for e in ant["per_maze"]:
+        lines += ["", f"The Ant (imperfect:moderate, stage 5, centre goal points): ours-corrector pooled per maze "
+                  f"(Wilson 95 %), grid `{ANT_GRID}`; beside it `{ANT_BEFORE}`, the same cells before a leg's start "
+                  "states were spread (docs/corrector.md, 'Chained estimates'; stopped there).", "",
+                  f"| maze | runs | success [95 % CI] | {ANT_BEFORE}: runs | {ANT_BEFORE}: success |",
+                  "|---|---|---|---|---|"]
+        for e, old in zip(ant["per_maze"], ant["before"]):
             ci = f" [{e['ci_low']:.3f}, {e['ci_high']:.3f}]" if "ci_low" in e else ""
-            lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} |")
+            lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} | {old['runs']} | "
+                         f"{_num(old['success'])} |")
         lines += ["", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
@@ -590,7 +607,7 @@ def run(args, p) -> int:
                     "trim": variant_study(TRIM)}
         record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
                   "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
-                  "front": front(point, held_out, levers=levers, **variants)}
+                  "front": front(point, held_out, levers=levers, ant=ant, **variants)}
         with locked(ensure_dir(args.out)):
             write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
             write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
@@ -612,11 +629,11 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
           gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
-          trim: dict | None = None) -> dict[str, str]:
+          trim: dict | None = None, ant: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
     counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
                                                       "corrector-levers", "corrector-gated", "corrector-lean",
-                                                      "corrector-precise", "corrector-trim")}
+                                                      "corrector-precise", "corrector-trim", ANT_GRID)}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -646,6 +663,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["lean"] = _variant_text(lean) if lean else "not run yet"
     out["precise"] = _variant_text(precise) if precise else "not run yet"
     out["trim"] = _variant_text(trim) if trim else "not run yet"
+    out["ant"] = _ant_text(ant) if ant else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -655,6 +673,16 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
     return out
+
+
+def _ant_text(ant: dict) -> str:
+    """The Ant's cells per maze in ANT_GRID and, beside, in ANT_BEFORE."""
+    def cells(per_maze):
+        ran = [e for e in per_maze if e["runs"]]
+        low = sum(e["success"] < ANT_FLOOR for e in ran)
+        return (", ".join(f"{e['maze']} {e['success']:.3f} ({e['runs']} run{'s' * (e['runs'] > 1)})" for e in ran)
+                + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
+    return f"{ANT_GRID}: {cells(ant['per_maze'])}. {ANT_BEFORE} (before the fix): {cells(ant['before'])}"
 
 
 def _levers_text(lv: dict) -> str:
