@@ -389,6 +389,8 @@ GRIDS = {g.name: g for g in (
                            code="4a9804f"),
     corrector_variant_grid("corrector-precise", "A gate on a larger check", "ours-corrector-precise", "precise",
                            code="2cda42b"),
+    corrector_variant_grid("corrector-precise-spread", "Chained estimates", "ours-corrector-precise",
+                           "precise_spread", code="1d06a16"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ExperimentGrid(
