@@ -191,10 +191,10 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
     readme = " ".join((ROOT / "README.md").read_text().split())
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
     assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
-            "trim", "ant"} <= set(marked)
+            "trim", "ant", "spread"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
                         lean=cc.lean_study(), precise=cc.precise_study(), trim=cc.variant_study(cc.TRIM),
-                        ant=cc.ant_study())
+                        ant=cc.ant_study(), spread=cc.variant_study(cc.SPREAD))
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -286,3 +286,21 @@ def test_the_ants_rules_read_the_spread_grid_with_the_cells_before_the_fix_besid
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_5 | 3 | 0.840 [" in md and "| 1 | 0.800 |" in md and "| 0 | — |" in md
     assert "below 0.85 on 1 of 9 mazes run" in cc._ant_text(ant)
+
+
+def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):
+    """corrector-precise-spread runs ours-corrector-precise again (spread start states): its rows are named
+    SPREAD in the claims, so that the paired rule compares the two runs of one method."""
+    lay(tmp_path, rates)
+    assert cc.variant_study(cc.SPREAD, tmp_path) is None
+    for part in (0, 1, 2):
+        lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.96, calls_of=lambda m: 8, part=part)
+        lay_grid(tmp_path, "corrector-precise-spread", lambda maze, m, p: 0.98, calls_of=lambda m: 8, part=part)
+    lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
+    vs = cc.variant_study(cc.SPREAD, tmp_path)
+    assert vs["reference"] == cc.PRECISE and vs["versus_corrector"]["estimate"] == pytest.approx(0.02)
+    assert all(e["success"] == pytest.approx(0.98) for e in vs["per_maze"])
+    text = cc._variant_text(vs)
+    assert text.startswith(f"{cc.SPREAD} - {cc.PRECISE} +0.020 ") and "(helps)" in text
+    assert "per layout and mix (ours-corrector-precise 0.960-0.960; higher on 12, lower on 0 of 12)" in text
+    assert cc.variant_study(cc.PRECISE, tmp_path)["versus_corrector"]["estimate"] == pytest.approx(-0.01)
