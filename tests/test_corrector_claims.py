@@ -158,8 +158,8 @@ def test_a_lever_grid_cut_short_is_marked_partial(tmp_path):
 def test_the_gated_corrector_is_judged_against_the_corrector_by_its_margin(tmp_path, gated, verdict):
     lay(tmp_path, rates)
     lay_grid(tmp_path, "corrector-gated", lambda maze, m, p: gated, calls_of=lambda m: 5)
-    gs = cc.gated_study(tmp_path)
-    v = {e["rule"]: e for e in cc.gated_verdicts(gs)}
+    gs = cc.variant_study(cc.GATED, tmp_path)
+    v = {e["rule"]: e for e in cc.variant_verdicts(gs)}
     paired = v[f"{cc.GATED} - {cc.METHOD} (paired, U-chains, mild and moderate): lower end >= -0.02"]
     assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
     cost = v[f"{cc.GATED}, imperfect:moderate: cost at most 3.0x ours (proposer calls, evaluations)"]
@@ -175,7 +175,7 @@ def test_the_gated_corrector_is_judged_against_the_corrector_by_its_margin(tmp_p
 
 def test_without_their_tables_the_levers_and_the_gate_are_not_run_yet(tmp_path):
     lay(tmp_path, rates)
-    assert cc.levers_study(tmp_path) is None and cc.gated_study(tmp_path) is None
+    assert cc.levers_study(tmp_path) is None and cc.variant_study(cc.GATED, tmp_path) is None
     text = cc.front(cc.point_study(tmp_path), None, tmp_path)
     assert text["levers"] == text["gated"] == "not run yet"
 
@@ -192,9 +192,8 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
     marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
     assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
             "trim", "ant", "spread"} <= set(marked)
-    expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), gated=cc.gated_study(),
-                        lean=cc.lean_study(), precise=cc.precise_study(), trim=cc.variant_study(cc.TRIM),
-                        ant=cc.ant_study(), spread=cc.variant_study(cc.SPREAD))
+    expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), ant=cc.ant_study(),
+                        **cc.variant_studies())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name
     rows = list(csv.DictReader((ROOT / GRIDS["corrector"].table).open()))
@@ -239,7 +238,7 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
 
 def test_without_their_tables_the_later_variants_are_not_run_yet(tmp_path):
     lay(tmp_path, rates)
-    assert cc.lean_study(tmp_path) is None and cc.precise_study(tmp_path) is None
+    assert cc.variant_study(cc.LEAN, tmp_path) is None and cc.variant_study(cc.PRECISE, tmp_path) is None
     text = cc.front(cc.point_study(tmp_path), None, tmp_path)
     assert text["lean"] == text["precise"] == "not run yet"
 
