@@ -7,6 +7,7 @@
 #   NEW=data/policies/ant_stage6.pt TAG=stage6 BASE=data/policies/ant_stage5.pt BASE_TAG=stage5 \
 #       OUT=data/results/ant/stage6_checks bash scripts/ant_heading_checks.sh
 set -euo pipefail
+. "$(dirname "$0")/check_lib.sh"
 cd "$(dirname "$0")/.."
 out=${OUT:-data/results/ant/heading_checks}
 new=${NEW:-data/policies/ant_stage4_heading.pt}
@@ -17,13 +18,13 @@ py=${PYTHON:-.venv/bin/python}
 mkdir -p "$out"
 for tag in "$base_tag" "$new_tag"; do
     pol=$([ "$tag" = "$base_tag" ] && echo "$base" || echo "$new")
-    [ -s "$out/open_floor_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --episodes 500 \
-        --seed 1 --goal-range 2 6 > "$out/open_floor_$tag.json"
-    [ -s "$out/chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
-        --goal-range 3 5 --episodes 200 --seed 5 > "$out/chain8_$tag.json"
+    produce "$out/open_floor_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --episodes 500 \
+        --seed 1 --goal-range 2 6
+    produce "$out/chain8_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
+        --goal-range 3 5 --episodes 200 --seed 5
     for s in 0 1 2; do
         file="$out/u_chain_2_s${s}_$tag.json"
-        [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" --episodes 300 \
-            --seed 77 --policy "$pol" --out "$file" > /dev/null
+        produce_self "$file" $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
+            --episodes 300 --seed 77 --policy "$pol" --out "$file" > /dev/null
     done
 done

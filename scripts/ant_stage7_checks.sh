@@ -7,6 +7,7 @@
 # points. Then the lost episodes by kind of leg, per policy and goal-point rule, into OUT/leg_kinds.md.
 #   bash scripts/ant_stage7_checks.sh
 set -euo pipefail
+. "$(dirname "$0")/check_lib.sh"
 cd "$(dirname "$0")/.."
 out=${OUT:-data/results/ant/stage7_checks}
 new=${NEW:-data/policies/ant_stage7.pt}
@@ -17,15 +18,15 @@ py=${PYTHON:-.venv/bin/python}
 mkdir -p "$out"
 for tag in "$new_tag" "$base_tag"; do
     pol=$([ "$tag" = "$base_tag" ] && echo "$base" || echo "$new")
-    [ -s "$out/open_floor_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --episodes 500 \
-        --seed 1 --goal-range 2 6 > "$out/open_floor_$tag.json"
-    [ -s "$out/chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
-        --goal-range 3 5 --episodes 200 --seed 5 > "$out/chain8_$tag.json"
-    [ -s "$out/turn_chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
-        --goal-range 3 5 --turn-goals 90 180 --episodes 500 --seed 5 > "$out/turn_chain8_$tag.json"
+    produce "$out/open_floor_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --episodes 500 \
+        --seed 1 --goal-range 2 6
+    produce "$out/chain8_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
+        --goal-range 3 5 --episodes 200 --seed 5
+    produce "$out/turn_chain8_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
+        --goal-range 3 5 --turn-goals 90 180 --episodes 500 --seed 5
     for s in 0 1 2; do
         file="$out/u_chain_2_s${s}_$tag.json"
-        [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
+        produce_self "$file" $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
             --episodes 300 --seed 77 --policy "$pol" --out "$file" > /dev/null
     done
 done
@@ -33,17 +34,8 @@ for tag in "$new_tag" "$base_tag"; do
     pol=$([ "$tag" = "$base_tag" ] && echo "$base" || echo "$new")
     for s in 0 1 2; do
         file="$out/u_chain_2_s${s}_centre_$tag.json"
-        [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
+        produce_self "$file" $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
             --episodes 300 --seed 77 --policy "$pol" --goal-points centre --out "$file" > /dev/null
     done
 done
-{
-    for tag in "$base_tag" "$new_tag"; do
-        for points in "" centre_; do
-            echo "**$tag, held-out U-chain 2 paths, $([ -n "$points" ] && echo centre || echo sampled) goal points** (\`$py -m specrefine.experiments.legs --failures $out/u_chain_2_s[012]_$points$tag.json\`)"
-            echo
-            $py -m specrefine.experiments.legs --failures "$out"/u_chain_2_s[012]_$points$tag.json
-            echo
-        done
-    done
-} > "$out/leg_kinds.md.tmp" && mv "$out/leg_kinds.md.tmp" "$out/leg_kinds.md"
+leg_kinds_md "$out" "$py" "$base_tag $new_tag" "sampled centre"

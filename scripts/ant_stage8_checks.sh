@@ -9,6 +9,7 @@
 # leg into OUT/leg_kinds.md.
 #   bash /tmp/heavy.sh bash scripts/ant_stage8_checks.sh
 set -euo pipefail
+. "$(dirname "$0")/check_lib.sh"
 cd "$(dirname "$0")/.."
 out=${OUT:-data/results/ant/stage8_checks}
 new=${NEW:-data/policies/ant_stage8.pt}
@@ -19,18 +20,18 @@ py=${PYTHON:-.venv/bin/python}
 mkdir -p "$out"
 if [ "$base_tag" = stage5 ]; then
     for f in open_floor_stage5.json u_chain_2_s{0,1,2}_centre_stage5.json u_chain_2_s{0,1,2}_stage5.json; do
-        [ -s "$out/$f" ] || cp data/results/ant/stage7_checks/$f "$out/$f"
+        produce "$out/$f" cat "data/results/ant/stage7_checks/$f"
     done
 fi
 policy_of() { [ "$1" = "$base_tag" ] && echo "$base" || echo "$new"; }
-[ -s "$out/open_floor_$new_tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$new" --episodes 500 \
-    --seed 1 --goal-range 2 6 > "$out/open_floor_$new_tag.json"
+produce "$out/open_floor_$new_tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$new" --episodes 500 \
+    --seed 1 --goal-range 2 6
 for tag in "$base_tag" "$new_tag"; do
     pol=$(policy_of "$tag")
-    [ -s "$out/chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
-        --goal-range 3 5 --episodes 200 --seed 5 --planned-goals > "$out/chain8_$tag.json"
-    [ -s "$out/turn_chain8_$tag.json" ] || $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
-        --goal-range 3 5 --turn-goals 90 180 --episodes 500 --seed 5 --planned-goals > "$out/turn_chain8_$tag.json"
+    produce "$out/chain8_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
+        --goal-range 3 5 --episodes 200 --seed 5 --planned-goals
+    produce "$out/turn_chain8_$tag.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 \
+        --goal-range 3 5 --turn-goals 90 180 --episodes 500 --seed 5 --planned-goals
 done
 for points in centre sampled; do
     for tag in "$base_tag" "$new_tag"; do
@@ -39,18 +40,9 @@ for points in centre sampled; do
             prefix=""
             [ "$points" = centre ] && prefix=centre_
             file="$out/u_chain_2_s${s}_$prefix$tag.json"
-            [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
+            produce_self "$file" $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${s}_result.json" \
                 --episodes 300 --seed 77 --policy "$pol" --goal-points "$points" --walls-only --out "$file" > /dev/null
         done
     done
 done
-{
-    for tag in "$base_tag" "$new_tag"; do
-        for points in centre_ ""; do
-            echo "**$tag, held-out U-chain 2 paths, $([ -n "$points" ] && echo centre || echo sampled) goal points** (\`$py -m specrefine.experiments.legs --failures $out/u_chain_2_s[012]_$points$tag.json\`)"
-            echo
-            $py -m specrefine.experiments.legs --failures "$out"/u_chain_2_s[012]_$points$tag.json
-            echo
-        done
-    done
-} > "$out/leg_kinds.md.tmp" && mv "$out/leg_kinds.md.tmp" "$out/leg_kinds.md"
+leg_kinds_md "$out" "$py" "$base_tag $new_tag" "centre sampled"

@@ -6,6 +6,7 @@
 # then U-chain 3 and 5 (PART=all).
 #   PART=all bash /tmp/heavy.sh bash scripts/ant_switching_checks.sh
 set -euo pipefail
+. "$(dirname "$0")/check_lib.sh"
 cd "$(dirname "$0")/.."
 out=${OUT:-data/results/ant/switching_checks}
 py=${PYTHON:-.venv/bin/python}
@@ -13,7 +14,7 @@ pol=data/policies/ant_stage5.pt
 mkdir -p "$out"
 held_out() {  # $1 goal points, $2 rule, $3 seed of the path
     local file="$out/u_chain_2_s${3}_$1_$2.json"
-    [ -s "$file" ] || $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${3}_result.json" \
+    produce_self "$file" $py -m specrefine.experiments.failures "data/results/ant/u_chain_2_s${3}_result.json" \
         --episodes 300 --seed 77 --policy "$pol" --goal-points "$1" --switching "$2" --walls-only --out "$file" \
         > /dev/null
 }
@@ -21,9 +22,8 @@ for rule in slow-turn at-region; do  # at-region's runs are also the walls runs 
     for s in 0 1 2; do held_out centre "$rule" "$s"; done
 done
 chain8() {  # $1 rule
-    local file="$out/chain8_$1.json"
-    [ -s "$file" ] || { $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 --goal-range 3 5 \
-        --episodes 200 --seed 5 --switching "$1" > "$file.tmp" && mv "$file.tmp" "$file"; }
+    produce "$out/chain8_$1.json" $py -m specrefine.sim.train --agent ant --evaluate "$pol" --chain 8 --goal-range 3 5 \
+        --episodes 200 --seed 5 --switching "$1"
 }
 chain8 slow-turn
 for s in 0 1 2; do held_out sampled slow-turn "$s"; done
