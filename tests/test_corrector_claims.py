@@ -303,3 +303,12 @@ def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_bef
     assert text.startswith(f"{cc.SPREAD} - {cc.PRECISE} +0.020 ") and "(helps)" in text
     assert "per layout and mix (ours-corrector-precise 0.960-0.960; higher on 12, lower on 0 of 12)" in text
     assert cc.variant_study(cc.PRECISE, tmp_path)["versus_corrector"]["estimate"] == pytest.approx(-0.01)
+
+
+def test_a_variant_whose_severe_part_did_not_run_says_so(tmp_path):
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, "corrector-trim", lambda maze, m, p: 0.97, calls_of=lambda m: 5, part=0)
+    vs = cc.variant_study(cc.TRIM, tmp_path)
+    severe = next(v for v in cc.variant_verdicts(vs) if "imperfect:severe: no worse" in v["rule"])
+    assert severe["verdict"] == "not run" and severe["value"] == "—"
+    assert "severe" not in cc._variant_text(vs) and "held out" not in cc._variant_text(vs)

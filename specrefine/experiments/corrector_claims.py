@@ -553,9 +553,10 @@ def variant_verdicts(vs: dict) -> list[dict]:
                         "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
     if "severe_vs_repair" in vs:
         severe = vs["severe_vs_repair"]
+        verdict = "not run" if math.isnan(severe["estimate"]) else \
+            ("no worse" if severe["verdict"] != "lower" else "worse") + ("" if severe["complete"] else " (partial)")
         out.append({"rule": f"{method}, imperfect:severe: no worse than ours-repair (paired, U-chains)",
-                    "value": _paired_text(severe), "verdict": ("no worse" if severe["verdict"] != "lower" else "worse")
-                    + ("" if severe["complete"] else " (partial)")})
+                    "value": _paired_text(severe), "verdict": verdict})
     return out
 
 
@@ -732,7 +733,7 @@ def _variant_text(vs: dict) -> str:
                      f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
                      + "".join(f", one-shot {cmp._interval_text(r)} ({r['verdict']}{_partial(r)})"
                                for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
-    if "severe_zero" in vs:
+    if "severe_zero" in vs and vs["severe_zero"][vs["method"]][1]:
         zero = vs["severe_zero"]
         parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({ref} "
                      f"{zero[ref][0]} of {zero[ref][1]}), - {ref} {_signed(vs['severe_vs_corrector'])}, - "
