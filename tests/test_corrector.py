@@ -12,7 +12,7 @@ from test_refine_search import _Arrive, _chain_graph, _Query
 from specrefine.core.graph import check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
-from specrefine.refine.correct import CHECK_SEED_OFFSET
+from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP
 
 
 class LegTable:
@@ -21,14 +21,15 @@ class LegTable:
 
     n = 32
 
-    def __init__(self, table, fresh=None):
+    def __init__(self, table, fresh=None, by_seed=None):
         self.table, self.fresh, self.calls = table, fresh or {}, []
+        self.by_seed = by_seed or {}  # seed -> a fresh table of its own (a later pass's draw)
 
     def evaluate(self, start, goal, avoid, goal_point=None, seed=None, n=None):
         x0 = 0.0 if isinstance(start, Box) else start[1][0]
         x1 = float(goal.centre()[0])
         self.calls.append((x0, x1, n, seed))
-        p = self.fresh.get((x0, x1)) if seed is not None else None
+        p = self.by_seed.get(seed, self.fresh).get((x0, x1)) if seed is not None else None
         return _Arrive(self.table.get((x0, x1), 1.0) if p is None else p, n=n or self.n, at=(x1, 0.0))
 
 
@@ -264,3 +265,32 @@ def test_ours_corrector_lean_runs_end_to_end_and_logs_its_pruning(tmp_path):
     done = next(s for s in steps if s["event"] == "correct-done")
     assert len(done["path"]) - 1 == result.data["path_edges"]
     assert result.data["method"] == "ours-corrector-lean" and result.data["refines_input"] is True
+
+
+# --- passes (SearchConfig.correct_passes): the correction again on a draw that did not choose the path -------------
+SECOND_DRAW = CHECK_SEED_OFFSET + PASS_SEED_STEP
+PASS_BOOK = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (4.5, 6.0): [5.25]}
+
+
+def test_a_second_pass_splits_a_leg_that_was_lucky_on_the_draw_that_chose_it():
+    # the first pass splits 3 -> 6 (0.75) through 4.5, whose legs never fail on its draw; on the second draw
+    # 4.5 -> 6 loses a fifth, and the second pass splits it through 5.25
+    ev = LegTable(LUCKY, FRESH, by_seed={SECOND_DRAW: {(4.5, 6.0): 0.8}})
+    g, result = run(ev, AnswerBook(PASS_BOOK), correct_rollouts=4, correct_passes=2)
+    assert xs(result) == [0.0, 3.0, 4.5, 5.25, 6.0, 10.0]
+    assert check_refines(result.graph, g) == []
+    assert {seed for *_, seed in ev.calls if seed is not None} == {CHECK_SEED_OFFSET, SECOND_DRAW}
+    legs = [s for s in result.steps if s["event"] == "correct-leg"]
+    assert [(s["correct_pass"], s["accepted"]) for s in legs] == [(1, "split"), (2, "split")]
+
+
+def test_one_pass_keeps_the_leg_its_own_draw_chose():
+    ev = LegTable(LUCKY, FRESH, by_seed={SECOND_DRAW: {(4.5, 6.0): 0.8}})
+    _, result = run(ev, AnswerBook(PASS_BOOK), correct_rollouts=4)
+    assert xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]
+    assert SECOND_DRAW not in {seed for *_, seed in ev.calls}
+
+
+def test_correct_passes_must_be_positive():
+    with pytest.raises(ValueError, match="correct_passes"):
+        SearchConfig(correct_passes=0)

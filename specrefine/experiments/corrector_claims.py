@@ -34,16 +34,17 @@ LEAN = "ours-corrector-lean"
 PRECISE = "ours-corrector-precise"
 TRIM = "ours-corrector-trim"
 SPREAD = "ours-corrector-precise (spread)"  # precise at the code with spread start states (its grid's rows, relabelled)
+RECHECK = "ours-corrector-recheck"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
-                 TRIM: "corrector-trim", SPREAD: "corrector-precise-spread"}
+                 TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
-VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE}
+VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
-VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD}
+VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK}
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -244,7 +245,7 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     rules, its cost beside the reference's, the held-out cells and, where its grid ran severe, severe against
     ours-repair."""
     grid, ref = GRIDS[VARIANT_GRIDS[method]], reference_of(method)
-    rows = (load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables + _reference_tables(method), root)
+    rows = (load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables, root) + _reference_rows(method, root)
             + named(load(grid.tables, root), method))
     if not any(r["method"] == method for r in rows):
         return None
@@ -296,19 +297,19 @@ def reference_of(method: str) -> str:
     return VARIANT_REFERENCE.get(method, METHOD)
 
 
-def _reference_tables(method: str, part: int | None = None) -> tuple:
-    """The shipped tables of the variant's reference where that is another variant (``part``: one part's only)."""
+def _reference_rows(method: str, root: Path, part: int | None = None) -> list[dict]:
+    """The rows of the variant's reference where that is another variant, under its name (``part``: one part's)."""
     ref = reference_of(method)
     if ref == METHOD:
-        return ()
+        return []
     grid = GRIDS[VARIANT_GRIDS[ref]]
-    return grid.tables if part is None else (grid.part_table(part),)
+    return named(load(grid.tables if part is None else (grid.part_table(part),), root), ref)
 
 
 def _held_out_rows(method: str, root: Path) -> list[dict]:
     grid = GRIDS[VARIANT_GRIDS[method]]
     part = next(i for i, part in enumerate(grid.parts) if set(part.proposers) == set(HELD_OUT_MIXES))
-    return (load(GRIDS["corrector-held-out"].tables + _reference_tables(method, part), root)
+    return (load(GRIDS["corrector-held-out"].tables, root) + _reference_rows(method, root, part)
             + named(load((grid.part_table(part),), root), method))
 
 
@@ -411,7 +412,7 @@ def _verdict(ok: bool, complete: bool) -> str:
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
              gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
-             trim: dict | None = None, spread: dict | None = None) -> str:
+             trim: dict | None = None, spread: dict | None = None, recheck: dict | None = None) -> str:
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -475,7 +476,7 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
-    for variant in (gated, lean, precise, trim, spread):
+    for variant in (gated, lean, precise, trim, spread, recheck):
         if variant:
             lines += variant_markdown(variant)
     return "\n".join(lines) + "\n"
@@ -631,11 +632,13 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
           gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
-          trim: dict | None = None, ant: dict | None = None, spread: dict | None = None) -> dict[str, str]:
+          trim: dict | None = None, ant: dict | None = None, spread: dict | None = None,
+          recheck: dict | None = None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
     counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
                                                       "corrector-levers", "corrector-gated", "corrector-lean",
                                                       "corrector-precise", "corrector-trim", "corrector-precise-spread",
+                                                      "corrector-recheck",
                                                       ANT_GRID)}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -667,6 +670,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["precise"] = _variant_text(precise) if precise else "not run yet"
     out["trim"] = _variant_text(trim) if trim else "not run yet"
     out["spread"] = _variant_text(spread) if spread else "not run yet"
+    out["recheck"] = _variant_text(recheck) if recheck else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]

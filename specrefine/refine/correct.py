@@ -45,6 +45,7 @@ from .common import Leg, LegEstimates, SubtaskEvaluator, estimate_legs, start_of
 from .shortcut import Shortcut, add_shortcuts, shortcuts
 
 CHECK_SEED_OFFSET = 104_729  # the correction's fresh rollouts: apart from the search's, polish's and the measurement's
+PASS_SEED_STEP = 15_485_863  # each further pass of the correction (SearchConfig.correct_passes) draws apart again
 
 
 @dataclass

@@ -31,7 +31,7 @@ import numpy as np
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
-from .correct import CHECK_SEED_OFFSET, correct, path_legs
+from .correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, correct, path_legs
 from .edge_split import SplitCandidate, edge_split
 from .polish import polish
 from .racing import Racing
@@ -70,10 +70,13 @@ class SearchConfig:
     correct_reach: float | None = None  # the correction drops a waypoint only where the leg it makes is this short
     correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
     correct_lean: bool = False  # the correction judges by posterior means and offers every waypoint its bypass
+    correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
+        if self.correct_passes < 1:
+            raise ValueError(f"correct_passes must be at least 1, got {self.correct_passes!r}")
 
     @classmethod
     def from_run(cls, run, **changes) -> SearchConfig:
@@ -377,6 +380,16 @@ class RefinementSearch:
 
     # --- beyond the paper: correcting the found path on fresh rollouts (correct.py) ------
     def _correct(self, path: list[str]) -> list[str]:
+        """The correction (correct.py), ``correct_passes`` times: each pass on its own fresh draw (new first
+        states, so a leg chosen on one pass's rollouts is judged again on rollouts that did not choose it), with a
+        budget of its own."""
+        for pass_ in range(self.cfg.correct_passes):
+            path = self._correct_pass(path, pass_)
+        assert_refines(self.graph, self.original)
+        self._estimate_again(path)
+        return path
+
+    def _correct_pass(self, path: list[str], pass_: int) -> list[str]:
         n, budget = self.evaluator.n, self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg *
                                                                          (len(path) - 1))
 
@@ -390,13 +403,13 @@ class RefinementSearch:
             return best
 
         reach = self.cfg.correct_reach or 0.0
+        log = self._log if self.cfg.correct_passes == 1 else \
+            (lambda event, **detail: self._log(event, **detail, correct_pass=pass_ + 1))
         self.graph, path, _ = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
-                                      seed=self.cfg.seed + CHECK_SEED_OFFSET, split_leg=split_leg,
-                                      may_split=lambda: self.splits_generated < budget, reach=reach,
-                                      clearance=getattr(self.evaluator, "clearance", 0.0), log=self._log,
+                                      seed=self.cfg.seed + CHECK_SEED_OFFSET + pass_ * PASS_SEED_STEP,
+                                      split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
+                                      reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
                                       min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean)
-        assert_refines(self.graph, self.original)
-        self._estimate_again(path)
         return path
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------

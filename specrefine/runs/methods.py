@@ -219,6 +219,10 @@ register_method("ours-corrector-trim", ours_variant(**CORRECTOR | dict(correct_r
                 "beyond the paper: ours-corrector-precise judging the correction by the legs' posterior means and "
                 "offering every waypoint of the corrected path its bypass (ours-corrector-lean's rule on the "
                 "512-rollout check)", colour="#3e2723")
+register_method("ours-corrector-recheck", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
+                                                                          correct_passes=2)),
+                "beyond the paper: ours-corrector-precise with its correction run again on a fresh draw, so that a "
+                "leg chosen on one draw's rollouts is judged on rollouts that did not choose it", colour="#1b5e20")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
