@@ -312,3 +312,17 @@ def test_a_variant_whose_severe_part_did_not_run_says_so(tmp_path):
     severe = next(v for v in cc.variant_verdicts(vs) if "imperfect:severe: no worse" in v["rule"])
     assert severe["verdict"] == "not run" and severe["value"] == "—"
     assert "severe" not in cc._variant_text(vs) and "held out" not in cc._variant_text(vs)
+
+
+def test_recheck_is_judged_against_precise_at_the_fixed_code(tmp_path):
+    """The reference's rows (precise-spread's grid runs ours-corrector-precise) are named as the reference is."""
+    lay(tmp_path, rates)
+    for part in (0, 1, 2):
+        lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.9, calls_of=lambda m: 8, part=part)
+        lay_grid(tmp_path, "corrector-precise-spread", lambda maze, m, p: 0.97, calls_of=lambda m: 8, part=part)
+        lay_grid(tmp_path, "corrector-recheck", lambda maze, m, p: 0.99, calls_of=lambda m: 9, part=part)
+    lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
+    vs = cc.variant_study(cc.RECHECK, tmp_path)
+    assert vs["reference"] == cc.SPREAD and vs["versus_corrector"]["estimate"] == pytest.approx(0.02)
+    assert cc._variant_text(vs).startswith(f"{cc.RECHECK} - {cc.SPREAD} +0.020 ")
+    assert "(ours-corrector-precise (spread) 0.970-0.970;" in cc._variant_text(vs)

@@ -391,6 +391,8 @@ GRIDS = {g.name: g for g in (
                            code="2cda42b"),
     corrector_variant_grid("corrector-precise-spread", "Chained estimates", "ours-corrector-precise",
                            "precise_spread", code="1d06a16"),
+    corrector_variant_grid("corrector-recheck", "A second pass on a fresh draw", "ours-corrector-recheck", "recheck",
+                           code="8a35865"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ExperimentGrid(
