@@ -411,8 +411,9 @@ def _verdict(ok: bool, complete: bool) -> str:
 
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
-             gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
-             trim: dict | None = None, spread: dict | None = None, recheck: dict | None = None) -> str:
+             **variants: dict | None) -> str:
+    """claims.md; ``variants``: the studies by their ``VARIANTS`` name (absent or None: not run)."""
+    _known(variants)
     lines = [f"{cmp.OFFLINE_NOTE}. Point mass unless named; pooled over seeds {list(POINT_SEEDS)} (Ant: "
              f"{list(ANT_SEEDS)}), 200 fresh episodes per run; rules fixed in docs/corrector.md before the grids ran.",
              "", "| rule | estimate | verdict |", "|---|---|---|"]
@@ -476,9 +477,9 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
-    for variant in (gated, lean, precise, trim, spread, recheck):
-        if variant:
-            lines += variant_markdown(variant)
+    for name in VARIANTS:
+        if variants.get(name):
+            lines += variant_markdown(variants[name])
     return "\n".join(lines) + "\n"
 
 
@@ -631,15 +632,13 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          gated: dict | None = None, lean: dict | None = None, precise: dict | None = None,
-          trim: dict | None = None, ant: dict | None = None, spread: dict | None = None,
-          recheck: dict | None = None) -> dict[str, str]:
-    """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies."""
-    counts = {name: progress(name, root) for name in ("corrector", "taxonomy", "corrector-held-out", "ant-corrector",
-                                                      "corrector-levers", "corrector-gated", "corrector-lean",
-                                                      "corrector-precise", "corrector-trim", "corrector-precise-spread",
-                                                      "corrector-recheck",
-                                                      ANT_GRID)}
+          ant: dict | None = None, **variants: dict | None) -> dict[str, str]:
+    """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
+    their ``VARIANTS`` name)."""
+    _known(variants)
+    grids = ("corrector", "taxonomy", "corrector-held-out", ANT_BEFORE, "corrector-levers",
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), ANT_GRID)
+    counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
     for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
@@ -665,12 +664,9 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
                              for e in ratios)
     out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
     out["levers"] = _levers_text(levers) if levers else "not run yet"
-    out["gated"] = _gated_text(gated) if gated else "not run yet"
-    out["lean"] = _variant_text(lean) if lean else "not run yet"
-    out["precise"] = _variant_text(precise) if precise else "not run yet"
-    out["trim"] = _variant_text(trim) if trim else "not run yet"
-    out["spread"] = _variant_text(spread) if spread else "not run yet"
-    out["recheck"] = _variant_text(recheck) if recheck else "not run yet"
+    for name in VARIANTS:
+        study = variants.get(name)
+        out[name] = ((_gated_text if name == "gated" else _variant_text)(study)) if study else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
@@ -681,6 +677,12 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
     return out
+
+
+def _known(variants: dict) -> None:
+    unknown = set(variants) - set(VARIANTS)
+    if unknown:
+        raise TypeError(f"not a variant: {', '.join(sorted(unknown))} (VARIANTS: {', '.join(VARIANTS)})")
 
 
 def _ant_text(ant: dict) -> str:
