@@ -231,6 +231,15 @@ def corrector_variant_grid(name: str, section: str, method: str, stem: str, code
                     out="severe")),
         seeds=(0, 1, 2, 3), workers=1, code=code, table=f"{table}.csv", out=f"runs/corrector_{stem}")
 
+def ant_corrector_grid(name: str, source: str, stem: str, code: str) -> ExperimentGrid:
+    """ours-corrector on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
+    adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv."""
+    part = Part(("ours-corrector",), ("imperfect:moderate",), split="seeds")
+    return ExperimentGrid(name, source, "ant", parts=(part,), seeds=(0, 1, 2), mazes=SCALING_MAZES,
+                          policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code=code,
+                          table=f"data/results/corrector/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
+
+
 GRIDS = {g.name: g for g in (
     ExperimentGrid(
         "paper-sweep", "data/results/README.md, the point sweep (the paper's Figures 4-6)", "point",
@@ -395,17 +404,11 @@ GRIDS = {g.name: g for g in (
                            code="8a35865"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
-    ExperimentGrid(
-        "ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first cell ran)", "ant",
-        parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
-        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
-        workers=1, code="5356175", table="data/results/corrector/ant.csv", out="runs/ant_corrector"),
-    ExperimentGrid(
-        "ant-corrector-spread", "docs/corrector.md, 'Chained estimates' (issue 39; fixed 2026-11-27 before its first "
-        "cell ran): ant-corrector's cells at the code with spread start states", "ant",
-        parts=(Part(("ours-corrector",), ("imperfect:moderate",), split="seeds"),), seeds=(0, 1, 2),
-        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
-        workers=1, code="1d06a16", table="data/results/corrector/ant_spread.csv", out="runs/ant_corrector_spread"),
+    ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
+                       "cell ran)", "ant", code="5356175"),
+    ant_corrector_grid("ant-corrector-spread", "docs/corrector.md, 'Chained estimates' (issue 39; fixed 2026-11-27 "
+                       "before its first cell ran): ant-corrector's cells at the code with spread start states",
+                       "ant_spread", code="1d06a16"),
     ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
