@@ -236,7 +236,8 @@ def ant_corrector_grid(name: str, source: str, stem: str, code: str) -> Experime
     adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv."""
     part = Part(("ours-corrector",), ("imperfect:moderate",), split="seeds")
     return ExperimentGrid(name, source, "ant", parts=(part,), seeds=(0, 1, 2), mazes=SCALING_MAZES,
-                          policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code=code,
+                          policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
+                          workers=1, code=code,
                           table=f"data/results/corrector/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
 
 
