@@ -294,3 +294,55 @@ def test_one_pass_keeps_the_leg_its_own_draw_chose():
 def test_correct_passes_must_be_positive():
     with pytest.raises(ValueError, match="correct_passes"):
         SearchConfig(correct_passes=0)
+
+
+# --- cheapest first (SearchConfig.correct_first_win) and one round (correct_rounds): method ours-corrector-frugal ---
+SPLIT_BOOK = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (3.0, 10.0): [5, 7.5]}
+
+
+def test_a_winning_bypass_asks_the_proposer_nothing():
+    for first_win, asked in ((False, True), (True, False)):
+        book = AnswerBook(SPLIT_BOOK)
+        _, result = run(LegTable(LUCKY, THREE_FAILURES), book, correct_rollouts=4, correct_min_failures=3,
+                        correct_reach=10.0, correct_first_win=first_win)
+        assert ((3.0, 6.0) in book.queries) is asked
+        assert xs(result) == [0.0, 6.0, 10.0]  # the bypass over 3 wins either way
+        leg = next(s for s in result.steps if s["event"] == "correct-leg")
+        assert leg["accepted"] == "bypass"
+
+
+def test_a_winning_split_is_taken_without_asking_over_the_next_waypoint():
+    for first_win, asked in ((False, True), (True, False)):
+        book = AnswerBook(SPLIT_BOOK)
+        _, result = run(LegTable(LUCKY, FRESH), book, correct_rollouts=4, correct_first_win=first_win)
+        assert ((3.0, 10.0) in book.queries) is asked
+        assert xs(result) == [0.0, 3.0, 4.5, 6.0, 10.0]
+        leg = next(s for s in result.steps if s["event"] == "correct-leg")
+        assert leg["accepted"] == "split" and [t["kind"] for t in leg["tried"]][0] == "split"
+
+
+def test_cheapest_first_still_asks_over_the_waypoint_when_the_split_does_not_win():
+    fresh = {(3.0, 6.0): 0.8, (6.0, 10.0): 0.8, (3.0, 10.0): 0.0, (4.5, 6.0): 0.8}
+    book = AnswerBook(SPLIT_BOOK)
+    g, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_reach=0.0, correct_first_win=True)
+    assert xs(result) == [0.0, 3.0, 5.0, 7.5, 10.0]
+    assert check_refines(result.graph, g) == []
+    leg = next(s for s in result.steps if s["event"] == "correct-leg")
+    assert [t["kind"] for t in leg["tried"]] == ["split", "resplit"] and leg["accepted"] == "resplit"
+
+
+def test_one_round_asks_the_proposer_once_per_correction_split():
+    # the split 3 -> 4.5 -> 6 loses on the search's own rollouts, so Algorithm 1 would ask a second round
+    table = {**LUCKY, (3.0, 4.5): 0.9}
+    for rounds, asked in ((None, 2), (1, 1)):
+        book = AnswerBook({(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5]})
+        config = SearchConfig(w=1, d=2, vertex_refinement=False, correct_rollouts=4, correct_rounds=rounds)
+        RefinementSearch(_chain_graph(), LegTable(table, FRESH), proposer=book, config=config,
+                         query_for=lambda graph, u, v, r: _Query(graph, u, v)).run()
+        assert book.queries.count((3.0, 6.0)) == asked
+        assert book.queries.count((0.0, 10.0)) == 1  # the search's own split never failed: no second round
+
+
+def test_correct_rounds_must_be_positive():
+    with pytest.raises(ValueError, match="correct_rounds"):
+        SearchConfig(correct_rounds=0)

@@ -26,7 +26,7 @@ def test_the_built_in_methods_are_registered_with_what_they_are():
     """The built-ins are there (a plugin may add more: the registry is not exactly them)."""
     asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
               "ours-repair", "ours-repair-tuned", "ours-corrector", "ours-corrector-gated", "ours-corrector-lean",
-              "ours-corrector-precise", "ours-corrector-trim", "ours-corrector-recheck",
+              "ours-corrector-precise", "ours-corrector-trim", "ours-corrector-recheck", "ours-corrector-frugal",
               "ours-deeprepair",
               "ours-feasible", "ours-checked",
               "ours-polish", "ours-shortcut", "vlm-oneshot",

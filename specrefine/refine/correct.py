@@ -24,6 +24,10 @@ two, where the straight leg is clear and in reach), judged the same way: the cor
 close waypoints leave paths longer than they need be (27.9 legs against the oracle's 18.8 on U-chain 4-5,
 docs/corrector.md), and each switch loses some episodes that 128 rollouts do not show.
 
+``first_win`` (method ``ours-corrector-frugal``): the alternatives to a leg are asked for cheapest first, the bypass
+(no proposer call), then the split, then the split over the next waypoint, and the first that wins is taken; a later
+one is asked for only when none before it won. Without it every alternative is asked for and the best is taken.
+
 ``min_failures`` > 1 (method ``ours-corrector-gated``) asks the proposer about a leg only when at least that many of
 its fresh rollouts failed: a leg losing a fraction of a per cent shows one failure in 128 about as often as a sound
 one, and splitting it spends proposer calls on noise (docs/corrector.md, 'Where the corrector still loses'). Such a
@@ -124,47 +128,64 @@ def spliced(graph: TaskGraph, path: list[str], i: int, j: int, waypoints) -> tup
 
 def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
-            log: Callable[..., None], min_failures: int = 1, lean: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            log: Callable[..., None], min_failures: int = 1, lean: bool = False,
+            first_win: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
     An alternative is judged on the legs it changes and the leg after them (the window), from the same fresh start
     states as the current path's legs there; it replaces the path when it gains at least one rollout's worth
     (1 / rollouts) over the window (``lean``: when its posterior score there is higher), and the path's legs from
-    the window on are then checked again. ``lean`` then offers every inner waypoint its bypass (module doc)."""
+    the window on are then checked again. ``lean`` then offers every inner waypoint its bypass (module doc).
+    ``first_win``: the alternatives are asked for and judged cheapest first (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean)
     log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
     tried: set = set()
     while (leg := weakest_untried(state.check, tried)) is not None:
         tried.add(_leg_key(state.check, leg))
-        graph, path, check = state.graph, state.path, state.check
-        options = [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
-        spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
-        if failures(check.results[leg]) < min_failures:
-            spans = []
-        for i, j in spans:
-            if not may_split():
+        groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures)
+        if not first_win:
+            groups = iter([[option for group in groups for option in group]])
+        check, path, seen, accepted = state.check, state.path, [], None
+        for group in groups:
+            judged, accepted = state.judge(leg, group)
+            seen += judged.tried
+            if accepted is not None:
                 break
-            leg_start = graph.region(path[0]) if i == 0 else start_of(check.results[i - 1])
-            if leg_start is None:  # no fresh rollout reaches the leg: nothing to start its split from
-                break
-            if j == i + 1:
-                result = check.results[i]
-            else:  # the span over a waypoint: how its straight edge does, for the proposer's picture
-                goal = path_legs(graph, path[j - 1:j + 1])[0]
-                result = evaluator.evaluate(leg_start, goal.goal, goal.avoid, goal_point=goal.goal_point, seed=seed,
-                                            n=rollouts)
-            fix = split_leg(*_with_edge(graph, path, i, j), path[i], path[j], result, leg_start)
-            if fix is not None and fix.waypoints:
-                options.append(("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints)))
-        judged, accepted = state.judge(leg, options)
         log("correct-leg", leg=leg, edge=path[leg:leg + 2], p_leg=check.probabilities[leg], p_window=judged.current,
-            tried=judged.tried, accepted=accepted)
+            tried=seen, accepted=accepted)
     if lean:
         _prune(state, reach, clearance, log)
     log("correct-done", path=state.path, p=state.check.p, probabilities=state.check.probabilities)
     return state.graph, state.path, state.check
+
+
+def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
+                  may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int):
+    """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses (no
+    proposer call), then its split, then its split over the next waypoint (one Algorithm 1 each). Lazy: a split is
+    asked for only when its group is reached."""
+    graph, path, check = state.graph, state.path, state.check
+    yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
+    if failures(check.results[leg]) < min_failures:
+        return
+    spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
+    for i, j in spans:
+        if not may_split():
+            return
+        leg_start = graph.region(path[0]) if i == 0 else start_of(check.results[i - 1])
+        if leg_start is None:  # no fresh rollout reaches the leg: nothing to start its split from
+            return
+        if j == i + 1:
+            result = check.results[i]
+        else:  # the span over a waypoint: how its straight edge does, for the proposer's picture
+            goal = path_legs(graph, path[j - 1:j + 1])[0]
+            result = evaluator.evaluate(leg_start, goal.goal, goal.avoid, goal_point=goal.goal_point,
+                                        seed=state.seed, n=state.rollouts)
+        fix = split_leg(*_with_edge(graph, path, i, j), path[i], path[j], result, leg_start)
+        if fix is not None and fix.waypoints:
+            yield [("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints))]
 
 
 @dataclass

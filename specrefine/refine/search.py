@@ -21,6 +21,7 @@ raises InvalidRefinement, because it is a bug.  Every step is recorded for repla
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from collections.abc import Callable
@@ -71,12 +72,16 @@ class SearchConfig:
     correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
     correct_lean: bool = False  # the correction judges by posterior means and offers every waypoint its bypass
     correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
+    correct_first_win: bool = False  # the correction asks for a leg's alternatives cheapest first, stops at a win
+    correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
         if self.correct_passes < 1:
             raise ValueError(f"correct_passes must be at least 1, got {self.correct_passes!r}")
+        if self.correct_rounds is not None and self.correct_rounds < 1:
+            raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
     @classmethod
     def from_run(cls, run, **changes) -> SearchConfig:
@@ -286,11 +291,12 @@ class RefinementSearch:
         cost = f.cost[u] + sum(self._weight(p) for p in best.probabilities)
         return Refinement("split", u, v, cost, best)
 
-    def _split_leg(self, chain_graph, a, b, result, start):
-        """Algorithm 1 on a -> b of ``chain_graph`` (a leg of a candidate or of the found path), from ``start``."""
+    def _split_leg(self, chain_graph, a, b, result, start, d: int | None = None):
+        """Algorithm 1 on a -> b of ``chain_graph`` (a leg of a candidate or of the found path), from ``start``, in
+        ``d`` proposer rounds (None: the configuration's)."""
         self.splits_generated += 1
         return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
-                          goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=self.cfg.d, k=self.cfg.k,
+                          goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
                           rng=self.rng, picture=self.picture, racing=self.racing,
                           feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
 
@@ -393,12 +399,14 @@ class RefinementSearch:
         n, budget = self.evaluator.n, self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg *
                                                                          (len(path) - 1))
 
+        split_once = functools.partial(self._split_leg, d=self.cfg.correct_rounds)
+
         def split_leg(graph, a, b, result, start):
-            outcome = self._split_leg(graph, a, b, result, start)
+            outcome = split_once(graph, a, b, result, start)
             best = outcome.best
             if best is not None and best.p == 0.0 and self.cfg.repair:
                 best = repair(cheapest(outcome.candidates, n), graph, a, b, start=start, evaluator=self.evaluator,
-                              split_leg=self._split_leg, may_split=lambda: self.splits_generated < budget,
+                              split_leg=split_once, may_split=lambda: self.splits_generated < budget,
                               depth=self.cfg.repair_depth) or best
             return best
 
@@ -409,7 +417,8 @@ class RefinementSearch:
                                       seed=self.cfg.seed + CHECK_SEED_OFFSET + pass_ * PASS_SEED_STEP,
                                       split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
-                                      min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean)
+                                      min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
+                                      first_win=self.cfg.correct_first_win)
         return path
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------

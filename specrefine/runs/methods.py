@@ -223,6 +223,12 @@ register_method("ours-corrector-recheck", ours_variant(**CORRECTOR | dict(correc
                                                                           correct_passes=2)),
                 "beyond the paper: ours-corrector-precise with its correction run again on a fresh draw, so that a "
                 "leg chosen on one draw's rollouts is judged on rollouts that did not choose it", colour="#1b5e20")
+register_method("ours-corrector-frugal", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
+                                                                        correct_first_win=True, correct_rounds=1)),
+                "beyond the paper: ours-corrector-precise asking the proposer less in its correction: a weak leg's "
+                "alternatives cheapest first (bypass, split, split over the next waypoint), stopping at the first "
+                "that wins, and each of its splits in one proposer round (the leg's failure picture already in it)",
+                colour="#006064")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
