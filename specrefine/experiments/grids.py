@@ -403,6 +403,8 @@ GRIDS = {g.name: g for g in (
                            "precise_spread", code="1d06a16"),
     corrector_variant_grid("corrector-recheck", "A second pass on a fresh draw", "ours-corrector-recheck", "recheck",
                            code="8a35865"),
+    corrector_variant_grid("corrector-frugal", "Fewer proposer calls in the correction", "ours-corrector-frugal",
+                           "frugal", code="bf8f0cc"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
