@@ -413,6 +413,12 @@ GRIDS = {g.name: g for g in (
                        "before its first cell ran): ant-corrector's cells at the code with spread start states",
                        "ant_spread", code="1d06a16"),
     ExperimentGrid(
+        "ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed 2026-11-27 "
+        "13:45 UTC before its first cell ran)", "ant", parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds"),),
+        seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", workers=1, code="e08c8b9", table="data/results/ant/oracle_spread.csv",
+        out="runs/ant_oracle_spread"),
+    ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
         parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2), mazes=("u_chain_3", "u_chain_5"),
