@@ -326,3 +326,21 @@ def test_recheck_is_judged_against_precise_at_the_fixed_code(tmp_path):
     assert vs["reference"] == cc.SPREAD and vs["versus_corrector"]["estimate"] == pytest.approx(0.02)
     assert cc._variant_text(vs).startswith(f"{cc.RECHECK} - {cc.SPREAD} +0.020 ")
     assert "(ours-corrector-precise (spread) 0.970-0.970;" in cc._variant_text(vs)
+
+
+def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_mazes(tmp_path):
+    """Its U-chains from its own grid, the other 8 suite mazes from its suite grid, ours from the taxonomy grid."""
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, "corrector-precise-spread", lambda maze, m, p: 0.97)
+    below = OTHER_POINT_MAZES[0]
+    lay_grid(tmp_path, "corrector-precise-suite", lambda maze, m, p: 0.3 if maze == below else 0.9)
+    vs = cc.variant_study(cc.SPREAD, tmp_path)
+    mild = [e for e in vs["versus_ours"] if e["proposer"] == "imperfect:mild"]
+    assert [e["maze"] for e in mild] == list(SCALING_MAZES + OTHER_POINT_MAZES)
+    assert all(e["method"] == cc.SPREAD and e["runs"] == 4 for e in mild)
+    rule = next(v for v in cc.variant_verdicts(vs) if v["rule"].endswith("imperfect:mild: not below ours on any suite "
+                                                                         "maze (Newcombe)"))
+    assert rule["value"] == f"below on 1 of 17 ({below})" and rule["verdict"] == "does not hold"
+    assert "Every suite maze: ours-corrector-precise (spread) - ours" in "\n".join(cc.variant_markdown(vs))
+    lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.97)
+    assert "versus_ours" not in cc.variant_study(cc.PRECISE, tmp_path)  # no suite grid: no such rule

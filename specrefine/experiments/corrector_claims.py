@@ -43,6 +43,8 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  FRUGAL: "corrector-frugal"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD}
+#: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
+VARIANT_SUITE = {SPREAD: "corrector-precise-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
@@ -271,6 +273,11 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                and cmp.is_done(r)}  # the reference's cost on the cells the variant ran
         study["corrector_costs"].append(costs([r for r in rows if (r["maze"], r["seed"]) in ran], proposer,
                                               SCALING_MAZES, POINT_SEEDS, first=ref))
+    if method in VARIANT_SUITE:
+        suite = rows + named(load(GRIDS[VARIANT_SUITE[method]].tables, root), method)
+        study["versus_ours"] = [e for p in presets for e in per_maze(suite, p, SCALING_MAZES + OTHER_POINT_MAZES,
+                                                                     POINT_SEEDS, reference=("ours", "*"),
+                                                                     method=method)]
     study["held_out"] = variant_held_out(method, root)
     study["held_out_costs"] = variant_held_out_costs(method, root)
     if "imperfect:severe" in grid.proposers:
@@ -551,6 +558,13 @@ def variant_verdicts(vs: dict) -> list[dict]:
         zero = next(z for z in vs["zero"] if z["proposer"] == proposer)["runs"]
         out.append({"rule": f"{method}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
                     "verdict": _verdict(zero[0] == 0, complete)})
+        versus = [e for e in vs.get("versus_ours", []) if e["proposer"] == proposer]
+        if versus:
+            below = [e["maze"] for e in versus if "ci_high" in e and e["ci_high"] < 0]
+            out.append({"rule": f"{method}, {proposer}: not below ours on any suite maze (Newcombe)",
+                        "value": f"below on {len(below)} of {len(versus)}" + (f" ({', '.join(below)})" if below
+                                                                              else ""),
+                        "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in versus))})
         ratio = next((e for e in vs.get("ratio", []) if e["proposer"] == proposer), None)
         if ratio is not None:
             out.append({"rule": f"{method}, {proposer}: >= 2x the one-shot on multi-room (point)",
@@ -582,6 +596,12 @@ def variant_markdown(vs: dict) -> list[str]:
               f"| proposer | maze | runs | {short} | oracle | difference |", "|---|---|---|---|---|---|"]
     lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
               f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["per_maze"] + vs.get("severe", [])]
+    if vs.get("versus_ours"):
+        lines += ["", f"Every suite maze: {method} - ours, pooled over seeds (Newcombe 95 %; ours at its own grids' "
+                  "code, before the spread start states).", "",
+                  f"| proposer | maze | runs (ours) | {short} | ours | difference |", "|---|---|---|---|---|---|"]
+        lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} ({e['reference_runs']}) | {_num(e['success'])} | "
+                  f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["versus_ours"]]
     if "severe_vs_corrector" in vs:
         lines += ["", f"Severe (described): {method} - {ref} {_paired_text(vs['severe_vs_corrector'])}; - "
                   f"ours-repair {_paired_text(vs['severe_vs_repair'])} (paired, U-chains, 95 % bootstrap)."]
@@ -640,7 +660,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     their ``VARIANTS`` name)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_BEFORE, "corrector-levers",
-             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), ANT_GRID)
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), ANT_GRID)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}

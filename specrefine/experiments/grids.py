@@ -231,6 +231,16 @@ def corrector_variant_grid(name: str, section: str, method: str, stem: str, code
                     out="severe")),
         seeds=(0, 1, 2, 3), workers=1, code=code, table=f"{table}.csv", out=f"runs/corrector_{stem}")
 
+def corrector_suite_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
+    """A variant of the corrector (issue 39) on the rest of the point suite (the mazes beside the U-chains) at mild
+    and moderate, seeds 0-3, into data/results/corrector/STEM_suite.csv: with its U-chains, all 17 suite mazes."""
+    return ExperimentGrid(
+        name, f"docs/corrector.md, '{section}' (issue 39; fixed 2026-11-27 before it ran)", "point",
+        parts=(Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),),
+        seeds=(0, 1, 2, 3), workers=1, code=code, table=f"data/results/corrector/{stem}_suite.csv",
+        out=f"runs/corrector_{stem}_suite")
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str) -> ExperimentGrid:
     """ours-corrector on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
     adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv."""
@@ -401,6 +411,8 @@ GRIDS = {g.name: g for g in (
                            code="2cda42b"),
     corrector_variant_grid("corrector-precise-spread", "Chained estimates", "ours-corrector-precise",
                            "precise_spread", code="1d06a16"),
+    corrector_suite_grid("corrector-precise-suite", "The whole suite", "ours-corrector-precise", "precise_spread",
+                         code="1d06a16"),
     corrector_variant_grid("corrector-recheck", "A second pass on a fresh draw", "ours-corrector-recheck", "recheck",
                            code="8a35865"),
     corrector_variant_grid("corrector-frugal", "Fewer proposer calls in the correction", "ours-corrector-frugal",
