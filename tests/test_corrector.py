@@ -346,3 +346,39 @@ def test_one_round_asks_the_proposer_once_per_correction_split():
 def test_correct_rounds_must_be_positive():
     with pytest.raises(ValueError, match="correct_rounds"):
         SearchConfig(correct_rounds=0)
+
+
+# --- asked again after an empty reply (SearchConfig.empty_retries): method ours-corrector-retry -------------------
+class LateBook(AnswerBook):
+    """The AnswerBook, but its first ``empty`` replies (proposer calls) give no valid candidate."""
+
+    def __init__(self, book, empty):
+        super().__init__(book)
+        self.empty = empty
+
+    def propose_split(self, query, w, feedback=()):
+        answer = super().propose_split(query, w, feedback)
+        if len(self.queries) <= self.empty:
+            return []
+        return answer
+
+
+def test_an_empty_reply_is_asked_again_and_its_split_taken():
+    # d = 1: each Algorithm 1 call is one proposer call; the first two replies are empty
+    for retries, found in ((0, [0.0, 10.0]), (1, [0.0, 10.0]), (2, [0.0, 3.0, 6.0, 10.0])):
+        book = LateBook({(0.0, 10.0): [3, 6]}, empty=2)
+        _, result = run(LegTable(LUCKY), book, empty_retries=retries)
+        assert xs(result) == found and len(book.queries) == 1 + min(retries, 2)
+        asked = [s.get("asked_again", 0) for s in result.steps if s["event"] == "split-generated"]
+        assert asked == list(range(1 + min(retries, 2)))
+
+
+def test_asking_again_stays_within_the_budget():
+    book = LateBook({(0.0, 10.0): [3, 6]}, empty=5)
+    _, result = run(LegTable(LUCKY), book, empty_retries=4, max_edge_splits=2)
+    assert len(book.queries) == 2 and xs(result) == [0.0, 10.0]
+
+
+def test_empty_retries_must_not_be_negative():
+    with pytest.raises(ValueError, match="empty_retries"):
+        SearchConfig(empty_retries=-1)

@@ -217,19 +217,20 @@ def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGri
 
 
 
-def corrector_variant_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
+def corrector_variant_grid(name: str, section: str, method: str, stem: str, code: str,
+                           severe_first: bool = False) -> ExperimentGrid:
     """A variant of the corrector (issue 39) on the point mass: the U-chains at mild and moderate, seeds 0-3, seed by
     seed, into data/results/corrector/STEM.csv; then the held-out layouts and mixes (seeds 0-1) into
-    STEM_held_out.csv; then severe on the U-chains into STEM_severe.csv."""
+    STEM_held_out.csv; then severe on the U-chains into STEM_severe.csv (``severe_first``: that part first)."""
     table = f"data/results/corrector/{stem}"
+    severe = Part((method,), ("imperfect:severe",), mazes=SCALING_MAZES, table=f"{table}_severe.csv", out="severe")
+    parts = (Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES, split="seeds"),
+             Part((method,), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES, table=f"{table}_held_out.csv",
+                  out="held_out"))
     return ExperimentGrid(
         name, f"docs/corrector.md, '{section}' (issue 39; fixed 2026-11-27 before it ran)", "point",
-        parts=(Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES, split="seeds"),
-               Part((method,), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES, table=f"{table}_held_out.csv",
-                    out="held_out"),
-               Part((method,), ("imperfect:severe",), mazes=SCALING_MAZES, table=f"{table}_severe.csv",
-                    out="severe")),
-        seeds=(0, 1, 2, 3), workers=1, code=code, table=f"{table}.csv", out=f"runs/corrector_{stem}")
+        parts=(severe, *parts) if severe_first else (*parts, severe), seeds=(0, 1, 2, 3), workers=1, code=code,
+        table=f"{table}.csv", out=f"runs/corrector_{stem}")
 
 def corrector_suite_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
     """A variant of the corrector (issue 39) on the rest of the point suite (the mazes beside the U-chains) at mild

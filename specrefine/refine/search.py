@@ -74,12 +74,16 @@ class SearchConfig:
     correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
     correct_first_win: bool = False  # the correction asks for a leg's alternatives cheapest first, stops at a win
     correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
+    empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
+    #                         this many times at most, within the budget (method ours-corrector-retry)
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
         if self.correct_passes < 1:
             raise ValueError(f"correct_passes must be at least 1, got {self.correct_passes!r}")
+        if self.empty_retries < 0:
+            raise ValueError(f"empty_retries must be at least 0, got {self.empty_retries!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
@@ -273,16 +277,13 @@ class RefinementSearch:
         return self.memo[sig]
 
     def _gen_split(self, u, v) -> Refinement | None:
-        self.splits_generated += 1
-        f, g = self.f, self.graph
-        query = self.query_for(g, u, v, self.results[(u, v)])
-        outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
-                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
-                             racing=self.racing, feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
-        budget = [self.splits_generated, self.cfg.max_edge_splits]  # Algorithm 1 calls so far, of the budget
-        self._log("split-generated", edge=[u, v], splits=budget, candidates=[
-            {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
-             "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
+        f = self.f
+        for attempt in range(1 + self.cfg.empty_retries):
+            if attempt and self.splits_generated >= self.cfg.max_edge_splits:
+                break
+            outcome = self._ask_split(u, v, attempt)
+            if outcome.candidates:
+                break
         best = outcome.best
         if best is None:
             return None
@@ -290,6 +291,22 @@ class RefinementSearch:
             best = self._repair(u, v, cheapest(outcome.candidates, self.evaluator.n)) or best
         cost = f.cost[u] + sum(self._weight(p) for p in best.probabilities)
         return Refinement("split", u, v, cost, best)
+
+    def _ask_split(self, u, v, attempt: int):
+        """One Algorithm 1 call on the search's edge u -> v (``attempt`` > 0: asked again after a reply that gave
+        no valid candidate), logged."""
+        self.splits_generated += 1
+        f, g = self.f, self.graph
+        query = self.query_for(g, u, v, self.results[(u, v)])
+        outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
+                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
+                             racing=self.racing, feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
+        budget = [self.splits_generated, self.cfg.max_edge_splits]  # Algorithm 1 calls so far, of the budget
+        retry = {"asked_again": attempt} if attempt else {}
+        self._log("split-generated", edge=[u, v], splits=budget, **retry, candidates=[
+            {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
+             "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
+        return outcome
 
     def _split_leg(self, chain_graph, a, b, result, start, d: int | None = None):
         """Algorithm 1 on a -> b of ``chain_graph`` (a leg of a candidate or of the found path), from ``start``, in

@@ -229,6 +229,11 @@ register_method("ours-corrector-frugal", ours_variant(**CORRECTOR | dict(correct
                 "alternatives cheapest first (bypass, split, split over the next waypoint), stopping at the first "
                 "that wins, and each of its splits in one proposer round (the leg's failure picture already in it)",
                 colour="#006064")
+register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
+                                                                       empty_retries=2)),
+                "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
+                "to an edge split of the search gave no valid candidate (within the budget of 30)",
+                colour="#33691e")
 register_method("ours-deeprepair", ours_variant(repair=True, repair_depth=3),
                 "lever of ours-corrector alone: ours-repair repairing a leg's split with a dead leg of its own, to "
                 "three levels", colour="#8e24aa")
