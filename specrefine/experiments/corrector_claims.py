@@ -36,20 +36,21 @@ TRIM = "ours-corrector-trim"
 SPREAD = "ours-corrector-precise (spread)"  # precise at the code with spread start states (its grid's rows, relabelled)
 RECHECK = "ours-corrector-recheck"
 FRUGAL = "ours-corrector-frugal"
+RETRY = "ours-corrector-retry"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
-                 FRUGAL: "corrector-frugal"}
+                 FRUGAL: "corrector-frugal", RETRY: "corrector-retry"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
-VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD}
+VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL}
+            "frugal": FRUGAL, "retry": RETRY}
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85

@@ -416,6 +416,8 @@ GRIDS = {g.name: g for g in (
                          code="1d06a16"),
     corrector_variant_grid("corrector-recheck", "A second pass on a fresh draw", "ours-corrector-recheck", "recheck",
                            code="8a35865"),
+    corrector_variant_grid("corrector-retry", "Asked again after an empty reply", "ours-corrector-retry", "retry",
+                           code="c16285c", severe_first=True),
     corrector_variant_grid("corrector-frugal", "Fewer proposer calls in the correction", "ours-corrector-frugal",
                            "frugal", code="bf8f0cc"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
