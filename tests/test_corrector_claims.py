@@ -344,3 +344,5 @@ def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_maze
     assert "Every suite maze: ours-corrector-precise (spread) - ours" in "\n".join(cc.variant_markdown(vs))
     lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.97)
     assert "versus_ours" not in cc.variant_study(cc.PRECISE, tmp_path)  # no suite grid: no such rule
+    assert f"every suite maze: below ours on 1 of 17 at mild ({below}), 1 of 17 at moderate ({below})" in \
+        cc._variant_text(vs)

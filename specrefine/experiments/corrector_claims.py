@@ -768,6 +768,12 @@ def _variant_text(vs: dict) -> str:
         parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({ref} "
                      f"{zero[ref][0]} of {zero[ref][1]}), - {ref} {_signed(vs['severe_vs_corrector'])}, - "
                      f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
+    if vs.get("versus_ours"):
+        below = {level: [e["maze"] for e in vs["versus_ours"] if e["proposer"] == f"imperfect:{level}"
+                         and "ci_high" in e and e["ci_high"] < 0] for level in ("mild", "moderate")}
+        mazes = len(SCALING_MAZES + OTHER_POINT_MAZES)
+        parts.append("every suite maze: below ours on " + ", ".join(
+            f"{len(m)} of {mazes} at {level}" + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))
     held = [e for e in vs["held_out"] if e["runs"]]
     if held:
         parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
