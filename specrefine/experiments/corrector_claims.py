@@ -45,7 +45,7 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
-VARIANT_SUITE = {SPREAD: "corrector-precise-suite"}
+VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them

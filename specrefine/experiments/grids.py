@@ -414,6 +414,8 @@ GRIDS = {g.name: g for g in (
                            "precise_spread", code="1d06a16"),
     corrector_suite_grid("corrector-precise-suite", "The whole suite", "ours-corrector-precise", "precise_spread",
                          code="1d06a16"),
+    corrector_suite_grid("corrector-recheck-suite", "The whole suite", "ours-corrector-recheck", "recheck",
+                         code="8a35865"),
     corrector_variant_grid("corrector-recheck", "A second pass on a fresh draw", "ours-corrector-recheck", "recheck",
                            code="8a35865"),
     corrector_variant_grid("corrector-retry", "Asked again after an empty reply", "ours-corrector-retry", "retry",
