@@ -369,11 +369,7 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
         zero = next(z for z in point["zero"] if z["proposer"] == proposer)[METHOD]
         out.append({"rule": f"{proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
                     "verdict": _verdict(zero[0] == 0, complete)})
-        versus = [e for e in point["versus_ours"] if e["proposer"] == proposer]
-        below = [e["maze"] for e in versus if "ci_high" in e and e["ci_high"] < 0]
-        out.append({"rule": f"{proposer}: not below ours on any suite maze (Newcombe)",
-                    "value": f"below on {len(below)} of {len(versus)}" + (f" ({', '.join(below)})" if below else ""),
-                    "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in versus))})
+        out.append(_suite_rule(point["versus_ours"], proposer, f"{proposer}"))
         ratio = next(e for e in point["ratio"] if e["proposer"] == proposer and e["method"].startswith(METHOD))
         out.append({"rule": f"{proposer}: {METHOD} >= 2x the one-shot on multi-room (point)",
                     "value": cmp._interval_text(ratio), "verdict": ratio["verdict"]
@@ -537,6 +533,19 @@ def versus_corrector(vs: dict) -> tuple[str, str]:
             word + ("" if v["complete"] else " (partial)"))
 
 
+def _below_ours(versus: list[dict], proposer: str) -> list[str]:
+    """The suite mazes where the method's Newcombe interval against ours lies below 0, at ``proposer``."""
+    return [e["maze"] for e in versus if e["proposer"] == proposer and "ci_high" in e and e["ci_high"] < 0]
+
+
+def _suite_rule(versus: list[dict], proposer: str, name: str) -> dict:
+    """The issue's rule 'not below ours on any suite maze' at ``proposer``, its row named ``name``."""
+    mine, below = [e for e in versus if e["proposer"] == proposer], _below_ours(versus, proposer)
+    return {"rule": f"{name}: not below ours on any suite maze (Newcombe)",
+            "value": f"below on {len(below)} of {len(mine)}" + (f" ({', '.join(below)})" if below else ""),
+            "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in mine))}
+
+
 def variant_verdicts(vs: dict) -> list[dict]:
     """The rules of the variant's section of docs/corrector.md."""
     method, out = vs["method"], []
@@ -559,13 +568,8 @@ def variant_verdicts(vs: dict) -> list[dict]:
         zero = next(z for z in vs["zero"] if z["proposer"] == proposer)["runs"]
         out.append({"rule": f"{method}, {proposer}: no run at 0", "value": f"{zero[0]} of {zero[1]} runs at 0",
                     "verdict": _verdict(zero[0] == 0, complete)})
-        versus = [e for e in vs.get("versus_ours", []) if e["proposer"] == proposer]
-        if versus:
-            below = [e["maze"] for e in versus if "ci_high" in e and e["ci_high"] < 0]
-            out.append({"rule": f"{method}, {proposer}: not below ours on any suite maze (Newcombe)",
-                        "value": f"below on {len(below)} of {len(versus)}" + (f" ({', '.join(below)})" if below
-                                                                              else ""),
-                        "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in versus))})
+        if vs.get("versus_ours"):
+            out.append(_suite_rule(vs["versus_ours"], proposer, f"{method}, {proposer}"))
         ratio = next((e for e in vs.get("ratio", []) if e["proposer"] == proposer), None)
         if ratio is not None:
             out.append({"rule": f"{method}, {proposer}: >= 2x the one-shot on multi-room (point)",
@@ -769,8 +773,7 @@ def _variant_text(vs: dict) -> str:
                      f"{zero[ref][0]} of {zero[ref][1]}), - {ref} {_signed(vs['severe_vs_corrector'])}, - "
                      f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
     if vs.get("versus_ours"):
-        below = {level: [e["maze"] for e in vs["versus_ours"] if e["proposer"] == f"imperfect:{level}"
-                         and "ci_high" in e and e["ci_high"] < 0] for level in ("mild", "moderate")}
+        below = {level: _below_ours(vs["versus_ours"], f"imperfect:{level}") for level in ("mild", "moderate")}
         mazes = len(SCALING_MAZES + OTHER_POINT_MAZES)
         parts.append("every suite maze: below ours on " + ", ".join(
             f"{len(m)} of {mazes} at {level}" + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))

@@ -232,6 +232,7 @@ def corrector_variant_grid(name: str, section: str, method: str, stem: str, code
         parts=(severe, *parts) if severe_first else (*parts, severe), seeds=(0, 1, 2, 3), workers=1, code=code,
         table=f"{table}.csv", out=f"runs/corrector_{stem}")
 
+
 def corrector_suite_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
     """A variant of the corrector (issue 39) on the rest of the point suite (the mazes beside the U-chains) at mild
     and moderate, seeds 0-3, into data/results/corrector/STEM_suite.csv: with its U-chains, all 17 suite mazes."""

@@ -295,12 +295,7 @@ class RefinementSearch:
     def _ask_split(self, u, v, attempt: int):
         """One Algorithm 1 call on the search's edge u -> v (``attempt`` > 0: asked again after a reply that gave
         no valid candidate), logged."""
-        self.splits_generated += 1
-        f, g = self.f, self.graph
-        query = self.query_for(g, u, v, self.results[(u, v)])
-        outcome = edge_split(self.evaluator, self.proposer, query, start=f.arrivals[u], goal_point=g.goal_point(v),
-                             w=self.cfg.w, d=self.cfg.d, k=self.cfg.k, rng=self.rng, picture=self.picture,
-                             racing=self.racing, feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
+        outcome = self._split_leg(self.graph, u, v, self.results[(u, v)], self.f.arrivals[u])
         budget = [self.splits_generated, self.cfg.max_edge_splits]  # Algorithm 1 calls so far, of the budget
         retry = {"asked_again": attempt} if attempt else {}
         self._log("split-generated", edge=[u, v], splits=budget, **retry, candidates=[
