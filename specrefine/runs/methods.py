@@ -229,6 +229,12 @@ register_method("ours-corrector-frugal", ours_variant(**CORRECTOR | dict(correct
                 "alternatives cheapest first (bypass, split, split over the next waypoint), stopping at the first "
                 "that wins, and each of its splits in one proposer round (the leg's failure picture already in it)",
                 colour="#006064")
+#: ours-corrector-thrift: recheck's two passes, frugal's asking, and a higher gate (docs/corrector.md, "Within 3x")
+THRIFT = dict(correct_rollouts=16, correct_min_failures=6, correct_passes=2, correct_first_win=True, correct_rounds=1)
+register_method("ours-corrector-thrift", ours_variant(**CORRECTOR | THRIFT),
+                "beyond the paper: ours-corrector-recheck asking the proposer as ours-corrector-frugal does "
+                "(cheapest alternative first, one round per split) and only about legs with at least 6 of their 512 "
+                "fresh rollouts failed; a leg with fewer is only bypassed", colour="#0d47a1")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
