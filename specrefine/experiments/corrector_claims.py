@@ -37,20 +37,23 @@ SPREAD = "ours-corrector-precise (spread)"  # precise at the code with spread st
 RECHECK = "ours-corrector-recheck"
 FRUGAL = "ours-corrector-frugal"
 RETRY = "ours-corrector-retry"
+THRIFT = "ours-corrector-thrift"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
-                 FRUGAL: "corrector-frugal", RETRY: "corrector-retry"}
+                 FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
-VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD}
+VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
+                     THRIFT: RECHECK}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
-VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite"}
+VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
+                 THRIFT: "corrector-thrift-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL, "retry": RETRY}
+            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT}
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85

@@ -423,6 +423,10 @@ GRIDS = {g.name: g for g in (
                            code="c16285c", severe_first=True),
     corrector_variant_grid("corrector-frugal", "Fewer proposer calls in the correction", "ours-corrector-frugal",
                            "frugal", code="bf8f0cc"),
+    corrector_variant_grid("corrector-thrift", "Within 3x: recheck asking less", "ours-corrector-thrift", "thrift",
+                           code="093a937"),
+    corrector_suite_grid("corrector-thrift-suite", "Within 3x: recheck asking less", "ours-corrector-thrift", "thrift",
+                         code="093a937"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
