@@ -144,6 +144,9 @@ def test_ours_corrector_runs_end_to_end_and_logs_its_correction(tmp_path):
     assert len(check["probabilities"]) == len(check["path"]) - 1
     assert result.data["method"] == "ours-corrector" and result.data["proposer_calls"] >= 1
     assert result.data["refines_input"] is True
+    calls = [s["proposer_calls"] for s in steps]  # each step: the proposer's calls so far
+    assert calls == sorted(calls) and calls[-1] == result.data["proposer_calls"]
+    assert 0 <= check["proposer_calls"] <= calls[-1]  # what the search spent before its correction
 
 
 # --- the gate (method ours-corrector-gated): the proposer is asked about a leg only with enough fresh failures -----

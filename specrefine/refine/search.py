@@ -478,6 +478,9 @@ class RefinementSearch:
     def _log(self, event: str, **detail) -> None:
         step = {"step": len(self.steps), "event": event, "open": sorted(self.f.open),
                 "closed": list(self.f.closed), **detail}
+        calls = getattr(self.proposer, "proposer_calls", None)
+        if calls is not None:  # the proposer's calls so far: what each phase of the search cost can be read off
+            step["proposer_calls"] = calls
         self.steps.append(step)
         if self.on_step:
             self.on_step(step)
