@@ -541,11 +541,19 @@ def _below_ours(versus: list[dict], proposer: str) -> list[str]:
     return [e["maze"] for e in versus if e["proposer"] == proposer and "ci_high" in e and e["ci_high"] < 0]
 
 
+def _mazes_run(versus: list[dict], proposer: str) -> str:
+    """How many suite mazes the method has runs on at ``proposer``: 'N' when all of them, else 'N run (of M)'."""
+    mine = [e for e in versus if e["proposer"] == proposer]
+    ran = sum(1 for e in mine if e["runs"])
+    return f"{ran}" if ran == len(mine) else f"{ran} run (of {len(mine)})"
+
+
 def _suite_rule(versus: list[dict], proposer: str, name: str) -> dict:
     """The issue's rule 'not below ours on any suite maze' at ``proposer``, its row named ``name``."""
     mine, below = [e for e in versus if e["proposer"] == proposer], _below_ours(versus, proposer)
     return {"rule": f"{name}: not below ours on any suite maze (Newcombe)",
-            "value": f"below on {len(below)} of {len(mine)}" + (f" ({', '.join(below)})" if below else ""),
+            "value": f"below on {len(below)} of {_mazes_run(versus, proposer)}" + (f" ({', '.join(below)})" if below
+                                                                                   else ""),
             "verdict": _verdict(not below, all(e["runs"] == len(POINT_SEEDS) for e in mine))}
 
 
@@ -777,9 +785,9 @@ def _variant_text(vs: dict) -> str:
                      f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
     if vs.get("versus_ours"):
         below = {level: _below_ours(vs["versus_ours"], f"imperfect:{level}") for level in ("mild", "moderate")}
-        mazes = len(SCALING_MAZES + OTHER_POINT_MAZES)
         parts.append("every suite maze: below ours on " + ", ".join(
-            f"{len(m)} of {mazes} at {level}" + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))
+            f"{len(m)} of {_mazes_run(vs['versus_ours'], f'imperfect:{level}')} at {level}"
+            + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))
     held = [e for e in vs["held_out"] if e["runs"]]
     if held:
         parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
