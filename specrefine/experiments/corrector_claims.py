@@ -795,6 +795,10 @@ def _variant_text(vs: dict) -> str:
                      f"{max(e['reference_success'] for e in held):.3f}; higher on "
                      f"{sum(e['success'] > e['reference_success'] for e in held)}, lower on "
                      f"{sum(e['success'] < e['reference_success'] for e in held)} of {len(held)})")
+        mine = [c for c in vs.get("held_out_costs", []) if c["method"] == vs["method"] and c["pairs"]]
+        if mine:
+            parts[-1] += ", " + ", ".join(f"{c['proposer']} {_num(c['proposer_calls_ratio'], '{:.1f}x')}"
+                                          for c in mine) + " the proposer calls of ours"
     return "; ".join(parts)
 
 
