@@ -229,8 +229,10 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     assert "1.7x the proposer calls of ours" in text and "one-shot ratio" in text
     assert "severe: runs at 0 0 of 36 (ours-corrector 0 of 36), - ours-corrector " in text
     higher = 12 if rate > 0.97 else 0
+    ratios = {c["proposer"]: c["proposer_calls_ratio"] for c in vs["held_out_costs"] if c["method"] == method}
     assert text.endswith(f"held out: {rate:.3f}-{rate:.3f} per layout and mix (ours-corrector 0.970-0.970; higher on "
-                         f"{higher}, lower on {12 - higher} of 12)")
+                         f"{higher}, lower on {12 - higher} of 12), mix A {ratios['mix A']:.1f}x, mix B "
+                         f"{ratios['mix B']:.1f}x the proposer calls of ours")
     assert v[f"{method}, imperfect:moderate: >= 2x the one-shot on multi-room (point)"]["verdict"] == "holds"
     md = "\n".join(cc.variant_markdown(vs))
     assert "Severe (described)" in md and "Held out (descriptive)" in md
