@@ -77,3 +77,21 @@ def test_show_refuses_what_is_not_a_run_in_one_line(tmp_path, capsys, content):
     assert main(["show", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "result.json" in err
+
+
+def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, tmp_path, capsys):
+    data = json.loads((runs / "ours" / "result.json").read_text())
+    capsys.readouterr()
+    assert main(["show", str(runs / "ours")]) == 0
+    out = capsys.readouterr().out
+    assert f"cost: {data['proposer_calls']} proposer calls, {data['evaluations']} evaluations\n" in out  # no correction
+    run = tmp_path / "corrector"
+    assert main(["refine", "u_chain_2", "--method", "ours-corrector", "--proposer", "imperfect:moderate", "--seed", "1",
+                 "--out", str(run), *TINY]) == 0
+    data = json.loads((run / "result.json").read_text())
+    steps = [json.loads(line) for line in (run / "steps.jsonl").read_text().splitlines()]
+    before = next(s["proposer_calls"] for s in steps if s["event"] == "correct-check")
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    assert (f"(proposer calls: {before} in the search, {data['proposer_calls'] - before} in the correction)"
+            in capsys.readouterr().out)

@@ -4,7 +4,8 @@
 
 prints the run's summary (the input task beside the refined one), its path leg by leg (each subtask's estimate
 from the search's rollouts and its measured success among the episodes that started it), where the wall time
-went, the official environment's result if ``specrefine official`` has run, and the paths of its pictures and
+went, what it asked of the proposer (and, for a corrector, how much of it in the correction), the official
+environment's result if ``specrefine official`` has run, and the paths of its pictures and
 files.  A folder that is not a finished run is one line (exit 2).
 """
 
@@ -44,8 +45,8 @@ def show(run_dir) -> str:
     run_dir = Path(run_dir)
     data = load_run(run_dir)
     try:
-        parts = [RunResult(data, run_dir).summary(), path_text(data), time_text(data), official_text(run_dir),
-                 files_text(run_dir)]
+        parts = [RunResult(data, run_dir).summary(), path_text(data), time_text(data), cost_text(run_dir, data),
+                 official_text(run_dir), files_text(run_dir)]
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise SpecrefineError(f"{run_dir / 'result.json'}: malformed ({type(exc).__name__}: {exc})") from None
     return "\n".join(part for part in parts if part)
@@ -87,6 +88,36 @@ def time_text(data: dict) -> str:
     shown = [f"{label} {seconds:.1f} s" for label, seconds in phases]
     return (f"time: {wall:.1f} s = " + ", ".join(shown[:3]) + f", setup {max(wall - inside, 0.0):.1f} s"
             + "".join(f"; then {part}" for part in shown[3:]))
+
+
+def cost_text(run_dir: Path, data: dict) -> str:
+    """What the run asked of the proposer and the evaluator; where the run corrected its path, the proposer calls
+    before and in the correction (read from steps.jsonl, whose steps carry the calls so far)."""
+    calls = data.get("proposer_calls")
+    if calls is None:
+        return ""
+    text = f"cost: {calls} proposer calls, {data.get('evaluations', '?')} evaluations"
+    before = calls_before_correction(run_dir / "steps.jsonl")
+    if before is not None:
+        text += f" (proposer calls: {before} in the search, {calls - before} in the correction)"
+    return text
+
+
+def calls_before_correction(path: Path) -> int | None:
+    """The proposer's calls when the correction began (its first 'correct-check' step), or None: no correction, a
+    log from before steps carried the calls, or a file that is not a readable regular file."""
+    if not path.is_file():
+        return None
+    try:
+        with path.open(encoding="utf-8") as fh:
+            for line in fh:
+                step = json.loads(line)
+                if step.get("event") == "correct-check":
+                    calls = step.get("proposer_calls")
+                    return calls if isinstance(calls, int) else None
+    except (OSError, ValueError, AttributeError):
+        return None
+    return None
 
 
 def official_text(run_dir: Path) -> str:
