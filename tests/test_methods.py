@@ -30,7 +30,7 @@ def test_the_built_in_methods_are_registered_with_what_they_are():
               "ours-corrector-retry", "ours-corrector-thrift",
               "ours-deeprepair",
               "ours-feasible", "ours-checked",
-              "ours-polish", "ours-shortcut", "vlm-oneshot",
+              "ours-polish", "ours-shortcut", "ours-tunecheck", "vlm-oneshot",
               "vlm-oneshot-matched"}
     assert set(METHODS) >= asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) >= asking
     assert not {"symbolic", "dirl"} & set(PROPOSER_METHODS)

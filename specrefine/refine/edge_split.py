@@ -10,6 +10,12 @@ no later candidate could be selected over it.
 
 Controls (each removes one thing): ``feedback=False`` asks the later rounds afresh, without the earlier
 candidates' results; ``tune=False`` evaluates the later rounds' candidates as proposed, without Algorithm 2.
+
+Beyond the paper (``tune_check_seed``, method ``ours-tunecheck``): Algorithm 2 picks the best of many chains on
+the same noisy estimates that then stand for it, so a tuned chain's estimate is the winner of a draw, not a measure.
+Its tuned chain is therefore kept only if it beats the chain as proposed on fresh rollouts, both chains run from the
+same start states on the same fresh seed (paired; a tie keeps the proposal), and the candidate carries the winner's
+fresh estimates.
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ class SplitCandidate:
     round: int
     tuned: bool = False  # went through the chain vertex refinement
     repaired: int = 0  # legs split once more by the look-ahead repair (repair.py; method ours-repair)
+    check: tuple[float, float] | None = None  # (proposed, tuned) on fresh rollouts, when the tuning was checked
 
     @property
     def probabilities(self) -> list[float]:
@@ -59,8 +66,10 @@ def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
 
 def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = PAPER.w,
                d: int = PAPER.d, k: int = PAPER.k, rng: np.random.Generator, picture: Callable | None = None,
-               racing=None, feedback: bool = True, tune: bool = True) -> SplitOutcome:
-    """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``."""
+               racing=None, feedback: bool = True, tune: bool = True, tune_check_seed: int | None = None
+               ) -> SplitOutcome:
+    """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``. ``tune_check_seed``:
+    a tuned chain is checked against its proposal on fresh rollouts of this seed (None: the paper, unchecked)."""
     from ..proposers import CandidateFeedback
 
     outcome = SplitOutcome(best=None)
@@ -89,8 +98,22 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
                                       k, rng, goal_point, racing=racing, floor=floor)
                 outcome.evaluations += choice.evaluations
                 candidate = SplitCandidate(choice.regions, choice.results, round_, tuned=True)
+                if tune_check_seed is not None and choice.regions != list(waypoints):
+                    candidate = checked_tuning(evaluator, start, list(waypoints), candidate, goal, avoid, goal_point,
+                                               seed=tune_check_seed)
+                    outcome.evaluations += 2 * len(candidate.results)
             outcome.candidates.append(candidate)
     if outcome.candidates:
         outcome.best = max(outcome.candidates, key=lambda c: c.p)
     return outcome
 
+
+def checked_tuning(evaluator: SubtaskEvaluator, start, proposed: list[Region], tuned: SplitCandidate, goal, avoid,
+                   goal_point, *, seed: int) -> SplitCandidate:
+    """The tuned chain if it beats ``proposed`` on the same fresh rollouts (seed ``seed``), else the proposal; either
+    way with the winner's fresh estimates."""
+    fresh = [estimate_legs(evaluator, start, split_legs(ws, goal, avoid, goal_point), seed=seed)
+             for ws in (proposed, tuned.waypoints)]
+    won = fresh[1].p > fresh[0].p
+    return SplitCandidate(tuned.waypoints if won else proposed, fresh[won].results, tuned.round, tuned=won,
+                          check=(fresh[0].p, fresh[1].p))

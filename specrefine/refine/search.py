@@ -42,6 +42,7 @@ from .vertex import refine_chain
 
 EVALUATIONS = ("fixed", "adaptive")
 POLISH_SEED_OFFSET = 7919  # polishing draws its rollouts apart from the search's (and the measurement's) seeds
+TUNE_CHECK_SEED_OFFSET = 15_485_863  # the tuning check's fresh rollouts: apart from every other estimate's
 
 
 @dataclass
@@ -52,6 +53,7 @@ class SearchConfig:
     edge_refinement: bool = True
     vertex_refinement: bool = True  # the search's own vertex refinements (Algorithm 3)
     split_tuning: bool = True  # Algorithm 2 on an edge split's later-round candidates (Algorithm 1, line 10)
+    tuning_check: bool = False  # beyond the paper: a tuned chain kept only if it beats its proposal on fresh rollouts
     split_feedback: bool = True  # later rounds of an edge split see the earlier candidates' results
     tau0: float = 0.02
     tau_step: float = 0.02
@@ -300,7 +302,9 @@ class RefinementSearch:
         retry = {"asked_again": attempt} if attempt else {}
         self._log("split-generated", edge=[u, v], splits=budget, **retry, candidates=[
             {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
-             "waypoints": [x.to_dict() for x in c.waypoints]} for c in outcome.candidates])
+             "waypoints": [x.to_dict() for x in c.waypoints],
+             **({"check": {"proposed": c.check[0], "tuned": c.check[1]}} if c.check else {})}
+            for c in outcome.candidates])
         return outcome
 
     def _split_leg(self, chain_graph, a, b, result, start, d: int | None = None):
@@ -310,7 +314,8 @@ class RefinementSearch:
         return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
                           goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
                           rng=self.rng, picture=self.picture, racing=self.racing,
-                          feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning)
+                          feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning,
+                          tune_check_seed=self.cfg.seed + TUNE_CHECK_SEED_OFFSET if self.cfg.tuning_check else None)
 
     def _repair(self, u, v, candidate):
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,

@@ -183,6 +183,9 @@ register_method("ours-nofeedback", ours_variant(split_feedback=False),
 register_method("ours-d1", ours_variant(d=1),
                 "the paper's d = 1: no later round in an edge split (its samples, feedback and tuning)",
                 colour="#00897b", knobs=("w", "k"))
+register_method("ours-tunecheck", ours_variant(tuning_check=True),
+                "Algorithm 3 where a split's tuned chain (Alg. 1 line 10) is kept only if it beats the chain as "
+                "proposed on the same fresh rollouts (refine/edge_split.py)", colour="#5d4037")
 register_method("ours-repair", ours_variant(repair=True),
                 "beyond the paper: ours, and when no split candidate succeeds end to end, its failing legs are split "
                 "once more before it is judged (refine/repair.py)", colour="#6a1b9a")
