@@ -441,6 +441,12 @@ GRIDS = {g.name: g for g in (
         goal_points="centre", workers=1, code="e08c8b9", table="data/results/ant/oracle_spread.csv",
         out="runs/ant_oracle_spread"),
     ExperimentGrid(
+        "ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC before its "
+        "first cell ran): ant-oracle-spread's cells with ours-tunecheck", "ant",
+        parts=(Part(("ours-tunecheck",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
+        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code="9b8f8f7",
+        table="data/results/ant/oracle_tunecheck.csv", out="runs/ant_oracle_tunecheck"),
+    ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
         parts=(Part(("ours",), (GEOMETRIC_48,)),), seeds=(0, 1, 2), mazes=("u_chain_3", "u_chain_5"),
