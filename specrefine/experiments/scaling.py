@@ -57,25 +57,28 @@ def _runs(rows, maze, method, proposer) -> list[dict]:
                    and int(r["seed"]) in SEEDS), key=lambda r: int(r["seed"]))
 
 
-def flat_claim(rows) -> dict:
-    """The first rule on ``ours`` x ORACLE: every maze pooled at least LEVEL, and the 1-5 room change flat."""
+def flat_claim(rows, method: str = "ours", level: float = LEVEL, tolerance: float = cmp.FLAT_TOLERANCE) -> dict:
+    """The first rule on ``method`` x ORACLE: every maze pooled at least ``level``, and the 1-5 room change flat
+    (its interval within +-``tolerance``)."""
     per_maze, complete = {}, True
     for maze in MAZES:
-        runs = _runs(rows, maze, "ours", ORACLE)
+        runs = _runs(rows, maze, method, ORACLE)
         complete &= len(runs) == len(SEEDS)
         if runs:
             ok, n = pooled(runs)
             per_maze[maze] = {"success": ok / n, "ci": list(wilson_ci(ok, n)), "episodes": n, "seeds": len(runs),
                               "runs": [r["success_rate"] for r in runs]}
     cells, failed = cmp.table_cells(rows, "ant")
-    change = cmp.rooms_claim(cells, failed, ORACLE, "ours", SEEDS)
-    level_met = len(per_maze) == len(MAZES) and all(m["success"] >= LEVEL for m in per_maze.values())
-    verdict = "holds" if level_met and change["verdict"] == "flat" else "not met"
-    return {"claim": f"ours x {ORACLE}: at least {LEVEL:.2f} on every maze, flat from 1 to 5 rooms",
+    change = cmp.rooms_claim(cells, failed, ORACLE, method, SEEDS)
+    change_verdict = cmp.rooms_verdict((change["ci_low"], change["ci_high"]), tolerance)
+    level_met = len(per_maze) == len(MAZES) and all(m["success"] >= level for m in per_maze.values())
+    verdict = "holds" if level_met and change_verdict == "flat" else "not met"
+    return {"claim": f"{method} x {ORACLE}: at least {level:.2f} on every maze, flat (+-{tolerance:.2f}) from 1 to "
+                     "5 rooms",
             "verdict": verdict if complete else f"partial ({verdict} so far)", "complete": complete,
-            "per_maze": per_maze, "below_level": sorted(m for m, v in per_maze.items() if v["success"] < LEVEL),
+            "per_maze": per_maze, "below_level": sorted(m for m, v in per_maze.items() if v["success"] < level),
             "change_1_to_5": change["estimate"], "change_ci": [change["ci_low"], change["ci_high"]],
-            "change_verdict": change["verdict"]}
+            "change_verdict": change_verdict}
 
 
 def _mean(runs) -> float | None:

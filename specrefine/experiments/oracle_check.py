@@ -1,0 +1,104 @@
+"""Issue 42's oracle rules on one Ant grid, and a lever's grid against its baseline, cell for cell
+(docs/ant_experiments.md, 'The oracle at the fixed code' and 'lever 4').
+
+    python -m specrefine.experiments.oracle_check data/results/ant/oracle_tunecheck.csv --method ours-tunecheck \\
+        --baseline data/results/ant/oracle_spread.csv --out data/results/ant/oracle_tunecheck_check.md
+
+The rule: at least ``--level`` (0.97) on every maze pooled over seeds 0-2 and the change from 1 to 5 rooms within
++-``--tolerance`` (0.03). Against a baseline (``ours`` on the same cells): the pooled difference over the cells both
+ran with Newcombe's 95 % interval, per maze too; the lever is adopted if, complete, the pooled difference is above 0
+and no maze is more than ``--margin`` (0.03) below. Every proposer here is offline, NOT a VLM.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
+from ..core.errors import SpecrefineError
+from ..core.results import newcombe_ci, rate_text
+from ..core.runfolder import write_atomic
+from .legs import pooled
+from .scaling import MAZES, ORACLE, SEEDS, flat_claim, read_rows
+
+
+def _cells(rows, method: str) -> dict[tuple[str, int], dict]:
+    return {(r["maze"], int(r["seed"])): r for r in rows
+            if r["method"] == method and r["proposer"] == ORACLE and int(r["seed"]) in SEEDS}
+
+
+def against(rows, base_rows, method: str, base_method: str, margin: float) -> dict:
+    """``method`` - ``base_method`` on the cells both ran: pooled and per maze (Newcombe 95 %), and the verdict."""
+    mine, base = _cells(rows, method), _cells(base_rows, base_method)
+    common = sorted(set(mine) & set(base))
+
+    def diff(keys):
+        (k1, n1), (k2, n2) = pooled([mine[c] for c in keys]), pooled([base[c] for c in keys])
+        return {"cells": len(keys), "lever": (k1, n1), "base": (k2, n2), "difference": k1 / n1 - k2 / n2,
+                "ci": newcombe_ci(k1, n1, k2, n2)}
+
+    per_maze = {m: diff([c for c in common if c[0] == m]) for m in MAZES if any(c[0] == m for c in common)}
+    total = diff(common) if common else None
+    complete = len(common) == len(MAZES) * len(SEEDS)
+    worst = min((v["difference"] for v in per_maze.values()), default=0.0)
+    adopted = total is not None and total["difference"] > 0 and worst >= -margin
+    verdict = ("adopted" if adopted else "not adopted") if complete else \
+        f"partial ({'adopted' if adopted else 'not adopted'} so far, {len(common)} of {len(MAZES) * len(SEEDS)} cells)"
+    return {"total": total, "per_maze": per_maze, "verdict": verdict, "margin": margin}
+
+
+def _diff_text(d) -> str:
+    lo, hi = d["ci"]
+    return f"{d['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+
+
+def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
+    lo, hi = flat["change_ci"]
+    lines = ["Every proposer here is offline, NOT a VLM (geometric: a planner on the map). Ant, pooled over seeds "
+             f"{', '.join(map(str, SEEDS))}, 200 fresh episodes per run; Wilson 95 % intervals.", "",
+             f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {flat['change_1_to_5']:+.3f} "
+             f"[{lo:+.3f}, {hi:+.3f}] ({flat['change_verdict']}); below the level: "
+             f"{', '.join(flat['below_level']) or 'none'}.", ""]
+    header = "| maze | seeds | " + method + " |" + (f" {base_method} (baseline) | difference |" if vs else "")
+    lines += [header, "|---" * (header.count("|") - 1) + "|"]
+    for maze, m in flat["per_maze"].items():
+        k, n = round(m["success"] * m["episodes"]), m["episodes"]
+        row = f"| {maze} | {m['seeds']} | {rate_text(k, n)} |"
+        if vs:
+            d = vs["per_maze"].get(maze)
+            row += (f" {rate_text(*d['base'])} | {_diff_text(d)} |" if d else " — | — |")
+        lines.append(row)
+    if vs and vs["total"]:
+        t = vs["total"]
+        lines += ["", f"**Against {base_method} on the same {t['cells']} cells: {vs['verdict']}** (adopted if, "
+                  f"complete, the pooled difference is above 0 and no maze is more than {vs['margin']:.2f} below). "
+                  f"Pooled {rate_text(*t['lever'])} against {rate_text(*t['base'])}: difference {_diff_text(t)} "
+                  "(Newcombe 95 %)."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    p = OneLineParser(prog="python -m specrefine.experiments.oracle_check", description=__doc__.split("\n")[0])
+    p.add_argument("table", help="the grid's table")
+    p.add_argument("--method", default="ours")
+    p.add_argument("--baseline", help="the baseline grid's table (cells matched by maze and seed)")
+    p.add_argument("--baseline-method", default="ours")
+    p.add_argument("--level", type=float, default=0.97)
+    p.add_argument("--tolerance", type=float, default=0.03)
+    p.add_argument("--margin", type=float, default=0.03)
+    p.add_argument("--out", type=Path, required=True)
+    args = p.parse_args(argv)
+    try:
+        rows = read_rows([args.table])
+        base = read_rows([args.baseline]) if args.baseline else None
+    except SpecrefineError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
+    flat = flat_claim(rows, args.method, args.level, args.tolerance)
+    vs = against(rows, base, args.method, args.baseline_method, args.margin) if base is not None else None
+    write_atomic(args.out, markdown(flat, vs, args.method, args.baseline_method))
+    print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict']}" if vs else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(exit_code_quiet_on_broken_pipe(main))

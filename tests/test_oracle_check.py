@@ -1,0 +1,60 @@
+"""specrefine.experiments.oracle_check: issue 42's oracle rule and a lever against its baseline, cell for cell."""
+import csv
+
+import pytest
+
+from specrefine.experiments import oracle_check, scaling
+from specrefine.runs.sweep import COLUMNS
+from test_scaling import _row
+
+
+def _grid(method, rate):
+    return [_row(maze, method, scaling.ORACLE, seed, rate(maze, seed) if callable(rate) else rate)
+            for maze in scaling.MAZES for seed in scaling.SEEDS]
+
+
+def _write(path, rows):
+    with path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    return str(path)
+
+
+def test_the_rule_takes_its_level_and_tolerance():
+    rows = _grid("ours", lambda m, s: 0.995 - 0.01 * scaling.rooms(m))  # 0.945-0.985: -0.04 over 4 rooms
+    strict = scaling.flat_claim(rows, level=0.97, tolerance=0.03)
+    assert strict["verdict"] == "not met" and strict["change_verdict"] == "falls"
+    assert strict["below_level"] == sorted(m for m in scaling.MAZES if scaling.rooms(m) >= 3)
+    loose = scaling.flat_claim(rows, level=0.90, tolerance=0.05)
+    assert loose["verdict"] == "holds" and loose["change_1_to_5"] == pytest.approx(-0.04)
+    assert scaling.flat_claim(_grid("ours-tunecheck", 0.99), method="ours-tunecheck", level=0.97,
+                              tolerance=0.03)["verdict"] == "holds"
+
+
+def test_a_lever_is_adopted_only_above_its_baseline_with_no_maze_far_below():
+    base = _grid("ours", 0.90)
+    better = oracle_check.against(_grid("ours-tunecheck", 0.93), base, "ours-tunecheck", "ours", 0.03)
+    assert better["verdict"] == "adopted" and better["total"]["cells"] == 27
+    assert better["total"]["difference"] == pytest.approx(0.03)
+    lo, hi = better["total"]["ci"]
+    assert lo < 0.03 < hi
+    one_worse = _grid("ours-tunecheck", lambda m, s: 0.85 if m == "u_chain_2" else 0.95)
+    verdict = oracle_check.against(one_worse, base, "ours-tunecheck", "ours", 0.03)
+    assert verdict["total"]["difference"] > 0 and verdict["verdict"] == "not adopted"
+    assert verdict["per_maze"]["u_chain_2"]["difference"] == pytest.approx(-0.05)
+    partial = oracle_check.against(_grid("ours-tunecheck", 0.93)[:5], base, "ours-tunecheck", "ours", 0.03)
+    assert partial["verdict"] == "partial (adopted so far, 5 of 27 cells)"
+
+
+def test_the_command_writes_the_rule_and_the_comparison(tmp_path):
+    lever = _write(tmp_path / "lever.csv", _grid("ours-tunecheck", 0.98))
+    base = _write(tmp_path / "base.csv", _grid("ours", 0.96))
+    out = tmp_path / "check.md"
+    assert oracle_check.main([lever, "--method", "ours-tunecheck", "--baseline", base, "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "at least 0.97 on every maze, flat (+-0.03) from 1 to 5 rooms: holds." in text
+    assert "| u_chain_3 | 3 | 0.980 [0.965, 0.989] (600) | 0.960 [0.941, 0.973] (600) | +0.020" in text
+    assert "**Against ours on the same 27 cells: adopted**" in text and "NOT a VLM" in text
+    with pytest.raises(SystemExit):
+        oracle_check.main([str(tmp_path / "absent.csv"), "--out", str(out)])
