@@ -2,10 +2,10 @@
 import csv
 
 import pytest
+from test_scaling import _row
 
 from specrefine.experiments import oracle_check, scaling
 from specrefine.runs.sweep import COLUMNS
-from test_scaling import _row
 
 
 def _grid(method, rate):
