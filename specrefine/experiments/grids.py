@@ -243,10 +243,11 @@ def corrector_suite_grid(name: str, section: str, method: str, stem: str, code: 
         out=f"runs/corrector_{stem}_suite")
 
 
-def ant_corrector_grid(name: str, source: str, stem: str, code: str) -> ExperimentGrid:
-    """ours-corrector on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
+def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector"
+                       ) -> ExperimentGrid:
+    """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
     adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv."""
-    part = Part(("ours-corrector",), ("imperfect:moderate",), split="seeds")
+    part = Part((method,), ("imperfect:moderate",), split="seeds")
     return ExperimentGrid(name, source, "ant", parts=(part,), seeds=(0, 1, 2), mazes=SCALING_MAZES,
                           policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
                           workers=1, code=code,

@@ -238,6 +238,10 @@ register_method("ours-corrector-thrift", ours_variant(**CORRECTOR | THRIFT),
                 "beyond the paper: ours-corrector-recheck asking the proposer as ours-corrector-frugal does "
                 "(cheapest alternative first, one round per split) and only about legs with at least 6 of their 512 "
                 "fresh rollouts failed; a leg with fewer is only bypassed", colour="#0d47a1")
+register_method("ours-corrector-tunecheck", ours_variant(**CORRECTOR | dict(tuning_check=True)),
+                "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a tuned "
+                "chain only if it beats its proposal on the same fresh rollouts (ours-tunecheck's check)",
+                colour="#bf360c")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
