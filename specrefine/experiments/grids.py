@@ -435,6 +435,9 @@ GRIDS = {g.name: g for g in (
     ant_corrector_grid("ant-corrector-spread", "docs/corrector.md, 'Chained estimates' (issue 39; fixed 2026-11-27 "
                        "before its first cell ran): ant-corrector's cells at the code with spread start states",
                        "ant_spread", code="1d06a16"),
+    ant_corrector_grid("ant-corrector-tunecheck", "docs/corrector.md, 'The Ant with the tuning check' (issue 39; fixed "
+                       "2026-11-27 19:15 UTC before its first cell ran)", "ant_tunecheck", code="c637b81",
+                       method="ours-corrector-tunecheck"),
     ExperimentGrid(
         "ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed 2026-11-27 "
         "13:45 UTC before its first cell ran)", "ant", parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds"),),
