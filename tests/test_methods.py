@@ -27,10 +27,10 @@ def test_the_built_in_methods_are_registered_with_what_they_are():
     asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
               "ours-repair", "ours-repair-tuned", "ours-corrector", "ours-corrector-gated", "ours-corrector-lean",
               "ours-corrector-precise", "ours-corrector-trim", "ours-corrector-recheck", "ours-corrector-frugal",
-              "ours-corrector-retry", "ours-corrector-thrift", "ours-corrector-tunecheck",
+              "ours-corrector-retry", "ours-corrector-thrift", "ours-corrector-confirm",
               "ours-deeprepair",
               "ours-feasible", "ours-checked",
-              "ours-polish", "ours-shortcut", "ours-tunecheck", "vlm-oneshot",
+              "ours-polish", "ours-shortcut", "ours-tunecheck", "ours-confirm", "vlm-oneshot",
               "vlm-oneshot-matched"}
     assert set(METHODS) >= asking | {"symbolic", "dirl"} and set(PROPOSER_METHODS) >= asking
     assert not {"symbolic", "dirl"} & set(PROPOSER_METHODS)

@@ -79,3 +79,60 @@ def test_ours_tunecheck_logs_each_check_and_differs_from_ours_only_there(tmp_pat
     assert splits["ours-tunecheck"][:first] == splits["ours"][:first]
     assert [c["waypoints"] for c in splits["ours-tunecheck"][first]["candidates"] if c["round"] == 0] == \
         [c["waypoints"] for c in splits["ours"][first]["candidates"] if c["round"] == 0]
+
+
+class _Rounds:
+    """A proposer whose first round offers FIRST and later rounds LATER (one candidate each)."""
+
+    name, is_vlm, calls = "stub", False, 0
+
+    def propose_split(self, query, w, feedback=()):
+        self.calls += 1
+        return [[LATER] if feedback else [FIRST]]
+
+
+FIRST, LATER = Disc(5, 0, 1.0), Disc(5, 1, 1.0)
+
+
+def _confirm_split(search: tuple[float, float], fresh: tuple[float, float], confirm: bool = True):
+    """p of the leg into FIRST / into LATER: ``search`` on the search's rollouts, ``fresh`` on seed FRESH."""
+
+    class Ev(TableEvaluator):
+        def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
+            self.calls.append((start, goal, seed))
+            if goal.centre()[0] == 10:
+                return _Arrive(1.0, at=(10.0, 0.0))
+            first, later = fresh if seed == FRESH else search
+            return _Arrive(first if goal == FIRST else later, at=tuple(goal.centre()))
+
+    g = _chain_graph()
+    return edge_split(Ev(None), _Rounds(), _Query(g, "S", "G"), start=Box(-0.5, -0.5, 0.5, 0.5), w=1, d=2, k=3,
+                      rng=np.random.default_rng(0), tune=False, confirm_seed=FRESH if confirm else None)
+
+
+@pytest.mark.parametrize("fresh, kept", [((0.95, 0.80), FIRST), ((0.80, 0.95), LATER), ((0.90, 0.90), FIRST)])
+def test_a_later_rounds_pick_is_kept_only_if_it_beats_the_first_rounds_best_on_fresh_rollouts(fresh, kept):
+    paper = _confirm_split(search=(0.90, 1.0), fresh=fresh, confirm=False)
+    assert paper.best.waypoints == [LATER] and paper.confirm is None  # the lucky draw wins in the paper's rule
+    out = _confirm_split(search=(0.90, 1.0), fresh=fresh)
+    assert out.best.waypoints == [kept] and out.confirm == pytest.approx(fresh)
+    assert out.best.p == pytest.approx(max(fresh) if kept is LATER else fresh[0])  # the winner's fresh estimate
+    assert out.evaluations == paper.evaluations + 2 * 2
+    assert [c.waypoints for c in out.candidates] == [[FIRST], [LATER]]  # the candidates themselves are as drawn
+
+
+def test_nothing_is_confirmed_when_the_first_round_wins_or_never_succeeded():
+    assert _confirm_split(search=(0.95, 0.90), fresh=(0.5, 1.0)).confirm is None  # the first round's best is the pick
+    dead = _confirm_split(search=(0.0, 0.90), fresh=(0.5, 1.0))
+    assert dead.confirm is None and dead.best.waypoints == [LATER]
+
+
+def test_ours_confirm_logs_each_confirmation(tmp_path):
+    """u_chain_2, imperfect:mild, seed 1, 16 rollouts: a confirmed split logs both fresh products and the pick."""
+    refine_maze("u_chain_2", agent="point", method="ours-confirm", proposer="imperfect:mild", seed=1, rollouts=16,
+                episodes=20, out=tmp_path)
+    steps = [json.loads(line) for line in (tmp_path / "steps.jsonl").read_text().splitlines()]
+    confirmed = [s["confirm"] for s in steps if s["event"] == "split-generated" and "confirm" in s]
+    assert confirmed
+    for c in confirmed:
+        assert c["kept"] == ("later" if c["later"] > c["first_round"] else "first round")

@@ -16,6 +16,11 @@ the same noisy estimates that then stand for it, so a tuned chain's estimate is 
 Its tuned chain is therefore kept only if it beats the chain as proposed on fresh rollouts, both chains run from the
 same start states on the same fresh seed (paired; a tie keeps the proposal), and the candidate carries the winner's
 fresh estimates.
+
+Beyond the paper (``confirm_seed``, method ``ours-confirm``): the same holds across candidates. A later round runs only
+because the first round's best failed somewhere, and its pick is the best of several candidates on one draw each, so
+the pick (tuned or as proposed) replaces the first round's best only if it beats it on fresh rollouts, paired as
+above (a tie keeps the first round's), and carries the winner's fresh estimates.
 """
 
 from __future__ import annotations
@@ -57,6 +62,7 @@ class SplitOutcome:
     best: SplitCandidate | None
     candidates: list[SplitCandidate] = field(default_factory=list)
     evaluations: int = 0
+    confirm: tuple[float, float] | None = None  # (first round's best, later pick) on fresh rollouts, when confirmed
 
 
 def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
@@ -66,10 +72,11 @@ def split_legs(waypoints, goal, avoid, goal_point=None) -> list[Leg]:
 
 def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_point=None, w: int = PAPER.w,
                d: int = PAPER.d, k: int = PAPER.k, rng: np.random.Generator, picture: Callable | None = None,
-               racing=None, feedback: bool = True, tune: bool = True, tune_check_seed: int | None = None
-               ) -> SplitOutcome:
+               racing=None, feedback: bool = True, tune: bool = True, tune_check_seed: int | None = None,
+               confirm_seed: int | None = None) -> SplitOutcome:
     """Algorithm 1 for the edge described by ``query`` (an EdgeQuery), started from ``start``. ``tune_check_seed``:
-    a tuned chain is checked against its proposal on fresh rollouts of this seed (None: the paper, unchecked)."""
+    a tuned chain is checked against its proposal on fresh rollouts of this seed; ``confirm_seed``: a later round's
+    pick against the first round's best (None: the paper, unchecked)."""
     from ..proposers import CandidateFeedback
 
     outcome = SplitOutcome(best=None)
@@ -105,15 +112,40 @@ def edge_split(evaluator: SubtaskEvaluator, proposer, query, *, start, goal_poin
             outcome.candidates.append(candidate)
     if outcome.candidates:
         outcome.best = max(outcome.candidates, key=lambda c: c.p)
+        if confirm_seed is not None and outcome.best.round > 0:
+            confirm_pick(evaluator, start, outcome, goal, avoid, goal_point, seed=confirm_seed)
     return outcome
+
+
+def duel(evaluator: SubtaskEvaluator, start, incumbent: list[Region], challenger: list[Region], goal, avoid,
+         goal_point, *, seed: int):
+    """Both chains' legs estimated on the same fresh rollouts (seed ``seed``, from the same start states)."""
+    return [estimate_legs(evaluator, start, split_legs(ws, goal, avoid, goal_point), seed=seed)
+            for ws in (incumbent, challenger)]
+
+
+def confirm_pick(evaluator: SubtaskEvaluator, start, outcome: SplitOutcome, goal, avoid, goal_point, *,
+                 seed: int) -> None:
+    """``outcome.best`` (a later round's) against the first round's best on the same fresh rollouts: the winner,
+    with its fresh estimates, becomes ``outcome.best`` (a tie keeps the first round's). Nothing to confirm against
+    when the first round had no candidate that ever succeeded."""
+    first = max((c for c in outcome.candidates if c.round == 0), key=lambda c: c.p, default=None)
+    if first is None or first.p <= 0.0:
+        return
+    later = outcome.best
+    fresh = duel(evaluator, start, first.waypoints, later.waypoints, goal, avoid, goal_point, seed=seed)
+    outcome.evaluations += len(first.results) + len(later.results)
+    outcome.confirm = (fresh[0].p, fresh[1].p)
+    won = later if fresh[1].p > fresh[0].p else first
+    outcome.best = SplitCandidate(won.waypoints, fresh[won is later].results, won.round, tuned=won.tuned,
+                                  check=won.check)
 
 
 def checked_tuning(evaluator: SubtaskEvaluator, start, proposed: list[Region], tuned: SplitCandidate, goal, avoid,
                    goal_point, *, seed: int) -> SplitCandidate:
     """The tuned chain if it beats ``proposed`` on the same fresh rollouts (seed ``seed``), else the proposal; either
     way with the winner's fresh estimates."""
-    fresh = [estimate_legs(evaluator, start, split_legs(ws, goal, avoid, goal_point), seed=seed)
-             for ws in (proposed, tuned.waypoints)]
+    fresh = duel(evaluator, start, proposed, tuned.waypoints, goal, avoid, goal_point, seed=seed)
     won = fresh[1].p > fresh[0].p
     return SplitCandidate(tuned.waypoints if won else proposed, fresh[won].results, tuned.round, tuned=won,
                           check=(fresh[0].p, fresh[1].p))

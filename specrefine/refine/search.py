@@ -43,6 +43,7 @@ from .vertex import refine_chain
 EVALUATIONS = ("fixed", "adaptive")
 POLISH_SEED_OFFSET = 7919  # polishing draws its rollouts apart from the search's (and the measurement's) seeds
 TUNE_CHECK_SEED_OFFSET = 15_485_863  # the tuning check's fresh rollouts: apart from every other estimate's
+CONFIRM_SEED_OFFSET = 32_452_843  # the confirmation's fresh rollouts: apart from every other estimate's
 
 
 @dataclass
@@ -54,6 +55,7 @@ class SearchConfig:
     vertex_refinement: bool = True  # the search's own vertex refinements (Algorithm 3)
     split_tuning: bool = True  # Algorithm 2 on an edge split's later-round candidates (Algorithm 1, line 10)
     tuning_check: bool = False  # beyond the paper: a tuned chain kept only if it beats its proposal on fresh rollouts
+    confirm_pick: bool = False  # beyond the paper: a later round's pick kept only if it beats the first round's best
     split_feedback: bool = True  # later rounds of an edge split see the earlier candidates' results
     tau0: float = 0.02
     tau_step: float = 0.02
@@ -111,6 +113,14 @@ def check_changes(changes: dict) -> None:
     if unknown:
         raise SpecrefineError(f"SearchConfig has no field {', '.join(map(repr, unknown))}: use "
                               f"{', '.join(f.name for f in fields(SearchConfig))}")
+
+
+def _confirm_log(outcome) -> dict:
+    """The split's confirmation for steps.jsonl: both fresh products and which pick was kept (none: not confirmed)."""
+    if outcome.confirm is None:
+        return {}
+    first, later = outcome.confirm
+    return {"confirm": {"first_round": first, "later": later, "kept": "later" if later > first else "first round"}}
 
 
 @dataclass
@@ -304,7 +314,7 @@ class RefinementSearch:
             {"round": c.round, "tuned": c.tuned, "p": c.p, "probabilities": c.probabilities,
              "waypoints": [x.to_dict() for x in c.waypoints],
              **({"check": {"proposed": c.check[0], "tuned": c.check[1]}} if c.check else {})}
-            for c in outcome.candidates])
+            for c in outcome.candidates], **_confirm_log(outcome))
         return outcome
 
     def _split_leg(self, chain_graph, a, b, result, start, d: int | None = None):
@@ -315,7 +325,8 @@ class RefinementSearch:
                           goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
                           rng=self.rng, picture=self.picture, racing=self.racing,
                           feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning,
-                          tune_check_seed=self.cfg.seed + TUNE_CHECK_SEED_OFFSET if self.cfg.tuning_check else None)
+                          tune_check_seed=self.cfg.seed + TUNE_CHECK_SEED_OFFSET if self.cfg.tuning_check else None,
+                          confirm_seed=self.cfg.seed + CONFIRM_SEED_OFFSET if self.cfg.confirm_pick else None)
 
     def _repair(self, u, v, candidate):
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,

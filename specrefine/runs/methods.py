@@ -186,6 +186,9 @@ register_method("ours-d1", ours_variant(d=1),
 register_method("ours-tunecheck", ours_variant(tuning_check=True),
                 "Algorithm 3 where a split's tuned chain (Alg. 1 line 10) is kept only if it beats the chain as "
                 "proposed on the same fresh rollouts (refine/edge_split.py)", colour="#5d4037")
+register_method("ours-confirm", ours_variant(confirm_pick=True),
+                "Algorithm 3 where a split's pick from a later round (tuned or as proposed) is kept only if it beats "
+                "the first round's best on the same fresh rollouts (refine/edge_split.py)", colour="#795548")
 register_method("ours-repair", ours_variant(repair=True),
                 "beyond the paper: ours, and when no split candidate succeeds end to end, its failing legs are split "
                 "once more before it is judged (refine/repair.py)", colour="#6a1b9a")
@@ -238,10 +241,10 @@ register_method("ours-corrector-thrift", ours_variant(**CORRECTOR | THRIFT),
                 "beyond the paper: ours-corrector-recheck asking the proposer as ours-corrector-frugal does "
                 "(cheapest alternative first, one round per split) and only about legs with at least 6 of their 512 "
                 "fresh rollouts failed; a leg with fewer is only bypassed", colour="#0d47a1")
-register_method("ours-corrector-tunecheck", ours_variant(**CORRECTOR | dict(tuning_check=True)),
-                "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a tuned "
-                "chain only if it beats its proposal on the same fresh rollouts (ours-tunecheck's check)",
-                colour="#bf360c")
+register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
+                "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
+                "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
+                "check)", colour="#bf360c")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
