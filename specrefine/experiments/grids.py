@@ -435,9 +435,9 @@ GRIDS = {g.name: g for g in (
     ant_corrector_grid("ant-corrector-spread", "docs/corrector.md, 'Chained estimates' (issue 39; fixed 2026-11-27 "
                        "before its first cell ran): ant-corrector's cells at the code with spread start states",
                        "ant_spread", code="1d06a16"),
-    ant_corrector_grid("ant-corrector-tunecheck", "docs/corrector.md, 'The Ant with the tuning check' (issue 39; fixed "
-                       "2026-11-27 19:15 UTC before its first cell ran)", "ant_tunecheck", code="c637b81",
-                       method="ours-corrector-tunecheck"),
+    ant_corrector_grid("ant-corrector-confirm", "docs/corrector.md, 'The Ant with a confirmed pick' (issue 39; fixed "
+                       "2026-11-27 19:55 UTC before its first cell ran)", "ant_confirm", code="c463c3e",
+                       method="ours-corrector-confirm"),
     ExperimentGrid(
         "ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed 2026-11-27 "
         "13:45 UTC before its first cell ran)", "ant", parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds"),),
@@ -450,6 +450,12 @@ GRIDS = {g.name: g for g in (
         parts=(Part(("ours-tunecheck",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
         policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code="9b8f8f7",
         table="data/results/ant/oracle_tunecheck.csv", out="runs/ant_oracle_tunecheck"),
+    ExperimentGrid(
+        "ant-oracle-confirm", "docs/ant_experiments.md, 'Issue 42, lever 5' (fixed 2026-11-27 19:55 UTC before its "
+        "first cell ran): ant-oracle-spread's cells with ours-confirm", "ant",
+        parts=(Part(("ours-confirm",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
+        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code="c463c3e",
+        table="data/results/ant/oracle_confirm.csv", out="runs/ant_oracle_confirm"),
     ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
