@@ -56,5 +56,7 @@ def test_the_command_writes_the_rule_and_the_comparison(tmp_path):
     assert "at least 0.97 on every maze, flat (+-0.03) from 1 to 5 rooms: holds." in text
     assert "| u_chain_3 | 3 | 0.980 [0.965, 0.989] (600) | 0.960 [0.941, 0.973] (600) | +0.020" in text
     assert "**Against ours on the same 27 cells: adopted**" in text and "NOT a VLM" in text
+    assert ("Summary: 27 of 27 cells; below the level on 0 of 9 mazes run; change from 1 to 5 rooms +0.000 "
+            "[+0.000, +0.000]; against ours on the same 27 cells +0.020 [") in text
     with pytest.raises(SystemExit):
         oracle_check.main([str(tmp_path / "absent.csv"), "--out", str(out)])

@@ -52,13 +52,27 @@ def _diff_text(d) -> str:
     return f"{d['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}]"
 
 
+def summary(flat: dict, vs: dict | None, base_method: str) -> str:
+    """One line: the cells run, the mazes below the level, the change; against the baseline, the pooled difference
+    (README quotes it)."""
+    cells = sum(m["seeds"] for m in flat["per_maze"].values())
+    lo, hi = flat["change_ci"]
+    below = flat["below_level"]
+    text = (f"{cells} of {len(MAZES) * len(SEEDS)} cells; below the level on {len(below)} of "
+            f"{len(flat['per_maze'])} mazes run{': ' + ', '.join(below) if below else ''}; change from 1 to 5 rooms "
+            f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]")
+    if vs and vs["total"]:
+        text += f"; against {base_method} on the same {vs['total']['cells']} cells {_diff_text(vs['total'])}"
+    return text
+
+
 def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
     lo, hi = flat["change_ci"]
     lines = ["Every proposer here is offline, NOT a VLM (geometric: a planner on the map). Ant, pooled over seeds "
              f"{', '.join(map(str, SEEDS))}, 200 fresh episodes per run; Wilson 95 % intervals.", "",
              f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {flat['change_1_to_5']:+.3f} "
              f"[{lo:+.3f}, {hi:+.3f}] ({flat['change_verdict']}); below the level: "
-             f"{', '.join(flat['below_level']) or 'none'}.", ""]
+             f"{', '.join(flat['below_level']) or 'none'}.", "", f"Summary: {summary(flat, vs, base_method)}.", ""]
     header = "| maze | seeds | " + method + " |" + (f" {base_method} (baseline) | difference |" if vs else "")
     lines += [header, "|---" * (header.count("|") - 1) + "|"]
     for maze, m in flat["per_maze"].items():
