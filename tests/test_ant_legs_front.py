@@ -127,3 +127,35 @@ def test_front_stage8_u_chains_recompute():
     assert f"Pooled {eight} [" in check and f"against {five} [" in check
     difference = re.search(r"difference ([+-][0-9.]+ \[[+-][0-9.]+, [+-][0-9.]+\])", check).group(1)
     assert front("stage8 uchains") == f"{eight} against {five} over the six cells, {difference}"
+
+
+ORACLE_CHECKS = {"oracle spread": ("oracle_spread.csv", []),
+                 "oracle tunecheck": ("oracle_tunecheck.csv", ["--method", "ours-tunecheck", "--baseline",
+                                                              "data/results/ant/oracle_spread.csv"])}
+
+
+def test_the_oracle_checks_regenerate_and_readme_quotes_their_summaries(tmp_path, monkeypatch):
+    """data/results/ant/oracle_*_check.md from their tables (experiments.oracle_check), and README's sentence."""
+    from specrefine.experiments import oracle_check
+
+    monkeypatch.chdir(ROOT)
+    for name, (table, args) in ORACLE_CHECKS.items():
+        shipped = ROOT / "data" / "results" / "ant" / table.replace(".csv", "_check.md")
+        out = tmp_path / shipped.name
+        assert oracle_check.main([f"data/results/ant/{table}", *args, "--out", str(out)]) == 0
+        assert out.read_text() == shipped.read_text()
+        summary = next(line for line in shipped.read_text().splitlines() if line.startswith("Summary: "))
+        assert front(name) == summary.removeprefix("Summary: ").rstrip(".")
+
+
+def test_readme_names_the_cells_whose_outcome_the_tuning_check_changed():
+    def rates(table):
+        with (ROOT / "data" / "results" / "ant" / table).open(newline="") as fh:
+            return {(r["maze"], int(r["seed"])): float(r["success_rate"]) for r in csv.DictReader(fh)
+                    if r["status"] == "ok"}
+
+    lever, base = rates("oracle_tunecheck.csv"), rates("oracle_spread.csv")
+    common = sorted(set(lever) & set(base))
+    changed = [c for c in common if lever[c] != base[c]]
+    cells = ", ".join(f"{m} seed {s}: {lever[(m, s)]:.3f} against {base[(m, s)]:.3f}" for m, s in changed)
+    assert front("tunecheck changed") == f"{len(changed)} of the {len(common)} cells run, {cells}"
