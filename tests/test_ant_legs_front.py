@@ -129,9 +129,12 @@ def test_front_stage8_u_chains_recompute():
     assert front("stage8 uchains") == f"{eight} against {five} over the six cells, {difference}"
 
 
-ORACLE_CHECKS = {"oracle spread": ("oracle_spread.csv", []),
+ORACLE_CHECKS = {"oracle spread": ("oracle_spread.csv", ["--baseline", "data/results/ant/scaling/ours_centre.csv",
+                                                        "--describe", "--baseline-label", "ours before the fix"]),
                  "oracle tunecheck": ("oracle_tunecheck.csv", ["--method", "ours-tunecheck", "--baseline",
-                                                              "data/results/ant/oracle_spread.csv"])}
+                                                              "data/results/ant/oracle_spread.csv"]),
+                 "oracle confirm": ("oracle_confirm.csv", ["--method", "ours-confirm", "--baseline",
+                                                          "data/results/ant/oracle_spread.csv"])}
 
 
 def test_the_oracle_checks_regenerate_and_readme_quotes_their_summaries(tmp_path, monkeypatch):

@@ -60,3 +60,15 @@ def test_the_command_writes_the_rule_and_the_comparison(tmp_path):
             "[+0.000, +0.000]; against ours on the same 27 cells +0.020 [") in text
     with pytest.raises(SystemExit):
         oracle_check.main([str(tmp_path / "absent.csv"), "--out", str(out)])
+
+
+def test_a_described_comparison_has_no_rule(tmp_path):
+    lever = _write(tmp_path / "now.csv", _grid("ours", 0.90))
+    base = _write(tmp_path / "before.csv", _grid("ours", 0.95)[:21])
+    out = tmp_path / "check.md"
+    assert oracle_check.main([lever, "--baseline", base, "--describe", "--baseline-label", "ours before the fix",
+                              "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "**Against ours before the fix on the same 21 cells (described, no rule).** Pooled 0.900" in text
+    assert "adopted" not in text and "against ours before the fix on the same 21 cells -0.050 [" in text
+    assert "| ours before the fix (baseline) |" in text

@@ -27,8 +27,9 @@ def _cells(rows, method: str) -> dict[tuple[str, int], dict]:
             if r["method"] == method and r["proposer"] == ORACLE and int(r["seed"]) in SEEDS}
 
 
-def against(rows, base_rows, method: str, base_method: str, margin: float) -> dict:
-    """``method`` - ``base_method`` on the cells both ran: pooled and per maze (Newcombe 95 %), and the verdict."""
+def against(rows, base_rows, method: str, base_method: str, margin: float | None) -> dict:
+    """``method`` - ``base_method`` on the cells both ran: pooled and per maze (Newcombe 95 %), and the verdict
+    (None with ``margin`` None: described, no rule)."""
     mine, base = _cells(rows, method), _cells(base_rows, base_method)
     common = sorted(set(mine) & set(base))
 
@@ -41,6 +42,8 @@ def against(rows, base_rows, method: str, base_method: str, margin: float) -> di
     total = diff(common) if common else None
     complete = len(common) == len(MAZES) * len(SEEDS)
     worst = min((v["difference"] for v in per_maze.values()), default=0.0)
+    if margin is None:
+        return {"total": total, "per_maze": per_maze, "verdict": None, "margin": None}
     adopted = total is not None and total["difference"] > 0 and worst >= -margin
     verdict = ("adopted" if adopted else "not adopted") if complete else \
         f"partial ({'adopted' if adopted else 'not adopted'} so far, {len(common)} of {len(MAZES) * len(SEEDS)} cells)"
@@ -84,8 +87,9 @@ def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
         lines.append(row)
     if vs and vs["total"]:
         t = vs["total"]
-        lines += ["", f"**Against {base_method} on the same {t['cells']} cells: {vs['verdict']}** (adopted if, "
-                  f"complete, the pooled difference is above 0 and no maze is more than {vs['margin']:.2f} below). "
+        rule = (f": {vs['verdict']}** (adopted if, complete, the pooled difference is above 0 and no maze is more than "
+                f"{vs['margin']:.2f} below)." if vs["verdict"] else " (described, no rule).**")
+        lines += ["", f"**Against {base_method} on the same {t['cells']} cells{rule} "
                   f"Pooled {rate_text(*t['lever'])} against {rate_text(*t['base'])}: difference {_diff_text(t)} "
                   "(Newcombe 95 %)."]
     return "\n".join(lines) + "\n"
@@ -97,9 +101,12 @@ def main(argv=None) -> int:
     p.add_argument("--method", default="ours")
     p.add_argument("--baseline", help="the baseline grid's table (cells matched by maze and seed)")
     p.add_argument("--baseline-method", default="ours")
+    p.add_argument("--baseline-label", help="how the tables name the baseline (default: its method)")
     p.add_argument("--level", type=float, default=0.97)
     p.add_argument("--tolerance", type=float, default=0.03)
     p.add_argument("--margin", type=float, default=0.03)
+    p.add_argument("--describe", action="store_true", help="the comparison with the baseline only, no adoption rule "
+                                                           "(e.g. the same cells before a fix)")
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
     try:
@@ -108,9 +115,11 @@ def main(argv=None) -> int:
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     flat = flat_claim(rows, args.method, args.level, args.tolerance)
-    vs = against(rows, base, args.method, args.baseline_method, args.margin) if base is not None else None
-    write_atomic(args.out, markdown(flat, vs, args.method, args.baseline_method))
-    print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict']}" if vs else ""))
+    margin = None if args.describe else args.margin
+    vs = against(rows, base, args.method, args.baseline_method, margin) if base is not None else None
+    write_atomic(args.out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method))
+    print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict'] or 'described'}"
+                                               if vs else ""))
     return 0
 
 
