@@ -16,8 +16,8 @@ PROPOSED = Disc(5, 0, 1.0)
 FRESH = 99
 
 
-def _evaluator(search: tuple[float, float], fresh: tuple[float, float]):
-    """p of a leg into PROPOSED / into one of its subsets: ``search`` on the search's rollouts, ``fresh`` on seed
+def _evaluator(search: tuple[float, float], fresh: tuple[float, float], region=PROPOSED):
+    """p of a leg into ``region`` / into any other waypoint: ``search`` on the search's rollouts, ``fresh`` on seed
     FRESH (the leg after a waypoint is sure)."""
 
     class Ev(TableEvaluator):
@@ -25,8 +25,8 @@ def _evaluator(search: tuple[float, float], fresh: tuple[float, float]):
             self.calls.append((start, goal, seed))
             if goal.centre()[0] == 10:
                 return _Arrive(1.0, at=(10.0, 0.0))
-            proposed, subset = fresh if seed == FRESH else search
-            return _Arrive(proposed if goal == PROPOSED else subset, at=tuple(goal.centre()))
+            ours, other = fresh if seed == FRESH else search
+            return _Arrive(ours if goal == region else other, at=tuple(goal.centre()))
 
     return Ev(None)
 
@@ -96,18 +96,10 @@ FIRST, LATER = Disc(5, 0, 1.0), Disc(5, 1, 1.0)
 
 def _confirm_split(search: tuple[float, float], fresh: tuple[float, float], confirm: bool = True):
     """p of the leg into FIRST / into LATER: ``search`` on the search's rollouts, ``fresh`` on seed FRESH."""
-
-    class Ev(TableEvaluator):
-        def evaluate(self, start, goal, avoid, goal_point=None, seed=None):
-            self.calls.append((start, goal, seed))
-            if goal.centre()[0] == 10:
-                return _Arrive(1.0, at=(10.0, 0.0))
-            first, later = fresh if seed == FRESH else search
-            return _Arrive(first if goal == FIRST else later, at=tuple(goal.centre()))
-
     g = _chain_graph()
-    return edge_split(Ev(None), _Rounds(), _Query(g, "S", "G"), start=Box(-0.5, -0.5, 0.5, 0.5), w=1, d=2, k=3,
-                      rng=np.random.default_rng(0), tune=False, confirm_seed=FRESH if confirm else None)
+    return edge_split(_evaluator(search, fresh, region=FIRST), _Rounds(), _Query(g, "S", "G"),
+                      start=Box(-0.5, -0.5, 0.5, 0.5), w=1, d=2, k=3, rng=np.random.default_rng(0), tune=False,
+                      confirm_seed=FRESH if confirm else None)
 
 
 @pytest.mark.parametrize("fresh, kept", [((0.95, 0.80), FIRST), ((0.80, 0.95), LATER), ((0.90, 0.90), FIRST)])

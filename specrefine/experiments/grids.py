@@ -254,6 +254,15 @@ def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str
                           table=f"data/results/corrector/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
 
 
+def ant_oracle_grid(name: str, source: str, method: str, stem: str, code: str) -> ExperimentGrid:
+    """``method`` x the oracle on the Ant (issue 42): the U-chains, seeds 0-2 seed by seed, stage 5, adaptive
+    evaluation, centre goal points, into data/results/ant/STEM.csv."""
+    return ExperimentGrid(name, source, "ant", parts=(Part((method,), (GEOMETRIC_48,), split="seeds"),),
+                          seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt",
+                          evaluation="adaptive", goal_points="centre", workers=1, code=code,
+                          table=f"data/results/ant/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
+
+
 GRIDS = {g.name: g for g in (
     ExperimentGrid(
         "paper-sweep", "data/results/README.md, the point sweep (the paper's Figures 4-6)", "point",
@@ -438,24 +447,14 @@ GRIDS = {g.name: g for g in (
     ant_corrector_grid("ant-corrector-confirm", "docs/corrector.md, 'The Ant with a confirmed pick' (issue 39; fixed "
                        "2026-11-27 19:55 UTC before its first cell ran)", "ant_confirm", code="c463c3e",
                        method="ours-corrector-confirm"),
-    ExperimentGrid(
-        "ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed 2026-11-27 "
-        "13:45 UTC before its first cell ran)", "ant", parts=(Part(("ours",), (GEOMETRIC_48,), split="seeds"),),
-        seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", workers=1, code="e08c8b9", table="data/results/ant/oracle_spread.csv",
-        out="runs/ant_oracle_spread"),
-    ExperimentGrid(
-        "ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC before its "
-        "first cell ran): ant-oracle-spread's cells with ours-tunecheck", "ant",
-        parts=(Part(("ours-tunecheck",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
-        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code="9b8f8f7",
-        table="data/results/ant/oracle_tunecheck.csv", out="runs/ant_oracle_tunecheck"),
-    ExperimentGrid(
-        "ant-oracle-confirm", "docs/ant_experiments.md, 'Issue 42, lever 5' (fixed 2026-11-27 19:55 UTC before its "
-        "first cell ran): ant-oracle-spread's cells with ours-confirm", "ant",
-        parts=(Part(("ours-confirm",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
-        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", workers=1, code="c463c3e",
-        table="data/results/ant/oracle_confirm.csv", out="runs/ant_oracle_confirm"),
+    ant_oracle_grid("ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed "
+                    "2026-11-27 13:45 UTC before its first cell ran)", "ours", "oracle_spread", code="e08c8b9"),
+    ant_oracle_grid("ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC "
+                    "before its first cell ran): ant-oracle-spread's cells with ours-tunecheck", "ours-tunecheck",
+                    "oracle_tunecheck", code="9b8f8f7"),
+    ant_oracle_grid("ant-oracle-confirm", "docs/ant_experiments.md, 'Issue 42, lever 5' (fixed 2026-11-27 19:55 UTC "
+                    "before its first cell ran): ant-oracle-spread's cells with ours-confirm", "ours-confirm",
+                    "oracle_confirm", code="c463c3e"),
     ExperimentGrid(
         "ant-slow-turn", "docs/ant_experiments.md, 'Issue 42, lever 1', check 5 (fixed 2026-11-27 04:40 UTC before "
         "its first cell ran; started 06:22 by scripts/ant_switching_checks.sh PART=cells)", "ant",
