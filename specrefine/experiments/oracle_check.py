@@ -19,12 +19,11 @@ from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, rate_text
 from ..core.runfolder import write_atomic
 from .legs import pooled
-from .scaling import MAZES, ORACLE, SEEDS, flat_claim, read_rows
+from .scaling import MAZES, ORACLE, SEEDS, _runs, flat_claim, read_rows
 
 
 def _cells(rows, method: str) -> dict[tuple[str, int], dict]:
-    return {(r["maze"], int(r["seed"])): r for r in rows
-            if r["method"] == method and r["proposer"] == ORACLE and int(r["seed"]) in SEEDS}
+    return {(maze, int(r["seed"])): r for maze in MAZES for r in _runs(rows, maze, method, ORACLE)}
 
 
 def against(rows, base_rows, method: str, base_method: str, margin: float | None) -> dict:
@@ -40,10 +39,10 @@ def against(rows, base_rows, method: str, base_method: str, margin: float | None
 
     per_maze = {m: diff([c for c in common if c[0] == m]) for m in MAZES if any(c[0] == m for c in common)}
     total = diff(common) if common else None
-    complete = len(common) == len(MAZES) * len(SEEDS)
-    worst = min((v["difference"] for v in per_maze.values()), default=0.0)
     if margin is None:
         return {"total": total, "per_maze": per_maze, "verdict": None, "margin": None}
+    complete = len(common) == len(MAZES) * len(SEEDS)
+    worst = min((v["difference"] for v in per_maze.values()), default=0.0)
     adopted = total is not None and total["difference"] > 0 and worst >= -margin
     verdict = ("adopted" if adopted else "not adopted") if complete else \
         f"partial ({'adopted' if adopted else 'not adopted'} so far, {len(common)} of {len(MAZES) * len(SEEDS)} cells)"
