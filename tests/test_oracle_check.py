@@ -62,6 +62,18 @@ def test_the_command_writes_the_rule_and_the_comparison(tmp_path):
         oracle_check.main([str(tmp_path / "absent.csv"), "--out", str(out)])
 
 
+@pytest.mark.parametrize("out", ["/dev/null", "folder", "link"])
+def test_an_out_that_is_no_regular_file_is_refused_before_any_work(tmp_path, capsys, out):
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "target.md").write_text("kept\n")
+    (tmp_path / "link").symlink_to(tmp_path / "target.md")
+    table = _write(tmp_path / "t.csv", _grid("ours", 0.98))
+    with pytest.raises(SystemExit) as exit_:
+        oracle_check.main([table, "--out", out if out.startswith("/") else str(tmp_path / out)])
+    assert exit_.value.code == 2 and len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert (tmp_path / "target.md").read_text() == "kept\n"
+
+
 def test_a_described_comparison_has_no_rule(tmp_path):
     lever = _write(tmp_path / "now.csv", _grid("ours", 0.90))
     base = _write(tmp_path / "before.csv", _grid("ours", 0.95)[:21])

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, rate_text
-from ..core.runfolder import write_atomic
+from ..core.runfolder import write_atomic, writing_into
 from .legs import pooled
 from .scaling import MAZES, ORACLE, SEEDS, _runs, flat_claim, read_rows
 
@@ -109,14 +109,15 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
     try:
-        rows = read_rows([args.table])
-        base = read_rows([args.baseline]) if args.baseline else None
+        with writing_into(args.out) as out:  # checked before any work; a run folder's lock held while writing there
+            rows = read_rows([args.table])
+            base = read_rows([args.baseline]) if args.baseline else None
+            flat = flat_claim(rows, args.method, args.level, args.tolerance)
+            margin = None if args.describe else args.margin
+            vs = against(rows, base, args.method, args.baseline_method, margin) if base is not None else None
+            write_atomic(out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method))
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
-    flat = flat_claim(rows, args.method, args.level, args.tolerance)
-    margin = None if args.describe else args.margin
-    vs = against(rows, base, args.method, args.baseline_method, margin) if base is not None else None
-    write_atomic(args.out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method))
     print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict'] or 'described'}"
                                                if vs else ""))
     return 0
