@@ -269,24 +269,30 @@ def test_trim_is_judged_against_precise_not_the_corrector(tmp_path, rate, verdic
     assert f"Cost beside {cc.PRECISE}'s on the same cells" in md and f"| trim | {cc.PRECISE} | difference |" in md
 
 
-def test_the_ants_rules_read_the_spread_grid_with_the_cells_before_the_fix_beside(tmp_path):
+def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_their_pooled_difference(tmp_path):
     lay(tmp_path, rates)
     assert cc.ant_study(tmp_path) is None  # neither Ant grid has a cell
     lay_grid(tmp_path, cc.ANT_BEFORE, lambda maze, m, p: 0.8, drop=20)  # 7 cells of seed 0 ... as it stopped
     ant = cc.ant_study(tmp_path)
     rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant, "))
     assert rule["verdict"] == "not run yet" and cc.ANT_GRID in rule["value"]
-    assert cc._ant_text(ant) == (f"{cc.ANT_GRID}: no cell yet. {cc.ANT_BEFORE} (before the fix): u_chain_1 0.800 "
-                                 "(3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals 0.800 (1 run); below 0.85 on "
-                                 "3 of 3 mazes run")
+    assert cc._ant_text(ant) == (f"{cc.ANT_GRID} ({cc.ANT_METHOD}): no cell yet. {cc.ANT_BEFORE} (ours-corrector, "
+                                 "stopped): u_chain_1 0.800 (3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals "
+                                 "0.800 (1 run); below 0.85 on 3 of 3 mazes run. Difference on the cells both ran: "
+                                 "no cell in both yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant, "))
-    assert rule["verdict"] == "does not hold" and rule["value"].endswith(": u_chain_5")
+    assert ant["paired"]["cells"] == 7 and ant["paired"]["estimate"] == pytest.approx(0.1)
+    assert ant["paired"]["ci_low"] < 0.1 < ant["paired"]["ci_high"]
+    rules = [v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant")]
+    assert rules[0]["verdict"] == "does not hold" and rules[0]["value"].endswith(": u_chain_5")
+    assert rules[1]["rule"].startswith(f"Ant: {cc.ANT_METHOD} >= 2x")
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_5 | 3 | 0.840 [" in md and "| 1 | 0.800 |" in md and "| 0 | — |" in md
-    assert "below 0.85 on 1 of 9 mazes run" in cc._ant_text(ant)
+    assert f"{cc.ANT_METHOD} - ours-corrector on the cells both ran: +0.100 [" in md
+    text = cc._ant_text(ant)
+    assert "below 0.85 on 1 of 9 mazes run" in text and text.endswith("over 7 cells (Newcombe 95 %, pooled)")
 
 
 def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):

@@ -59,8 +59,11 @@ TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
 COST_CAP = 3.0
 POINT_SEEDS = GRIDS["corrector"].seeds
-ANT_GRID = "ant-corrector-spread"  # the Ant's rules read this grid (docs/corrector.md, "Chained estimates")
-ANT_BEFORE = "ant-corrector"  # the same cells before spread start states (stopped at 10 of 27): shown beside
+#: the Ant's rules read this grid and its method (docs/corrector.md, "The Ant with a confirmed pick")
+ANT_GRID, ANT_METHOD = "ant-corrector-confirm", "ours-corrector-confirm"
+#: the same cells with ours-corrector at the fixed code (stopped at 10 of 27): shown beside, cell for cell
+ANT_BEFORE = "ant-corrector-spread"
+ANT_FIRST = "ant-corrector"  # ours-corrector before spread start states (stopped at 10 of 27; ant.csv)
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
@@ -187,30 +190,49 @@ def table_name(maze: str) -> str:
 
 
 def ant_study(root: Path = ROOT) -> dict | None:
-    """The Ant's rules on ``ANT_GRID``, with ``ANT_BEFORE``'s cells (chained estimates drawn with replacement)
-    beside; None while neither has a cell."""
-    now, before = _ant_grid_study(ANT_GRID, root), _ant_grid_study(ANT_BEFORE, root)
+    """The Ant's rules on ``ANT_GRID`` (``ANT_METHOD``), with ``ANT_BEFORE``'s cells (ours-corrector) beside and
+    their pooled difference on the cells both ran; None while neither has a cell."""
+    now, before = _ant_grid_study(ANT_GRID, ANT_METHOD, root), _ant_grid_study(ANT_BEFORE, METHOD, root)
     if not any(e["runs"] for e in now["per_maze"] + before["per_maze"]):
         return None
-    return now | {"grid": ANT_GRID, "before": before["per_maze"]}
+    return now | {"grid": ANT_GRID, "method": ANT_METHOD, "before": before["per_maze"],
+                  "paired": _ant_paired(root)}
 
 
-def _ant_grid_study(grid: str, root: Path) -> dict:
+def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
     rows = load(GRIDS[grid].tables + (ANT_ONESHOT, ANT_ORACLE, ANT_ERRING), root)
     proposer = "imperfect:moderate"
     maze_rows = []
     for maze in SCALING_MAZES:
-        k, n, runs = episodes_of(rows, maze, METHOD, proposer, ANT_SEEDS)
+        k, n, runs = episodes_of(rows, maze, method, proposer, ANT_SEEDS)
         entry = {"maze": maze, "runs": runs, "success": k / n if n else math.nan}
         if n:
             entry["ci_low"], entry["ci_high"] = wilson_ci(k, n)
         maze_rows.append(entry)
     cells, failed = cmp.table_cells(rows, "ant")
-    ratios = [cmp.ratio_claim(as_ours(cells, METHOD), set(as_ours(dict.fromkeys(failed), METHOD)), proposer,
-                              ANT_SEEDS) | {"method": f"{METHOD} / vlm-oneshot"},
+    ratios = [cmp.ratio_claim(as_ours(cells, method), set(as_ours(dict.fromkeys(failed), method)), proposer,
+                              ANT_SEEDS) | {"method": f"{method} / vlm-oneshot"},
               cmp.ratio_claim(cells, failed, proposer, ANT_SEEDS) | {"method": "ours / vlm-oneshot"}]
-    return {"per_maze": maze_rows, "ratio": ratios, "costs": costs(rows, proposer, SCALING_MAZES, ANT_SEEDS),
-            "zero": zero_runs(rows, METHOD, proposer, SCALING_MAZES)}
+    return {"per_maze": maze_rows, "ratio": ratios,
+            "costs": costs(rows, proposer, SCALING_MAZES, ANT_SEEDS, first=method),
+            "zero": zero_runs(rows, method, proposer, SCALING_MAZES)}
+
+
+def _ant_paired(root: Path) -> dict:
+    """ANT_METHOD - ours-corrector (ANT_BEFORE) pooled over the cells both grids ran (Newcombe 95 %)."""
+    rows = load(GRIDS[ANT_GRID].tables + GRIDS[ANT_BEFORE].tables, root)
+    done = {(r["maze"], r["method"], r["seed"]): r for r in rows if cmp.is_done(r)}
+    both = [(done[(m, ANT_METHOD, s)], done[(m, METHOD, s)]) for m in SCALING_MAZES for s in ANT_SEEDS
+            if (m, ANT_METHOD, s) in done and (m, METHOD, s) in done]
+    counts = [(round(float(r["success_rate"]) * int(r["episodes"])), int(r["episodes"])) for pair in both
+              for r in pair]
+    k1, n1 = (sum(c[i] for c in counts[0::2]) for i in (0, 1))
+    k2, n2 = (sum(c[i] for c in counts[1::2]) for i in (0, 1))
+    out = {"cells": len(both), "estimate": math.nan, "ci_low": math.nan, "ci_high": math.nan}
+    if n1 and n2:
+        lo, hi = newcombe_ci(k1, n1, k2, n2)
+        out |= {"estimate": k1 / n1 - k2 / n2, "ci_low": lo, "ci_high": hi}
+    return out
 
 
 def levers_study(root: Path = ROOT) -> dict | None:
@@ -398,7 +420,7 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                     "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of {len(ant['per_maze'])})"
                     + (f": {', '.join(low)}" if low else ""), "verdict": _verdict(not low, complete)})
         ratio = ant["ratio"][0]
-        out.append({"rule": f"Ant: {METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
+        out.append({"rule": f"Ant: {ANT_METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                     "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
     return out
 
@@ -474,16 +496,17 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
             lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                          f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
     if ant:
-        lines += ["", f"The Ant (imperfect:moderate, stage 5, centre goal points): ours-corrector pooled per maze "
-                  f"(Wilson 95 %), grid `{ANT_GRID}`; beside it `{ANT_BEFORE}`, the same cells before a leg's start "
-                  "states were spread (docs/corrector.md, 'Chained estimates'; stopped there).", "",
+        lines += ["", f"The Ant (imperfect:moderate, stage 5, centre goal points): {ANT_METHOD} pooled per maze "
+                  f"(Wilson 95 %), grid `{ANT_GRID}`; beside it `{ANT_BEFORE}`, ours-corrector on the same cells "
+                  "(stopped at its 10; docs/corrector.md, 'The Ant with a confirmed pick'), described.", "",
                   f"| maze | runs | success [95 % CI] | {ANT_BEFORE}: runs | {ANT_BEFORE}: success |",
                   "|---|---|---|---|---|"]
         for e, old in zip(ant["per_maze"], ant["before"]):
             ci = f" [{e['ci_low']:.3f}, {e['ci_high']:.3f}]" if "ci_low" in e else ""
             lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} | {old['runs']} | "
                          f"{_num(old['success'])} |")
-        lines += ["", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
+        lines += ["", f"{ANT_METHOD} - ours-corrector on the cells both ran: {_ant_paired_text(ant['paired'])}.",
+                  "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
         lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
     if levers:
         lines += levers_markdown(levers)
@@ -675,8 +698,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
     their ``VARIANTS`` name)."""
     _known(variants)
-    grids = ("corrector", "taxonomy", "corrector-held-out", ANT_BEFORE, "corrector-levers",
-             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), ANT_GRID)
+    grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), ANT_BEFORE, ANT_GRID)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -725,13 +748,21 @@ def _known(variants: dict) -> None:
 
 
 def _ant_text(ant: dict) -> str:
-    """The Ant's cells per maze in ANT_GRID and, beside, in ANT_BEFORE."""
+    """The Ant's cells per maze in ANT_GRID and, beside, in ANT_BEFORE, with their pooled difference."""
     def cells(per_maze):
         ran = [e for e in per_maze if e["runs"]]
         low = sum(e["success"] < ANT_FLOOR for e in ran)
         return (", ".join(f"{e['maze']} {e['success']:.3f} ({e['runs']} run{'s' * (e['runs'] > 1)})" for e in ran)
                 + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
-    return f"{ANT_GRID}: {cells(ant['per_maze'])}. {ANT_BEFORE} (before the fix): {cells(ant['before'])}"
+    return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['per_maze'])}. {ANT_BEFORE} (ours-corrector, stopped): "
+            f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}")
+
+
+def _ant_paired_text(e: dict) -> str:
+    if not e["cells"]:
+        return "no cell in both yet"
+    return (f"{e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}] over {e['cells']} "
+            f"cell{'s' * (e['cells'] > 1)} (Newcombe 95 %, pooled)")
 
 
 def _levers_text(lv: dict) -> str:
