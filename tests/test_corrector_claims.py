@@ -188,10 +188,15 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
 
     from specrefine.experiments.grids import ROOT
 
-    readme = " ".join((ROOT / "README.md").read_text().split())
-    marked = dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", readme))
+    def marks(path):
+        text = " ".join((ROOT / path).read_text().split())
+        return dict(re.findall(r"<!-- front corrector ([\w-]+) -->(.*?)<!-- /front corrector \1 -->", text))
+
+    front_page, corrector_doc = marks("README.md"), marks("docs/corrector.md")
+    assert {"table", "ant"} <= set(front_page)
+    marked = front_page | corrector_doc
     assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
-            "trim", "ant", "spread", "recheck", "frugal", "retry", "thrift"} <= set(marked)
+            "trim", "ant", "spread", "recheck", "frugal", "retry", "thrift", "status"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), ant=cc.ant_study(),
                         **cc.variant_studies())
     for name, text in marked.items():
@@ -274,7 +279,7 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     assert cc.ant_study(tmp_path) is None  # neither Ant grid has a cell
     lay_grid(tmp_path, cc.ANT_BEFORE, lambda maze, m, p: 0.8, drop=20)  # 7 cells of seed 0 ... as it stopped
     ant = cc.ant_study(tmp_path)
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant, "))
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
     assert rule["verdict"] == "not run yet" and cc.ANT_GRID in rule["value"]
     assert cc._ant_text(ant) == (f"{cc.ANT_GRID} ({cc.ANT_METHOD}): no cell yet. {cc.ANT_BEFORE} (ours-corrector, "
                                  "stopped): u_chain_1 0.800 (3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals "
@@ -354,3 +359,36 @@ def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_maze
     assert "versus_ours" not in cc.variant_study(cc.PRECISE, tmp_path)  # no suite grid: no such rule
     assert f"every suite maze: below ours on 1 of 17 at mild ({below}), 1 of 17 at moderate ({below})" in \
         cc._variant_text(vs)
+
+
+def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
+    doc = tmp_path / "doc.md"
+    doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"
+                   "    <!-- front corrector table --><!-- /front corrector table -->\n")
+    cc.fill(doc, {"ant": "new", "table": "\n| a |\n|---|\n\n"})
+    assert doc.read_text() == ("- a <!-- front corrector ant -->new<!-- /front corrector ant -->.\n"
+                               "    <!-- front corrector table -->\n    | a |\n    |---|\n\n"
+                               "    <!-- /front corrector table -->\n")
+    before = doc.read_text()
+    with pytest.raises(cc.SpecrefineError, match="no text for the marker"):
+        cc.fill(doc, {"ant": "x"})
+    assert doc.read_text() == before  # nothing written
+
+
+def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_cells_and_the_ants(tmp_path):
+    lay(tmp_path, rates)
+    for part in (0, 1, 2):
+        lay_grid(tmp_path, cc.VARIANT_GRIDS[cc.LEAN], lambda maze, m, p: 0.96, calls_of=lambda m: 5, part=part)
+    lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9)
+    vs, point = cc.variant_study(cc.LEAN, tmp_path), cc.point_study(tmp_path)
+    table = cc.rules_table(vs, point, cc.ant_study(tmp_path))
+    lines = table.strip().splitlines()
+    assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
+    rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 2  # + the two held-out mixes + the Ant's two rules
+    assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
+    assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
+    assert rules[-2].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-1].startswith(f"Ant: {cc.ANT_METHOD}")
+    assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
+    assert cc.rules_table(None, point, None) == "not run yet"

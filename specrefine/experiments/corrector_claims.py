@@ -4,17 +4,21 @@
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
 and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
-alone), the corrector variants' grids and ``ant-corrector-spread`` (``ant-corrector`` beside it) with the Ant
-scaling grid's one-shot;
+alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corrector-spread`` beside it) with the
+Ant scaling grid's one-shot;
 writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
 rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
-marked partial.
+marked partial. ``--fill FILE ...`` also rewrites the ``<!-- front corrector NAME -->`` passages of those files
+(README.md, docs/corrector.md) from the same studies::
+
+    specrefine corrector-claims --out data/results/corrector --fill README.md docs/corrector.md
 """
 
 from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -54,6 +58,8 @@ VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT}
+REPORTED = "thrift"  # the variant README reports first (docs/corrector.md, "Within 3x"), by its VARIANTS name
+MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 ANT_FLOOR = 0.85
@@ -410,13 +416,13 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                              f" over {c['pairs']} pairs",
                     "verdict": _cost_verdict(c)})
     if ant and not any(e["runs"] for e in ant["per_maze"]):
-        out.append({"rule": f"Ant, imperfect:moderate: at least {ANT_FLOOR} on every maze",
+        out.append({"rule": f"Ant ({ANT_METHOD}), imperfect:moderate: at least {ANT_FLOOR} on every maze",
                     "value": f"{ANT_GRID}: no cell yet", "verdict": "not run yet"})
     elif ant:
         complete = all(e["runs"] == len(ANT_SEEDS) for e in ant["per_maze"])
         ran = [e for e in ant["per_maze"] if e["runs"]]
         low = [e["maze"] for e in ran if e["success"] < ANT_FLOOR]
-        out.append({"rule": f"Ant, imperfect:moderate: at least {ANT_FLOOR} on every maze",
+        out.append({"rule": f"Ant ({ANT_METHOD}), imperfect:moderate: at least {ANT_FLOOR} on every maze",
                     "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of {len(ant['per_maze'])})"
                     + (f": {', '.join(low)}" if low else ""), "verdict": _verdict(not low, complete)})
         ratio = ant["ratio"][0]
@@ -664,6 +670,9 @@ def add_arguments(p) -> None:
     p.description = __doc__.split("\n\n")[0]
     p.add_argument("--out", type=out_path, default=Path("data/results/corrector"),
                    help="folder for claims.md and claims.json (default: data/results/corrector)")
+    p.add_argument("--fill", type=Path, nargs="+", default=[], metavar="FILE",
+                   help="rewrite the '<!-- front corrector NAME -->' passages of these files (README.md, "
+                        "docs/corrector.md) from the same studies")
 
 
 def run(args, p) -> int:
@@ -678,11 +687,58 @@ def run(args, p) -> int:
             write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
             write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
             save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
+        for path in args.fill:
+            fill(path, record["front"])
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
     print(f"-> {args.out}/claims.md")
     return 0
+
+
+def fill(path: Path, texts: dict[str, str]) -> None:
+    """Rewrite every ``<!-- front corrector NAME -->`` passage of ``path`` with ``texts[NAME]`` (whole file, atomic;
+    a marker with no text is an error, and nothing is written). A text of several lines keeps the indentation of its
+    marker's line, so that a table stays inside its list item."""
+    source = path.read_text()
+    unknown = sorted({m.group(2) for m in MARKER.finditer(source)} - set(texts))
+    if unknown:
+        raise SpecrefineError(f"{path}: no text for the marker(s) {', '.join(unknown)}")
+
+    def text(m: re.Match) -> str:
+        line = source[source.rfind("\n", 0, m.start()) + 1:m.start()]
+        indent = line if not line.strip() else ""
+        body = re.sub(r"\n[ \t]+(?=\n)", "\n", texts[m.group(2)].replace("\n", "\n" + indent))
+        return m.group(1) + body + m.group(4)
+
+    with locked(path.parent):
+        write_atomic(path, MARKER.sub(text, source))
+
+
+def rules_table(variant: dict | None, point: dict, ant: dict | None) -> str:
+    """Issue 39's rules for the reported variant, the held-out cells it is described on, and the Ant's rules, as one
+    markdown table (README's front page)."""
+    if not variant:
+        return "not run yet"
+    method = variant["method"]
+    rows = [dict(v, rule=v["rule"].removeprefix(f"{method}, ")) for v in variant_verdicts(variant)]
+    order = [v for v in rows if "cost at most" not in v["rule"] and not v["rule"].startswith(method)]
+    order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
+    for mix in MIX_NAMES.values():
+        held = [e for e in variant["held_out"] if e["runs"] and e["mix"] == mix]
+        cost = next((c for c in variant.get("held_out_costs", []) if c["method"] == method
+                     and c["proposer"] == f"mix {mix}" and c["pairs"]), None)
+        if held and cost:
+            order.append({"rule": f"held out, mix {mix} ({len(held)} layouts, seeds {list(HELD_OUT_SEEDS)}): "
+                                  "success per layout; proposer calls, evaluations over ours",
+                          "value": f"{min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f}; "
+                                   f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, "
+                                   f"{_num(cost['evaluations_ratio'], '{:.2f}x')} over {cost['pairs']} pairs",
+                          "verdict": "described" + (f" (over {COST_CAP}x)" if _cost_verdict(cost) != "holds" else "")})
+    order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
+    table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
+    table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
+    return "\n" + "\n".join(table) + "\n\n"  # the markers on lines of their own, around the table
 
 
 def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
@@ -730,6 +786,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         study = variants.get(name)
         out[name] = ((_gated_text if name == "gated" else _variant_text)(study)) if study else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
+    out["table"] = rules_table(variants.get(REPORTED), point, ant)
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
