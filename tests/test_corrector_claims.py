@@ -392,3 +392,18 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     assert rules[-2].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-1].startswith(f"Ant: {cc.ANT_METHOD}")
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
+
+
+def test_corrector_claims_refuses_a_file_to_fill_that_is_missing_or_a_link_before_any_work(tmp_path, capsys):
+    import argparse
+
+    target = tmp_path / "real.md"
+    target.write_text("x")
+    (tmp_path / "link.md").symlink_to(target)
+    p = argparse.ArgumentParser(prog="specrefine corrector-claims")
+    cc.add_arguments(p)
+    for name in ("missing.md", "link.md"):
+        args = p.parse_args(["--out", str(tmp_path / "out"), "--fill", str(tmp_path / name)])
+        assert cc.run(args, p) == 2
+        assert "not a regular file" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists() and target.read_text() == "x"

@@ -676,6 +676,10 @@ def add_arguments(p) -> None:
 
 
 def run(args, p) -> int:
+    for path in args.fill:  # before any work: a file to fill is a regular file that exists
+        if not path.is_file() or path.is_symlink():
+            print(f"{p.prog}: error: --fill {path}: not a regular file", file=sys.stderr)
+            return 2
     try:
         point, ant, held_out = point_study(), ant_study(), held_out_study()
         levers = levers_study()
