@@ -20,6 +20,11 @@ EVENT_TEXT = {
     "refine-accept": "ACCEPT {kind} on {edge[0]} -> {edge[1]} (cost {cost:.2f} < {c_progress:.2f} - tau {tau:.2f})",
     "refine-declined": "decline {kind} on {edge[0]} -> {edge[1]} (cost {cost:.2f} vs {c_progress:.2f} - tau {tau:.2f})",
     "done": "done: path {path}, predicted success {predicted_success:.2f}",
+    "split-repaired": "repair the split of {edge[0]} -> {edge[1]}: {legs_repaired} leg(s) split again",
+    "correct-check": "check the path on fresh rollouts{pass_text}: p = {p:.3f} over {n_legs} legs",
+    "correct-leg": "correct leg {leg} ({edge[0]} -> {edge[1]}, fresh p {p_leg:.3f}, window {p_window:.3f}): "
+                   "tried {tried_text}; accepted {accepted_text}",
+    "correct-done": "correction done{pass_text}: p = {p:.3f} over {n_legs} legs (on the rollouts that chose them)",
 }
 
 
@@ -39,6 +44,12 @@ def describe(step: dict) -> str:
     detail = dict(step)
     if "candidates" in detail:
         detail["n_candidates"] = len(detail["candidates"])
+    if "probabilities" in detail:
+        detail["n_legs"] = len(detail["probabilities"])
+    detail["pass_text"] = f" (pass {detail['correct_pass']})" if "correct_pass" in detail else ""
+    if "tried" in detail:
+        detail["tried_text"] = ", ".join(f"{t['kind']} {t['p_window']:.3f}" for t in detail["tried"]) or "nothing"
+        detail["accepted_text"] = detail.get("accepted") or "none"
     try:
         return f"step {step['step']}: " + EVENT_TEXT[step["event"]].format(**detail)
     except (KeyError, IndexError, TypeError, ValueError):
