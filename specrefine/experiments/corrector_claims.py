@@ -728,21 +728,27 @@ def rules_table(variant: dict | None, point: dict, ant: dict | None) -> str:
     rows = [dict(v, rule=v["rule"].removeprefix(f"{method}, ")) for v in variant_verdicts(variant)]
     order = [v for v in rows if "cost at most" not in v["rule"] and not v["rule"].startswith(method)]
     order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
-    for mix in MIX_NAMES.values():
-        held = [e for e in variant["held_out"] if e["runs"] and e["mix"] == mix]
-        cost = next((c for c in variant.get("held_out_costs", []) if c["method"] == method
-                     and c["proposer"] == f"mix {mix}" and c["pairs"]), None)
-        if held and cost:
-            order.append({"rule": f"held out, mix {mix} ({len(held)} layouts, seeds {list(HELD_OUT_SEEDS)}): "
-                                  "success per layout; proposer calls, evaluations over ours",
-                          "value": f"{min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f}; "
-                                   f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, "
-                                   f"{_num(cost['evaluations_ratio'], '{:.2f}x')} over {cost['pairs']} pairs",
-                          "verdict": "described" + (f" (over {COST_CAP}x)" if _cost_verdict(cost) != "holds" else "")})
+    order += [row for mix in MIX_NAMES.values() if (row := _held_out_row(variant, mix))]
     order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
     table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
     table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
     return "\n" + "\n".join(table) + "\n\n"  # the markers on lines of their own, around the table
+
+
+def _held_out_row(variant: dict, mix: str) -> dict | None:
+    """The variant's held-out cells of one error mix as a described row: success per layout, cost over ours."""
+    method = variant["method"]
+    held = [e for e in variant["held_out"] if e["runs"] and e["mix"] == mix]
+    cost = next((c for c in variant.get("held_out_costs", []) if c["method"] == method
+                 and c["proposer"] == f"mix {mix}" and c["pairs"]), None)
+    if not (held and cost):
+        return None
+    return {"rule": f"held out, mix {mix} ({len(held)} layouts, seeds {list(HELD_OUT_SEEDS)}): success per layout; "
+                    "proposer calls, evaluations over ours",
+            "value": f"{min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f}; "
+                     f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, {_num(cost['evaluations_ratio'], '{:.2f}x')} "
+                     f"over {cost['pairs']} pairs",
+            "verdict": "described" + (f" (over {COST_CAP}x)" if _cost_verdict(cost) != "holds" else "")}
 
 
 def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
