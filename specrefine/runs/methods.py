@@ -241,6 +241,11 @@ register_method("ours-corrector-thrift", ours_variant(**CORRECTOR | THRIFT),
                 "beyond the paper: ours-corrector-recheck asking the proposer as ours-corrector-frugal does "
                 "(cheapest alternative first, one round per split) and only about legs with at least 6 of their 512 "
                 "fresh rollouts failed; a leg with fewer is only bypassed", colour="#0d47a1")
+register_method("ours-corrector-polish", ours_variant(**CORRECTOR | THRIFT | dict(polish_rollouts=512)),
+                "beyond the paper: ours-corrector-thrift polishing the found path before its correction: each inner "
+                "waypoint whose leg in fails at least twice in 512 fresh rollouts is narrowed by Algorithm 2 (k "
+                "subsets of its region) where that raises its two legs' product (ours-polish's step)",
+                colour="#4a148c")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
