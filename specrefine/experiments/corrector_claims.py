@@ -42,22 +42,24 @@ RECHECK = "ours-corrector-recheck"
 FRUGAL = "ours-corrector-frugal"
 RETRY = "ours-corrector-retry"
 THRIFT = "ours-corrector-thrift"
+POLISH = "ours-corrector-polish"
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
-                 FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift"}
+                 FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
+                 POLISH: "corrector-polish"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
-                     THRIFT: RECHECK}
+                     THRIFT: RECHECK, POLISH: THRIFT}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
-                 THRIFT: "corrector-thrift-suite"}
+                 THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT}
+            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH}
 REPORTED = "thrift"  # the variant README reports first (docs/corrector.md, "Within 3x"), by its VARIANTS name
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")

@@ -437,6 +437,10 @@ GRIDS = {g.name: g for g in (
                            code="093a937"),
     corrector_suite_grid("corrector-thrift-suite", "Within 3x: recheck asking less", "ours-corrector-thrift", "thrift",
                          code="093a937"),
+    corrector_variant_grid("corrector-polish", "Polished before corrected", "ours-corrector-polish", "polish",
+                           code="5123ff7"),
+    corrector_suite_grid("corrector-polish-suite", "Polished before corrected", "ours-corrector-polish", "polish",
+                         code="5123ff7"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
