@@ -100,7 +100,8 @@ def test_docs_choices_lists_every_departure_the_code_makes():
             if line.startswith("| ") and not line.startswith("| ---")][1:]  # the header row aside
     listed = {(agent, re.search(r"`(--[a-z-]+)`", setting).group(1)): (best, paper)
               for agent, setting, best, paper, _ in rows if agent != "point"}
-    flags = {"evaluation": "--evaluation", "goal_points": "--goal-points", "policy": "--policy"}
+    flags = {"evaluation": "--evaluation", "goal_points": "--goal-points", "policy": "--policy",
+             "split_pick": "--split-pick"}
     for name in AGENTS:
         best, paper = RunConfig(agent=name).resolved(), RunConfig(agent=name, preset="paper").resolved()
         for field, flag in flags.items():
@@ -119,8 +120,38 @@ def test_every_run_setting_reaches_a_sweep_cell():
     dests = {action.dest for action in sweep.parser()._actions}
     axes = {"method": "methods", "proposer": "proposers", "seed": "seeds", "spec": "specs"}
     assert [f.name for f in fields(RunConfig) if axes.get(f.name, f.name) not in dests] == []
-    assert sweep.OTHER_SETTINGS == ("switching",)  # named in the id when not its default; the rest have a place
+    assert sweep.OTHER_SETTINGS == ("split_pick", "switching")  # named in the id when not the paper's
     parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers", "geometric",
                                         "--agent", "ant", "--seeds", "0", "--switching", "slow-turn"])
     [cell] = sweep.cells_of(parsed)
     assert cell.config.switching == "slow-turn" and cell.id.endswith("__centre__switching-slow-turn")
+
+
+def test_the_split_pick_is_a_preset_setting_that_reaches_the_search_and_is_named_where_not_the_papers():
+    for name in AGENTS:
+        paper = RunConfig(agent=name, preset="paper").resolved()
+        assert paper.split_pick == PAPER.split_pick == "estimate" and not SearchConfig.from_run(paper).confirm_pick
+        assert "split_pick" not in paper.record()  # older folders' run.json stay valid
+    confirmed = RunConfig(agent="point", split_pick="confirmed").resolved()
+    assert SearchConfig.from_run(confirmed).confirm_pick and confirmed.record()["split_pick"] == "confirmed"
+    assert SearchConfig.from_run(RunConfig().resolved(), confirm_pick=True).confirm_pick  # a method's own wins
+    parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers", "geometric",
+                                        "--seeds", "0", "--split-pick", "confirmed"])
+    [cell] = sweep.cells_of(parsed)
+    assert cell.id.endswith("__s0__split_pick-confirmed")
+    [paper_cell] = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers",
+                                                             "geometric", "--seeds", "0", "--preset", "paper"]))
+    assert paper_cell.id == "u_maze__point__ours__geometric__s0"  # the id every older table holds
+
+
+def test_a_confirmed_split_pick_runs_ours_as_the_method_ours_confirm_does(tmp_path):
+    from specrefine.runs.pipeline import refine_maze
+
+    common = dict(agent="point", proposer="imperfect:moderate", seed=3, rollouts=8, episodes=16)
+    by_setting = refine_maze("u_chain_2", method="ours", split_pick="confirmed", out=tmp_path / "setting", **common)
+    by_method = refine_maze("u_chain_2", method="ours-confirm", out=tmp_path / "method", **common)
+    for key in ("path", "success_rate", "evaluations", "proposer_calls", "refinements"):
+        assert by_setting.data[key] == by_method.data[key], key
+    assert by_setting.data["split_pick"] == "confirmed" and by_method.data["split_pick"] == "estimate"
+    steps = (tmp_path / "setting" / "steps.jsonl").read_text()
+    assert '"confirm": {' in steps  # a later round's pick was confirmed here: the setting reached the split

@@ -23,12 +23,12 @@ def test_every_field_is_an_option(capsys):
     args = build_parser().parse_args(["refine", "u_maze", "--agent", "point", "--method", "symbolic", "--proposer",
                                       "random", "--spec", "a -> G", "--seed", "4", "--rollouts", "8", "--episodes",
                                       "9", "--policy", "scripted", "-w", "4", "-d", "1", "-k", "6", "--evaluation",
-                                      "adaptive", "--goal-points", "centre", "--switching", "slow-turn", "--preset",
-                                      "paper"])
+                                      "adaptive", "--goal-points", "centre", "--switching", "slow-turn",
+                                      "--split-pick", "confirmed", "--preset", "paper"])
     assert asdict(RunConfig.from_namespace(args)) == dict(
         agent="point", method="symbolic", proposer="random", spec="a -> G", seed=4, rollouts=8, episodes=9,
         policy="scripted", w=4, d=1, k=6, evaluation="adaptive", goal_points="centre", switching="slow-turn",
-        preset="paper")
+        split_pick="confirmed", preset="paper")
 
 
 def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_path, capsys):
@@ -36,7 +36,8 @@ def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_
                  "--out", str(tmp_path / "cli")]) == 0
     recorded = json.loads((tmp_path / "cli" / "result.json").read_text())["config"]
     assert recorded == {**asdict(DEFAULTS), "method": "dirl", "rollouts": 8, "episodes": 16, "k": 7,
-                        "evaluation": "fixed", "goal_points": "sampled", "policy": "shipped"}  # the preset's, resolved
+                        "evaluation": "fixed", "goal_points": "sampled", "policy": "shipped",
+                        "split_pick": "estimate"}  # the preset's, resolved
     data = refine_maze("u_maze", method="dirl", rollouts=8, episodes=16, k=7, out=tmp_path / "kw").data
     assert data["config"] == recorded
     with pytest.raises(TypeError):

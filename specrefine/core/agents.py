@@ -64,6 +64,7 @@ class Agent:
     default_evaluation: str = "fixed"  # subtask evaluation when none is asked for: "fixed" (the paper) or "adaptive"
     default_goal_points: str = "sampled"  # where a leg aims: "sampled" (the paper) or "centre"
     default_policy: str = "shipped"  # "shipped" (data/policies/NAME.pt) or the name of another shipped checkpoint
+    default_split_pick: str = "estimate"  # an edge split's pick: "estimate" (the paper) or "confirmed"
 
 
 AGENTS: dict[str, Agent] = {

@@ -15,6 +15,7 @@ class PaperSettings:
     episodes: int = 200  # fresh end-to-end episodes of the final measurement
     goal_points: str = "sampled"  # a leg aims at a point drawn in its goal vertex's set, a new one per rollout
     evaluation: str = "fixed"  # every subtask estimate on `rollouts` rollouts (no adaptive racing)
+    split_pick: str = "estimate"  # Algorithm 1 takes the candidate with the best estimate, from whatever round
 
 
 PAPER = PaperSettings()

@@ -58,6 +58,7 @@ class ExperimentGrid:
     evaluation: str | None = None  # None: the agent's default (the sweep's, not passed)
     goal_points: str | None = None  # None: what the pinned code defaulted to, the paper's sampled points (not passed)
     switching: str | None = None  # None: the pinned code's rule, the paper's at-region (not passed)
+    split_pick: str | None = None  # None: the pinned code's rule, the paper's best estimate (not passed)
     rollouts: int | None = None  # None: the sweep's default (not passed)
     episodes: int | None = None
     workers: int = 2
@@ -137,6 +138,8 @@ def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int
         common += ["--goal-points", g.goal_points]
     if g.switching:
         common += ["--switching", g.switching]
+    if g.split_pick:
+        common += ["--split-pick", g.split_pick]
     if (policy := _policy(g, part, root)) != "shipped":
         common += ["--policy", policy]
     for name, value in _budget(g).items():
@@ -172,7 +175,8 @@ def part_cells(g: ExperimentGrid, index: int, *, root: Path = ROOT) -> list[Cell
         mazes = axes["mazes"] if axes["mazes"] is not None else sorted(benchmark_mazes())
         cells += grid(mazes, axes["methods"], axes["proposers"], axes["seeds"], agent=g.agent,
                       evaluation=g.evaluation, policy=_recorded_policy(g, part, root),
-                      goal_points=g.goal_points or PAPER.goal_points, **_budget(g),
+                      goal_points=g.goal_points or PAPER.goal_points, split_pick=g.split_pick or PAPER.split_pick,
+                      **_budget(g),
                       **({"switching": g.switching} if g.switching else {}))
     return list(dict.fromkeys(cells))
 

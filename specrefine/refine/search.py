@@ -41,6 +41,7 @@ from .shortcut import add_shortcuts, shortcuts
 from .vertex import refine_chain
 
 EVALUATIONS = ("fixed", "adaptive")
+SPLIT_PICKS = ("estimate", "confirmed")  # the paper's pick (best estimate), or confirmed on fresh rollouts
 POLISH_SEED_OFFSET = 7919  # polishing draws its rollouts apart from the search's (and the measurement's) seeds
 TUNE_CHECK_SEED_OFFSET = 15_485_863  # the tuning check's fresh rollouts: apart from every other estimate's
 CONFIRM_SEED_OFFSET = 32_452_843  # the confirmation's fresh rollouts: apart from every other estimate's
@@ -97,6 +98,7 @@ class SearchConfig:
         seed and evaluation), with ``changes`` to any field; an unknown field is a one-line SpecrefineError."""
         check_changes(changes)
         taken = {name: getattr(run, name) for name in FROM_RUN}
+        taken["confirm_pick"] = getattr(run, "split_pick", None) == "confirmed"  # a method's own setting wins
         return cls(**{**taken, **changes})
 
 

@@ -2,7 +2,8 @@
 
 The defaults are the best measured settings (``preset="best"``: per agent, ``core.agents.Agent.default_*``);
 ``preset="paper"`` restores every rule of the paper they depart from (docs/choices.md, "Presets"). The settings a
-preset decides (``evaluation``, ``goal_points``, ``policy``) default to None, filled in by :meth:`RunConfig.resolved`.
+preset decides (``evaluation``, ``goal_points``, ``policy``, ``split_pick``) default to None, filled in by
+:meth:`RunConfig.resolved`.
 A sweep cell is a maze and a RunConfig, ``run.json`` is :meth:`RunConfig.record`, and every method's search
 settings are ``SearchConfig.from_run(config, **changes)``: a new run setting is a field here and the code that
 uses it.
@@ -77,6 +78,12 @@ def _goal_points() -> tuple[str, ...]:
     return GOAL_POINTS
 
 
+def _split_picks() -> tuple[str, ...]:
+    from ..refine.search import SPLIT_PICKS
+
+    return SPLIT_PICKS
+
+
 def _switching() -> tuple[str, ...]:
     from ..sim.switching import SWITCHING
 
@@ -131,12 +138,19 @@ class RunConfig:
                                          "entering the goal region, the paper's rule) or slow-turn (a leg that starts "
                                          "with the torso moving fast and turned away from its goal first brakes; "
                                          "beyond the paper, docs/ant_experiments.md section 6)", choices=_switching)
+    split_pick: str | None = option(None, "which of an edge split's candidates the search takes: estimate (the best "
+                                          "product of its estimates, whatever round it came from: the paper's "
+                                          "Algorithm 1) or confirmed (a later round's pick kept only if it beats the "
+                                          "first round's best on the same fresh rollouts; beyond the paper, "
+                                          "docs/ant_experiments.md 'lever 5')", choices=_split_picks,
+                                    shown="the preset's: best: estimate for point and ant; paper: estimate")
     preset: str = option("best", "what the settings left unset default to: best (the best measured settings, per "
                                  "agent) or paper (every rule of the paper they depart from: docs/choices.md, "
                                  "'Presets')", choices=lambda: PRESETS)
 
     def resolved(self) -> RunConfig:
-        """This configuration with what its preset decides filled in (``evaluation``, ``goal_points``, ``policy``):
+        """This configuration with what its preset decides filled in (``evaluation``, ``goal_points``, ``policy``,
+        ``split_pick``):
         the agent's ``default_*`` under ``best``, the paper's rules under ``paper`` (the policy is the agent's
         adopted one under either: the paper does not fix how its policy is trained)."""
         from ..core.agents import get_agent
@@ -148,16 +162,18 @@ class RunConfig:
         best = self.preset == "best"
         return replace(self, evaluation=self.evaluation or (agent.default_evaluation if best else PAPER.evaluation),
                        goal_points=self.goal_points or (agent.default_goal_points if best else PAPER.goal_points),
-                       policy=self.policy or agent.default_policy)
+                       policy=self.policy or agent.default_policy,
+                       split_pick=self.split_pick or (agent.default_split_pick if best else PAPER.split_pick))
 
     def to_dict(self) -> dict:
         return asdict(self)
 
     def record(self) -> dict:
         """What ``run.json`` records of this (resolved) configuration: a rerun into the folder with another record is
-        refused. Derived from the fields, with four rules that keep older folders' records valid: no proposer for a
+        refused. Derived from the fields, with five rules that keep older folders' records valid: no proposer for a
         method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not sampled,
-        ``switching`` only when not at-region; the preset is not recorded (what it decided is)."""
+        ``switching`` only when not at-region, ``split_pick`` only when not the paper's; the preset is not recorded
+        (what it decided is)."""
         from .methods import get_method
 
         data = {k: v for k, v in self.to_dict().items() if k != "preset"}
@@ -169,6 +185,8 @@ class RunConfig:
             del data["goal_points"]
         if data["switching"] == "at-region":
             del data["switching"]
+        if data["split_pick"] in (None, PAPER.split_pick):  # None: an unresolved configuration
+            del data["split_pick"]
         return data
 
     @classmethod

@@ -142,6 +142,7 @@ def _refine(exp, config: RunConfig, out: Path, t0: float, shown: RunProgress) ->
     data.update(prediction.to_dict())  # calibrated: held-out end-to-end episodes, Jeffreys posterior
     data["evaluation"], data["goal_points"] = config.evaluation, config.goal_points
     data["switching"] = config.switching  # when each leg's goal point is fed (sim.switching)
+    data["split_pick"] = config.split_pick  # which of an edge split's candidates the search takes
     data["policy"], data["policy_fingerprint"] = exp.policy_name, evaluator.policy_fingerprint  # which policy
     data["commit"] = code_commit()  # which code: the checkout's commit, "-dirty" if specrefine/ was edited
     data["spec"] = maze_spec_text(maze, config.spec)  # the task as an expression (the original: data["input_graph"])

@@ -133,7 +133,7 @@ class Cell:
                         if getattr(self, knob) != getattr(PAPER, knob))  # the paper's w, d, k: the id they had
         tail += "" if self.goal_points == PAPER.goal_points else f"__{self.goal_points}"
         tail += "".join(f"__{name}-{getattr(self, name)}" for name in OTHER_SETTINGS  # a later setting, when set
-                        if getattr(self, name) != getattr(DEFAULTS_RESOLVED[self.agent], name))
+                        if getattr(self, name) != getattr(PAPER_RESOLVED[self.agent], name))
         whole = self._id(name, spec_slug(self.spec), prop, tail)
         if len(whole.encode()) <= ID_LIMIT:  # every id a shipped table holds
             return whole
@@ -151,10 +151,11 @@ class Cell:
 _SETTINGS = frozenset(f.name for f in fields(RunConfig))
 #: in the cell id: the agent, method, proposer, seed and spec, then evaluation, w, d, k, goal_points as they always
 #: were; not in it: what OUT/sweep.json checks (PARAMS) and the preset (what it decides is); any other setting a
-#: RunConfig gains is named in the id whenever it differs from its default, with no change here
+#: RunConfig gains is named in the id whenever it differs from the paper's (what every older id ran), with no
+#: change here
 OTHER_SETTINGS = tuple(sorted(_SETTINGS - {"agent", "method", "proposer", "seed", "spec", "evaluation", *KNOBS,
                                           "goal_points", "rollouts", "episodes", "policy", "preset"}))
-DEFAULTS_RESOLVED = {name: RunConfig(agent=name).resolved() for name in AGENTS}
+PAPER_RESOLVED = {name: RunConfig(agent=name, preset="paper").resolved() for name in AGENTS}
 #: the settings a results row records, in the order of the table's columns
 ROW_SETTINGS = ("agent", "method", "proposer", "seed", "rollouts", "episodes", "spec", "evaluation", "policy", "w",
                 "d", "k", "goal_points")
