@@ -142,6 +142,10 @@ def test_the_split_pick_is_a_preset_setting_that_reaches_the_search_and_is_named
     [paper_cell] = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers",
                                                              "geometric", "--seeds", "0", "--preset", "paper"]))
     assert paper_cell.id == "u_maze__point__ours__geometric__s0"  # the id every older table holds
+    [dirl] = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "dirl", "--seeds", "0",
+                                                       "--split-pick", "confirmed"]))
+    assert dirl.id == "u_maze__point__dirl__none__s0"  # it splits no edge: nothing to name
+    assert "split_pick" not in RunConfig(method="dirl", split_pick="confirmed").resolved().record()
 
 
 def test_a_confirmed_split_pick_runs_ours_as_the_method_ours_confirm_does(tmp_path):

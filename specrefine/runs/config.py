@@ -170,15 +170,16 @@ class RunConfig:
 
     def record(self) -> dict:
         """What ``run.json`` records of this (resolved) configuration: a rerun into the folder with another record is
-        refused. Derived from the fields, with five rules that keep older folders' records valid: no proposer for a
-        method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not sampled,
-        ``switching`` only when not at-region, ``split_pick`` only when not the paper's; the preset is not recorded
-        (what it decided is)."""
+        refused. Derived from the fields, with five rules that keep older folders' records valid: no proposer (nor
+        split pick) for a method that asks none, ``evaluation`` only when not fixed, ``goal_points`` only when not
+        sampled, ``switching`` only when not at-region, ``split_pick`` only when not the paper's; the preset is not
+        recorded (what it decided is)."""
         from .methods import get_method
 
         data = {k: v for k, v in self.to_dict().items() if k != "preset"}
-        if not get_method(self.method).asks_proposer:
+        if not get_method(self.method).asks_proposer:  # nor does it split an edge
             data["proposer"] = None
+            data["split_pick"] = None
         if data["evaluation"] == PAPER.evaluation:
             del data["evaluation"]
         if data["goal_points"] == PAPER.goal_points:

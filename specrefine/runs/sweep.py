@@ -117,6 +117,10 @@ class Cell:
         return self.config.proposer if self.config.method in PROPOSER_METHODS else "none"
 
     @property
+    def split_pick(self) -> str:  # a method that splits no edge runs the paper's, whatever was asked
+        return self.config.split_pick if self.config.method in PROPOSER_METHODS else PAPER.split_pick
+
+    @property
     def spec(self) -> str:
         return self.config.spec or ""
 
