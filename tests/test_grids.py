@@ -90,8 +90,9 @@ def test_sweep_args_parse_back_to_the_grids_cells(name, tmp_path, monkeypatch):
         steps = grids.sweep_args(g, i, root=root)
         assert steps and all("--out" not in args for args in steps)
         # every grid is pinned to code from before the best-measured defaults: its sweep's defaults were the
-        # paper's goal points and the shipped policy, which today's sweep is told explicitly
-        then = ["--goal-points", "sampled"] if g.goal_points is None else []
+        # paper's goal points, split pick and the shipped policy, which today's sweep is told explicitly
+        then = (["--goal-points", "sampled"] if g.goal_points is None else []) + \
+            (["--split-pick", "estimate"] if g.split_pick is None else [])
         parsed = [c for args in steps for c in sweep.cells_of(sweep.parser().parse_args(
             args + then + ([] if "--policy" in args else ["--policy", "shipped"])))]
         assert list(dict.fromkeys(parsed)) == grids.part_cells(g, i, root=root)

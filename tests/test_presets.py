@@ -75,8 +75,8 @@ def test_a_sweep_cell_is_a_maze_and_a_run_config():
     cells = sweep.cells_of(parsed)
     assert all(isinstance(c.config, RunConfig) and c.config == c.config.resolved() for c in cells)
     ours = [c for c in cells if c.method == "ours"]
-    assert [c.id for c in ours] == ["u_maze__ant__ours__geometric__s0__adaptive__centre",
-                                    "u_maze__ant__ours__geometric__s0__adaptive__k7__centre"]
+    assert [c.id for c in ours] == ["u_maze__ant__ours__geometric__s0__adaptive__centre__split_pick-confirmed",
+                                    "u_maze__ant__ours__geometric__s0__adaptive__k7__centre__split_pick-confirmed"]
     assert {(c.config.goal_points, c.config.policy, c.k) for c in ours} == {("centre", "ant_stage5", 5),
                                                                              ("centre", "ant_stage5", 7)}
     (dirl,) = [c for c in cells if c.method == "dirl"]
@@ -124,7 +124,8 @@ def test_every_run_setting_reaches_a_sweep_cell():
     parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers", "geometric",
                                         "--agent", "ant", "--seeds", "0", "--switching", "slow-turn"])
     [cell] = sweep.cells_of(parsed)
-    assert cell.config.switching == "slow-turn" and cell.id.endswith("__centre__switching-slow-turn")
+    assert cell.config.switching == "slow-turn"
+    assert cell.id.endswith("__centre__split_pick-confirmed__switching-slow-turn")
 
 
 def test_the_split_pick_is_a_preset_setting_that_reaches_the_search_and_is_named_where_not_the_papers():

@@ -91,7 +91,9 @@ AGENTS: dict[str, Agent] = {
         # point mass keeps the paper's protocol, on which all its tables rest and where the rule was never run.
         # Centre goal points and stage 5 measured best on the Ant (docs/choices.md, "Presets"); the point mass
         # keeps the paper's rule and its one policy, where nothing else was measured.
-        default_evaluation="adaptive", default_goal_points="centre", default_policy="ant_stage5"),
+        # A confirmed split pick passed lever 5's rule on the oracle grid (docs/ant_experiments.md, "lever 5").
+        default_evaluation="adaptive", default_goal_points="centre", default_policy="ant_stage5",
+        default_split_pick="confirmed"),
 }
 
 

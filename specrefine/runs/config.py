@@ -143,7 +143,8 @@ class RunConfig:
                                           "Algorithm 1) or confirmed (a later round's pick kept only if it beats the "
                                           "first round's best on the same fresh rollouts; beyond the paper, "
                                           "docs/ant_experiments.md 'lever 5')", choices=_split_picks,
-                                    shown="the preset's: best: estimate for point and ant; paper: estimate")
+                                    shown="the preset's: best: estimate for point, confirmed for ant; paper: "
+                                          "estimate")
     preset: str = option("best", "what the settings left unset default to: best (the best measured settings, per "
                                  "agent) or paper (every rule of the paper they depart from: docs/choices.md, "
                                  "'Presets')", choices=lambda: PRESETS)
