@@ -288,8 +288,8 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
-    assert ant["paired"]["cells"] == 7 and ant["paired"]["estimate"] == pytest.approx(0.1)
-    assert ant["paired"]["ci_low"] < 0.1 < ant["paired"]["ci_high"]
+    assert ant["paired"]["cells"] == 7 and ant["paired"]["difference"] == pytest.approx(0.1)
+    assert ant["paired"]["ci"][0] < 0.1 < ant["paired"]["ci"][1]
     rules = [v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant")]
     assert rules[0]["verdict"] == "does not hold" and rules[0]["value"].endswith(": u_chain_5")
     assert rules[1]["rule"].startswith(f"Ant: {cc.ANT_METHOD} >= 2x")

@@ -227,20 +227,12 @@ def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
 
 
 def _ant_paired(root: Path) -> dict:
-    """ANT_METHOD - ours-corrector (ANT_BEFORE) pooled over the cells both grids ran (Newcombe 95 %)."""
-    rows = load(GRIDS[ANT_GRID].tables + GRIDS[ANT_BEFORE].tables, root)
-    done = {(r["maze"], r["method"], r["seed"]): r for r in rows if cmp.is_done(r)}
-    both = [(done[(m, ANT_METHOD, s)], done[(m, METHOD, s)]) for m in SCALING_MAZES for s in ANT_SEEDS
-            if (m, ANT_METHOD, s) in done and (m, METHOD, s) in done]
-    counts = [(round(float(r["success_rate"]) * int(r["episodes"])), int(r["episodes"])) for pair in both
-              for r in pair]
-    k1, n1 = (sum(c[i] for c in counts[0::2]) for i in (0, 1))
-    k2, n2 = (sum(c[i] for c in counts[1::2]) for i in (0, 1))
-    out = {"cells": len(both), "estimate": math.nan, "ci_low": math.nan, "ci_high": math.nan}
-    if n1 and n2:
-        lo, hi = newcombe_ci(k1, n1, k2, n2)
-        out |= {"estimate": k1 / n1 - k2 / n2, "ci_low": lo, "ci_high": hi}
-    return out
+    """ANT_METHOD - ours-corrector (ANT_BEFORE) pooled over the cells both grids ran (``levers.lever_check``)."""
+    from .levers import lever_check
+
+    rows = [r for r in load(GRIDS[ANT_GRID].tables + GRIDS[ANT_BEFORE].tables, root) if cmp.is_done(r)]
+    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m} for m in (ANT_METHOD, METHOD)}
+    return lever_check(by[ANT_METHOD], by[METHOD], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
 
 
 def levers_study(root: Path = ROOT) -> dict | None:
@@ -830,7 +822,8 @@ def _ant_text(ant: dict) -> str:
 def _ant_paired_text(e: dict) -> str:
     if not e["cells"]:
         return "no cell in both yet"
-    return (f"{e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}] over {e['cells']} "
+    lo, hi = e["ci"]
+    return (f"{e['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] over {e['cells']} "
             f"cell{'s' * (e['cells'] > 1)} (Newcombe 95 %, pooled)")
 
 
