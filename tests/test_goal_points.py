@@ -84,13 +84,13 @@ def test_a_centre_run_records_the_rule_and_its_policy_aims_at_the_centres(tmp_pa
     assert len(points) == len(expected) and all(np.allclose(p, e) for p, e in zip(points, expected))
     # the paper's rule into the same folder is another run: refused, the folder left alone
     with pytest.raises(SpecrefineError):
-        refine_maze("u_chain_1", RunConfig(agent="point", method="ours", **TINY), out=out)
+        refine_maze("u_chain_1", RunConfig(agent="point", method="ours", preset="paper", **TINY), out=out)
     assert json.loads((out / "result.json").read_text())["config"]["goal_points"] == "centre"
 
 
 def test_a_sampled_run_keeps_the_records_it_always_had(tmp_path):
     out = tmp_path / "run"
-    refine_maze("u_maze", RunConfig(agent="point", method="dirl", **TINY), out=out)
+    refine_maze("u_maze", RunConfig(agent="point", method="dirl", preset="paper", **TINY), out=out)
     assert "goal_points" not in json.loads((out / "run.json").read_text())
 
 
@@ -112,7 +112,7 @@ def test_a_given_evaluator_with_the_other_rule_is_refused():
 
 def test_sweep_cells_name_the_rule_and_old_tables_refuse_it(tmp_path):
     (cell,) = sweep.grid(["u_maze"], ["dirl"], ["none"], [0], goal_points="centre")
-    (paper,) = sweep.grid(["u_maze"], ["dirl"], ["none"], [0])
+    (paper,) = sweep.grid(["u_maze"], ["dirl"], ["none"], [0], preset="paper")
     assert cell.id == paper.id + "__centre" and cell.config.goal_points == "centre"
     table = tmp_path / "old.csv"
     table.write_text(",".join(c for c in sweep.COLUMNS if c != "goal_points") + "\n")

@@ -16,8 +16,8 @@ from specrefine.runs.pipeline import METHODS, PROPOSER_METHODS, refine_maze
 SMALL = dict(agent="point", rollouts=8, episodes=20, seed=0)
 
 
-def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2"):
-    result = refine_maze(maze, method=method, proposer=proposer, out=tmp_path / method, **SMALL)
+def run(tmp_path, method, proposer="imperfect:mild", maze="u_chain_2", **settings):
+    result = refine_maze(maze, method=method, proposer=proposer, out=tmp_path / method, **SMALL, **settings)
     steps = [json.loads(line) for line in (tmp_path / method / "steps.jsonl").read_text().splitlines()]
     return result.data, steps
 
@@ -38,9 +38,10 @@ def test_the_built_in_methods_are_registered_with_what_they_are():
 
 
 def test_controls_of_ours(tmp_path):
-    full, full_steps = run(tmp_path, "ours")
-    novertex, nv_steps = run(tmp_path, "ours-novertex")
-    d1, d1_steps = run(tmp_path, "ours-d1")
+    # sampled goal points (the paper's): with centre points ours asks no follow-up round here
+    full, full_steps = run(tmp_path, "ours", preset="paper")
+    novertex, nv_steps = run(tmp_path, "ours-novertex", preset="paper")
+    d1, d1_steps = run(tmp_path, "ours-d1", preset="paper")
     assert not any(s["event"] == "vertex-generated" for s in nv_steps)
     rounds = {c["round"] for s in d1_steps if s["event"] == "split-generated" for c in s["candidates"]}
     assert rounds == {0}  # rounds count from 0: no follow-up
@@ -50,9 +51,10 @@ def test_controls_of_ours(tmp_path):
 
 
 def _search_steps(tmp_path, method):
-    """The issue's reproduction: u_chain_2, imperfect:mild, seed 1, 16 rollouts (later rounds tuned there)."""
+    """The issue's reproduction: u_chain_2, imperfect:mild, seed 1, 16 rollouts (later rounds tuned there), at the
+    paper's sampled goal points."""
     refine_maze("u_chain_2", agent="point", method=method, proposer="imperfect:mild", seed=1, rollouts=16,
-                episodes=20, out=tmp_path / method)
+                episodes=20, preset="paper", out=tmp_path / method)
     steps = [json.loads(line) for line in (tmp_path / method / "steps.jsonl").read_text().splitlines()]
     candidates = [c for s in steps if s["event"] == "split-generated" for c in s["candidates"]]
     return {"vertex": sum(s["event"] == "vertex-generated" for s in steps),

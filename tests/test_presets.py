@@ -31,9 +31,11 @@ def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules(
     assert (best.evaluation, best.goal_points, best.policy) == ("adaptive", "centre", "ant_stage5")
     assert (paper.evaluation, paper.goal_points, paper.policy) == ("fixed", "sampled", "ant_stage5")
     assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
-    point = resolved()
-    assert replace(resolved("--preset", "paper"), preset="best") == point  # the point mass: the same settings
-    assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "sampled", "shipped")
+    point, point_paper = resolved(), resolved("--preset", "paper")
+    # the point mass: the same settings but the goal points (centre since grid corrector-centre)
+    assert replace(point_paper, preset="best", goal_points="centre") == point
+    assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "centre", "shipped")
+    assert (point_paper.evaluation, point_paper.goal_points, point_paper.policy) == ("fixed", "sampled", "shipped")
     explicit = resolved("--agent", "ant", "--preset", "paper", "--goal-points", "centre", "--policy", "shipped")
     assert (explicit.goal_points, explicit.policy, explicit.evaluation) == ("centre", "shipped", "fixed")
     with pytest.raises(SystemExit):
@@ -45,10 +47,14 @@ def test_a_run_records_its_preset_and_official_prints_it(tmp_path, capsys):
     assert main(["refine", "split_doorway", *TINY, "--out", str(out)]) == 0
     assert "preset=best" in capsys.readouterr().out
     data = json.loads((out / "result.json").read_text())
-    assert data["preset"] == "best" and data["config"]["goal_points"] == "sampled"
+    assert data["preset"] == "best" and data["config"]["goal_points"] == "centre"
     assert data["config"]["evaluation"] == "fixed" and data["config"]["policy"] == "shipped"
-    # the point mass's presets are the same settings: the folder takes the rerun (run.json records what runs)
-    assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--out", str(out)]) == 0
+    # the point mass's presets differ in the goal points only: run.json records what runs, so the paper's
+    # preset is another run (refused), and with centre points the same one (the folder takes the rerun)
+    assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--out", str(out)]) == 2
+    assert "holds another run" in capsys.readouterr().err
+    assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--goal-points", "centre", "--out",
+                 str(out)]) == 0
     assert json.loads((out / "result.json").read_text())["preset"] == "paper"
     capsys.readouterr()
     assert main(["official", str(out), "--episodes", "2"]) == 0
@@ -99,7 +105,7 @@ def test_docs_choices_lists_every_departure_the_code_makes():
     rows = [[c.strip() for c in line.split("|")[1:-1]] for line in table.splitlines()
             if line.startswith("| ") and not line.startswith("| ---")][1:]  # the header row aside
     listed = {(agent, re.search(r"`(--[a-z-]+)`", setting).group(1)): (best, paper)
-              for agent, setting, best, paper, _ in rows if agent != "point"}
+              for agent, setting, best, paper, _ in rows if re.search(r"`--[a-z-]+`", setting)}  # not "any other"
     flags = {"evaluation": "--evaluation", "goal_points": "--goal-points", "policy": "--policy",
              "split_pick": "--split-pick"}
     for name in AGENTS:
@@ -137,14 +143,14 @@ def test_the_split_pick_is_a_preset_setting_that_reaches_the_search_and_is_named
     assert SearchConfig.from_run(confirmed).confirm_pick and confirmed.record()["split_pick"] == "confirmed"
     assert SearchConfig.from_run(RunConfig().resolved(), confirm_pick=True).confirm_pick  # a method's own wins
     parsed = sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers", "geometric",
-                                        "--seeds", "0", "--split-pick", "confirmed"])
+                                        "--seeds", "0", "--split-pick", "confirmed", "--preset", "paper"])
     [cell] = sweep.cells_of(parsed)
     assert cell.id.endswith("__s0__split_pick-confirmed")
     [paper_cell] = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "ours", "--proposers",
                                                              "geometric", "--seeds", "0", "--preset", "paper"]))
     assert paper_cell.id == "u_maze__point__ours__geometric__s0"  # the id every older table holds
     [dirl] = sweep.cells_of(sweep.parser().parse_args(["--mazes", "u_maze", "--methods", "dirl", "--seeds", "0",
-                                                       "--split-pick", "confirmed"]))
+                                                       "--split-pick", "confirmed", "--preset", "paper"]))
     assert dirl.id == "u_maze__point__dirl__none__s0"  # it splits no edge: nothing to name
     assert "split_pick" not in RunConfig(method="dirl", split_pick="confirmed").resolved().record()
 
@@ -152,7 +158,8 @@ def test_the_split_pick_is_a_preset_setting_that_reaches_the_search_and_is_named
 def test_a_confirmed_split_pick_runs_ours_as_the_method_ours_confirm_does(tmp_path):
     from specrefine.runs.pipeline import refine_maze
 
-    common = dict(agent="point", proposer="imperfect:moderate", seed=3, rollouts=8, episodes=16)
+    # sampled goal points (the paper's): with centre points no later round's pick is confirmed on this cell
+    common = dict(agent="point", proposer="imperfect:moderate", seed=3, rollouts=8, episodes=16, preset="paper")
     by_setting = refine_maze("u_chain_2", method="ours", split_pick="confirmed", out=tmp_path / "setting", **common)
     by_method = refine_maze("u_chain_2", method="ours-confirm", out=tmp_path / "method", **common)
     for key in ("path", "success_rate", "evaluations", "proposer_calls", "refinements"):

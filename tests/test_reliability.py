@@ -79,7 +79,7 @@ def test_sweep_runs_maze_files_from_their_path(tmp_path, capsys):
     (elsewhere / "my_room.maze").write_text(ROOM)  # a name data/mazes does not have
     out = tmp_path / "s"
     code = sweep.main(["--mazes", str(elsewhere / "u_maze.maze"), str(elsewhere / "my_room.maze"), "u_maze",
-                       "--out", str(out), *SWEEP])
+                       "--out", str(out), *SWEEP, "--preset", "paper"])  # the paper's: ids without a suffix
     rows = {r["maze"]: r for r in sweep.read_table(out / "results.csv")}
     assert code == 0, capsys.readouterr().err
     assert set(rows) == {str(elsewhere / "u_maze.maze"), str(elsewhere / "my_room.maze"), "u_maze"}
@@ -115,7 +115,7 @@ def test_sweep_redoes_a_truncated_ok_row(tmp_path):
     out.mkdir()
     cell = "u_maze__point__dirl__none__s0"
     (out / "results.csv").write_text(",".join(sweep.COLUMNS) + f"\r\n{cell},u_maze,point,dirl,none,False,0,ok")
-    assert sweep.main(["--mazes", "u_maze", "--out", str(out), *SWEEP]) == 0
+    assert sweep.main(["--mazes", "u_maze", "--out", str(out), *SWEEP, "--preset", "paper"]) == 0
     (row,) = sweep.read_table(out / "results.csv")  # one row per cell, complete
     assert row["cell"] == cell and sweep.is_done(row) and 0 <= row["success_rate"] <= 1
 

@@ -36,7 +36,7 @@ def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_
                  "--out", str(tmp_path / "cli")]) == 0
     recorded = json.loads((tmp_path / "cli" / "result.json").read_text())["config"]
     assert recorded == {**asdict(DEFAULTS), "method": "dirl", "rollouts": 8, "episodes": 16, "k": 7,
-                        "evaluation": "fixed", "goal_points": "sampled", "policy": "shipped",
+                        "evaluation": "fixed", "goal_points": "centre", "policy": "shipped",
                         "split_pick": "estimate"}  # the preset's, resolved
     data = refine_maze("u_maze", method="dirl", rollouts=8, episodes=16, k=7, out=tmp_path / "kw").data
     assert data["config"] == recorded

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pytest
 
+from specrefine.core.tables import goal_points_of
 from specrefine.evaluation import evaluator
 from specrefine.runs.pipeline import refine_maze
 
@@ -39,7 +40,8 @@ def test_rerun_reproduces_the_shipped_row(table, cell, tmp_path, monkeypatch):
     row = _shipped(table, cell)
     got = refine_maze(row["maze"], agent=row["agent"], method=row["method"], proposer=row["proposer"],
                       seed=int(row["seed"]), out=tmp_path, rollouts=int(row["rollouts_per_evaluation"]),
-                      episodes=int(row["episodes"])).data
+                      episodes=int(row["episodes"]),
+                      goal_points=goal_points_of(row)).data  # the row's own rule: sampled where it names none
     for key in EXACT:
         if key == "sim_steps" and cell in FEWER_STEPS:
             assert got[key] < int(row[key])

@@ -193,9 +193,10 @@ def test_refine_with_a_spec_records_it(tmp_path, capsys):
 
 
 def test_cell_ids_carry_the_spec_only_when_given():
-    plain = Cell.of("u_maze", "point", "dirl", "none", 0)
+    plain = Cell.of("u_maze", "point", "dirl", "none", 0, preset="paper")  # the paper's: no suffix
     assert plain.id == "u_maze__point__dirl__none__s0" and plain.spec == ""
-    cells = grid(["two_doors"], ["dirl"], ["geometric"], [0], specs=[None, "(a | b) -> c -> G", "b -> c -> G"])
+    cells = grid(["two_doors"], ["dirl"], ["geometric"], [0], specs=[None, "(a | b) -> c -> G", "b -> c -> G"],
+                 preset="paper")
     ids = [c.id for c in cells]
     assert ids[0] == "two_doors__point__dirl__none__s0"
     assert ids[1] == "two_doors__Pa-or-bQ-then-c-then-G__point__dirl__none__s0"

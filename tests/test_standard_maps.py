@@ -106,7 +106,7 @@ def test_cli_unknown_standard_map_exits_2_with_one_line(tmp_path, capsys):
 
 
 def test_sweep_runs_a_standard_map(tmp_path):
-    cells = grid(["gr:U_MAZE"], ["dirl"], ["geometric"], [0], agent="point", rollouts=8, episodes=16)
+    cells = grid(["gr:U_MAZE"], ["dirl"], ["geometric"], [0], agent="point", rollouts=8, episodes=16, preset="paper")
     assert cells[0].id == "gr-U_MAZE__point__dirl__none__s0"
     (row,) = read_table(run_sweep(cells, tmp_path, workers=1))
     assert row["status"] == "ok" and row["maze"] == "gr:U_MAZE" and row["episodes"] == 16

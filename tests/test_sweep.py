@@ -211,7 +211,7 @@ def test_pinned_sweep_runs_the_commits_code_and_ships_done_rows(tmp_path, layout
 def test_w_d_k_are_grid_axes_and_the_paper_values_keep_their_ids(tmp_path):
     from specrefine.runs.sweep import Cell, _append, pending
 
-    cells = grid(["u_maze"], ["ours", "symbolic", "dirl"], ["geometric"], [0], w=[3, 5], k=[5, 10])
+    cells = grid(["u_maze"], ["ours", "symbolic", "dirl"], ["geometric"], [0], w=[3, 5], k=[5, 10], preset="paper")
     ids = sorted(c.id for c in cells)
     assert ids == sorted(["u_maze__point__ours__geometric__s0", "u_maze__point__ours__geometric__s0__w5",
                           "u_maze__point__ours__geometric__s0__k10", "u_maze__point__ours__geometric__s0__w5__k10",

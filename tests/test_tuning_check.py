@@ -62,12 +62,13 @@ def test_the_check_costs_two_fresh_chains_and_is_skipped_when_nothing_was_tuned(
 
 
 def test_ours_tunecheck_logs_each_check_and_differs_from_ours_only_there(tmp_path):
-    """u_chain_2, imperfect:mild, seed 1, 16 rollouts (later rounds are tuned there): each tuned candidate of
-    ours-tunecheck carries its check in steps.jsonl; the search is ours' up to its first checked split."""
+    """u_chain_2, imperfect:mild, seed 1, 16 rollouts, sampled goal points (later rounds are tuned there): each tuned
+    candidate of ours-tunecheck carries its check in steps.jsonl; the search is ours' up to its first checked
+    split."""
     steps = {}
     for method in ("ours", "ours-tunecheck"):
         refine_maze("u_chain_2", agent="point", method=method, proposer="imperfect:mild", seed=1, rollouts=16,
-                    episodes=20, out=tmp_path / method)
+                    episodes=20, preset="paper", out=tmp_path / method)
         steps[method] = [json.loads(line) for line in (tmp_path / method / "steps.jsonl").read_text().splitlines()]
     splits = {m: [s for s in steps[m] if s["event"] == "split-generated"] for m in steps}
     checked = [c for s in splits["ours-tunecheck"] for c in s["candidates"] if "check" in c]
@@ -120,9 +121,10 @@ def test_nothing_is_confirmed_when_the_first_round_wins_or_never_succeeded():
 
 
 def test_ours_confirm_logs_each_confirmation(tmp_path):
-    """u_chain_2, imperfect:mild, seed 1, 16 rollouts: a confirmed split logs both fresh products and the pick."""
+    """u_chain_2, imperfect:mild, seed 1, 16 rollouts, sampled goal points: a confirmed split logs both fresh
+    products and the pick."""
     refine_maze("u_chain_2", agent="point", method="ours-confirm", proposer="imperfect:mild", seed=1, rollouts=16,
-                episodes=20, out=tmp_path)
+                episodes=20, preset="paper", out=tmp_path)
     steps = [json.loads(line) for line in (tmp_path / "steps.jsonl").read_text().splitlines()]
     confirmed = [s["confirm"] for s in steps if s["event"] == "split-generated" and "confirm" in s]
     assert confirmed
