@@ -132,7 +132,7 @@ class RunConfig:
                                      "search, the measurement and the calibration alike: sampled (a point drawn in "
                                      "the goal region per rollout, the paper's rule) or centre (the goal region's "
                                      "centre in every rollout; beyond the paper)", choices=_goal_points,
-                                     shown="the preset's: best: sampled for point, centre for ant; paper: sampled")
+                                     shown="the preset's: best: centre; paper: sampled")
     switching: str = option("at-region", "when a leg's policy is fed the next goal point, in the search, the "
                                          "measurement, the calibration and the saved policy alike: at-region (on "
                                          "entering the goal region, the paper's rule) or slow-turn (a leg that starts "
