@@ -111,13 +111,26 @@ def lay_grid(root, name, rate_of, calls_of=lambda m: 3, seeds=None, part=0, drop
     """A grid's part table under ``root``: rate_of(maze, method, proposer) per cell (the last ``drop`` rows left
     out), each maze named as a sweep's table names it."""
     g = GRIDS[name]
-    p = g.parts[part]
-    cost = {"evaluations": 10, "sim_steps": 1000}
-    rows = [row(cc.table_name(maze), m, rate_of(maze, m, pr), s, pr) | cost | {"proposer_calls": calls_of(m)}
-            for maze in (p.mazes or g.mazes) for m in p.methods for pr in p.proposers for s in (p.seeds or g.seeds)]
+    rows = part_rows(g, g.parts[part], rate_of, calls_of)
     path = root / g.part_table(part)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_csv(path, rows[:len(rows) - drop])
+
+
+def part_rows(g, p, rate_of, calls_of) -> list[dict]:
+    cost = {"evaluations": 10, "sim_steps": 1000}
+    return [row(cc.table_name(maze), m, rate_of(maze, m, pr), s, pr) | cost | {"proposer_calls": calls_of(m)}
+            for maze in (p.mazes or g.mazes) for m in p.methods for pr in p.proposers for s in (p.seeds or g.seeds)]
+
+
+def lay_all_parts(root, name, rate_of, calls_of=lambda m: 3):
+    """Every part of a grid, the parts that share a table written into it together."""
+    g, tables = GRIDS[name], {}
+    for i, p in enumerate(g.parts):
+        tables.setdefault(g.part_table(i), []).extend(part_rows(g, p, rate_of, calls_of))
+    for path, rows in tables.items():
+        (root / path).parent.mkdir(parents=True, exist_ok=True)
+        write_csv(root / path, rows)
 
 
 LEVER_RATES = {"ours-deeprepair": 0.8, "ours-feasible": 0.6, "ours-checked": 0.97}
@@ -359,6 +372,37 @@ def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_maze
     assert "versus_ours" not in cc.variant_study(cc.PRECISE, tmp_path)  # no suite grid: no such rule
     assert f"every suite maze: below ours on 1 of 17 at mild ({below}), 1 of 17 at moderate ({below})" in \
         cc._variant_text(vs)
+
+
+CENTRE_RATES = {"ours-corrector-polish": 0.99, "ours-repair": 0.7, "vlm-oneshot": 0.8}
+
+
+def centre_rate(maze, method, proposer):
+    return 1.0 if proposer == "geometric" else CENTRE_RATES.get(method, 0.9)
+
+
+def test_the_centre_variant_is_judged_with_its_own_grids_references_and_against_polish(tmp_path):
+    """corrector-centre runs polish, the oracle, ours, ours-repair and the one-shot at centre goal points: the
+    variant's rules read those rows only (never the taxonomy and corrector grids', at the paper's sampled points),
+    its paired rule reads polish's own grid, and its held-out cells come from its suite grid."""
+    lay(tmp_path, rates)  # sampled points: oracle 0.99, ours 0.6, the one-shot 0.3
+    for part in (0, 1):
+        lay_grid(tmp_path, "corrector-polish", lambda maze, m, p: 0.96, part=part)
+    lay_all_parts(tmp_path, "corrector-centre", centre_rate)
+    lay_all_parts(tmp_path, "corrector-centre-suite", centre_rate)
+    vs = cc.variant_study(cc.CENTRE, tmp_path)
+    assert vs["reference"] == cc.POLISH and vs["versus_corrector"]["estimate"] == pytest.approx(0.03)
+    assert all(e["reference_success"] == pytest.approx(1.0) and e["runs"] == 4 for e in vs["per_maze"])
+    assert all(e["reference_success"] == pytest.approx(0.9) for e in vs["versus_ours"])
+    assert [e["maze"] for e in vs["versus_ours"][:17]] == list(SCALING_MAZES + OTHER_POINT_MAZES)
+    ratio = {e["proposer"]: e for e in vs["ratio"]}
+    assert ratio["imperfect:mild"]["estimate"] == pytest.approx(0.99 / 0.8)  # the one-shot at centre points
+    assert vs["severe_vs_repair"]["estimate"] == pytest.approx(0.29)
+    held = vs["held_out"]
+    assert len(held) == 12 and all(e["success"] == pytest.approx(0.99) and e["ours"] == pytest.approx(0.9)
+                                   and e["reference_success"] == pytest.approx(0.96) for e in held)
+    assert vs["oracle_versus_paper"]["estimate"] == pytest.approx(0.01) and vs["oracle_versus_paper"]["n_cells"] == 36
+    assert "ours at its grids' code and settings" in "\n".join(cc.variant_markdown(vs))
 
 
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):

@@ -43,24 +43,29 @@ FRUGAL = "ours-corrector-frugal"
 RETRY = "ours-corrector-retry"
 THRIFT = "ours-corrector-thrift"
 POLISH = "ours-corrector-polish"
+CENTRE = "ours-corrector-polish (centre)"  # polish with every leg aimed at its region's centre (its grid's rows)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
-                 POLISH: "corrector-polish"}
+                 POLISH: "corrector-polish", CENTRE: "corrector-centre"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
-                     THRIFT: RECHECK, POLISH: THRIFT}
+                     THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
-                 THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite"}
+                 THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
+                 CENTRE: "corrector-centre-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
-VARIANT_RUNS = {SPREAD: PRECISE}
+VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
+#: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
+#: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
+SELF_CONTAINED = {CENTRE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH}
-REPORTED = "polish"  # the variant README reports first (docs/corrector.md, "Polished before corrected")
+            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE}
+REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -117,10 +122,11 @@ def per_maze(rows, proposer, mazes, seeds, reference=ORACLE, method=METHOD) -> l
     return out
 
 
-def zero_runs(rows, method, proposer, mazes) -> tuple[int, int]:
+def zero_runs(rows, method, proposer, mazes, rate: float = 0.0) -> tuple[int, int]:
+    """(runs of ``method`` with ``proposer`` on ``mazes`` at success ``rate`` exactly, runs done)."""
     done = [r for r in rows if r["method"] == method and r["proposer"] == proposer and r["maze"] in mazes
             and cmp.is_done(r)]
-    return sum(1 for r in done if float(r["success_rate"]) == 0.0), len(done)
+    return sum(1 for r in done if float(r["success_rate"]) == rate), len(done)
 
 
 def costs(rows, proposer, mazes, seeds, first=METHOD, second="ours") -> dict:
@@ -276,8 +282,7 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     rules, its cost beside the reference's, the held-out cells and, where its grid ran severe, severe against
     ours-repair."""
     grid, ref = GRIDS[VARIANT_GRIDS[method]], reference_of(method)
-    rows = (load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables, root) + _reference_rows(method, root)
-            + named(load(grid.tables, root), method))
+    rows = _base_rows(method, root) + _reference_rows(method, root) + named(load(grid.tables, root), method)
     if not any(r["method"] == method for r in rows):
         return None
     cells, failed = cmp.table_cells(rows, "point")
@@ -306,6 +311,9 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                                      method=method)]
     study["held_out"] = variant_held_out(method, root)
     study["held_out_costs"] = variant_held_out_costs(method, root)
+    if method in SELF_CONTAINED:
+        study["oracle_versus_paper"] = _oracle_versus_paper(rows, root)
+        study["every_episode"] = {p: zero_runs(rows, method, p, SCALING_MAZES, rate=1.0) for p in presets}
     if "imperfect:severe" in grid.proposers:
         study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, method=method)
         study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, "ours-repair",
@@ -315,6 +323,23 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     return study
+
+
+def _oracle_versus_paper(rows: list[dict], root: Path) -> dict:
+    """The oracle of a self-contained variant's grid (its settings) against the taxonomy grid's oracle (the paper's
+    settings), paired over the U-chain cells (bootstrap over cells), described beside its rules."""
+    mine = [r | {"method": "oracle (its settings)"} for r in rows if (r["method"], r["proposer"]) == ORACLE]
+    paper = [r | {"method": "oracle (paper)"} for r in load(GRIDS["taxonomy"].tables, root)
+             if (r["method"], r["proposer"]) == ORACLE]
+    cells, failed = cmp.table_cells(mine + paper, "point")
+    return cmp.paired_difference(cells, failed, ORACLE[1], "oracle (its settings)", "oracle (paper)", POINT_SEEDS,
+                                 SCALING_MAZES)
+
+
+def _base_rows(method: str, root: Path) -> list[dict]:
+    """The oracle's, ours's, ours-repair's and the one-shot's rows a variant is judged with: the taxonomy and
+    corrector grids', or none for a variant whose grid runs its own (``SELF_CONTAINED``)."""
+    return [] if method in SELF_CONTAINED else load(GRIDS["taxonomy"].tables + GRIDS["corrector"].tables, root)
 
 
 def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
@@ -333,20 +358,27 @@ def reference_of(method: str) -> str:
     return VARIANT_REFERENCE.get(method, METHOD)
 
 
-def _reference_rows(method: str, root: Path, part: int | None = None) -> list[dict]:
-    """The rows of the variant's reference where that is another variant, under its name (``part``: one part's)."""
+def _reference_rows(method: str, root: Path, held_out: bool = False) -> list[dict]:
+    """The rows of the variant's reference where that is another variant, under its name (``held_out``: its
+    held-out part's only)."""
     ref = reference_of(method)
     if ref == METHOD:
         return []
-    grid = GRIDS[VARIANT_GRIDS[ref]]
-    return named(load(grid.tables if part is None else (grid.part_table(part),), root), ref)
+    return named(load(_held_out_tables(ref) if held_out else GRIDS[VARIANT_GRIDS[ref]].tables, root), ref)
+
+
+def _held_out_tables(method: str) -> tuple:
+    """The tables of the held-out part(s) of a variant's grids (a self-contained variant's: its suite grid's,
+    its own oracle's included)."""
+    grid = GRIDS[(VARIANT_SUITE if method in SELF_CONTAINED else VARIANT_GRIDS)[method]]
+    return tuple(grid.part_table(i) for i, part in enumerate(grid.parts)
+                 if set(part.proposers) <= set(HELD_OUT_MIXES) | {ORACLE[1]} and part.mazes == HELD_OUT_MAZES)
 
 
 def _held_out_rows(method: str, root: Path) -> list[dict]:
-    grid = GRIDS[VARIANT_GRIDS[method]]
-    part = next(i for i, part in enumerate(grid.parts) if set(part.proposers) == set(HELD_OUT_MIXES))
-    return (load(GRIDS["corrector-held-out"].tables, root) + _reference_rows(method, root, part)
-            + named(load((grid.part_table(part),), root), method))
+    base = [] if method in SELF_CONTAINED else load(GRIDS["corrector-held-out"].tables, root)
+    return (base + _reference_rows(method, root, held_out=True)
+            + named(load(_held_out_tables(method), root), method))
 
 
 def variant_held_out_costs(method: str, root: Path = ROOT) -> list[dict]:
@@ -592,7 +624,7 @@ def variant_verdicts(vs: dict) -> list[dict]:
     for proposer in ("imperfect:mild", "imperfect:moderate"):
         mazes = [e for e in vs["per_maze"] if e["proposer"] == proposer]
         within = [e for e in mazes if e["runs"] and e["success"] >= e["reference_success"] - TOLERANCE]
-        complete = all(e["runs"] == len(POINT_SEEDS) for e in mazes)
+        complete = all(e["runs"] == len(POINT_SEEDS) and e["reference_runs"] for e in mazes)
         out.append({"rule": f"{method}, {proposer}: within {TOLERANCE} of the oracle on every U-chain",
                     "value": f"{len(within)} of {len(mazes)} mazes", "verdict": _verdict(len(within) == len(mazes),
                                                                                         complete)})
@@ -636,11 +668,16 @@ def variant_markdown(vs: dict) -> list[str]:
     lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | "
               f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["per_maze"] + vs.get("severe", [])]
     if vs.get("versus_ours"):
-        lines += ["", f"Every suite maze: {method} - ours, pooled over seeds (Newcombe 95 %; ours at its own grids' "
-                  "code, before the spread start states).", "",
+        whose = "its grids' code and settings" if method in SELF_CONTAINED else \
+            "its own grids' code, before the spread start states"
+        lines += ["", f"Every suite maze: {method} - ours, pooled over seeds (Newcombe 95 %; ours at {whose}).", "",
                   f"| proposer | maze | runs (ours) | {short} | ours | difference |", "|---|---|---|---|---|---|"]
         lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} ({e['reference_runs']}) | {_num(e['success'])} | "
                   f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["versus_ours"]]
+    if "oracle_versus_paper" in vs:
+        lines += ["", "Described beside its rules: the oracle (ours, geometric) as this grid runs it, against the "
+                  f"oracle at the paper's settings (grid taxonomy) {_paired_text(vs['oracle_versus_paper'])} "
+                  "(paired, U-chains, 95 % bootstrap)."]
     if "severe_vs_corrector" in vs:
         lines += ["", f"Severe (described): {method} - {ref} {_paired_text(vs['severe_vs_corrector'])}; - "
                   f"ours-repair {_paired_text(vs['severe_vs_repair'])} (paired, U-chains, 95 % bootstrap)."]
@@ -789,6 +826,16 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     for name in VARIANTS:
         study = variants.get(name)
         out[name] = ((_gated_text if name == "gated" else _variant_text)(study)) if study else "not run yet"
+        if study:
+            v = study["versus_corrector"]
+            out[f"{name}-paired"] = f"{_signed(v)} over {v['n_cells']} paired U-chain cells"
+        if study and "oracle_versus_paper" in study:
+            out[f"{name}-oracle"] = _paired_text(study["oracle_versus_paper"])
+            out[f"{name}-runs"] = "; ".join(f"{p.split(':')[1]} {k} of {n}" for p, (k, n) in
+                                            study["every_episode"].items())
+            if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
+                k, n = study["severe_zero"][study["method"]]
+                out[f"{name}-severe-zero"] = f"{k} of {n}"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["table"] = rules_table(variants.get(REPORTED), point, ant)
     if held_out:
@@ -883,11 +930,14 @@ def _variant_text(vs: dict) -> str:
             + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))
     held = [e for e in vs["held_out"] if e["runs"]]
     if held:
+        both = [e for e in held if e["reference_runs"]]
+        beside = (f"{ref} {min(e['reference_success'] for e in both):.3f}-"
+                  f"{max(e['reference_success'] for e in both):.3f}; higher on "
+                  f"{sum(e['success'] > e['reference_success'] for e in both)}, lower on "
+                  f"{sum(e['success'] < e['reference_success'] for e in both)} of {len(both)}"
+                  + ("" if len(both) == len(held) else " run by both") if both else f"{ref} not run there")
         parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
-                     f"layout and mix ({ref} {min(e['reference_success'] for e in held):.3f}-"
-                     f"{max(e['reference_success'] for e in held):.3f}; higher on "
-                     f"{sum(e['success'] > e['reference_success'] for e in held)}, lower on "
-                     f"{sum(e['success'] < e['reference_success'] for e in held)} of {len(held)})")
+                     f"layout and mix ({beside})")
         mine = [c for c in vs.get("held_out_costs", []) if c["method"] == vs["method"] and c["pairs"]]
         if mine:
             parts[-1] += ", " + ", ".join(f"{c['proposer']} {_num(c['proposer_calls_ratio'], '{:.1f}x')}"
