@@ -8,6 +8,7 @@ row; floats are compared as README prints them, verdicts exactly.
 from __future__ import annotations
 
 import importlib.util
+import json
 import math
 import re
 from pathlib import Path
@@ -821,6 +822,8 @@ def test_the_choices_numbers_are_their_tables():
     (ka, na), (kf, nf) = (pooled(held[ev], episodes=200) for ev in ("adaptive", "fixed"))
     assert (f"{ratio['sim_steps']:.2f}x fewer simulator steps and {ratio['wall_seconds']:.2f}x less wall time on the "
             f"held-out Ant runs at equal success ({ka}/{na} adaptive against {kf}/{nf} fixed") in doc
+    front = json.loads((ROOT / "data/results/corrector/claims.json").read_text())["front"]  # corrector-claims'
+    assert f"points {front['centre-paired']}; the oracle {front['centre-oracle']} (paired)" in doc
 
 
 def test_the_stage5_section_is_its_csvs():
