@@ -203,6 +203,15 @@ OTHER_POINT_MAZES = ("hazard_pool", "or_maze", "split_doorway", "two_doors", "u_
 HELD_OUT_MAZES = ("data/mazes/unseen/spiral.maze", "data/mazes/unseen/zigzag.maze",
                   "data/mazes/unseen/detour_subgoal.maze", "data/mazes/unseen/pillars.maze", "random:3x4:7",
                   "random:4x4:11")
+#: fresh held-out layouts and mixes for the centre rule (docs/corrector.md, "Fresh layouts for the centre rule"):
+#: generated mazes no run had used, and two more error mixes (C: small, cornered regions and uncapped replies; D:
+#: mirrored replies, wrong branches and dropped turns, growing with the turns a query spans)
+FRESH_MAZES = ("random:4x5:23", "random:5x5:31", "random:3x6:5", "random:5x4:42")
+FRESH_MIXES = ("imperfect:position_sigma=0.25,coord_grid=0.1,radius=0.35,radius_log_sigma=0.45,corner_pull=0.35,"
+               "p_drop_turn=0.2,p_uncapped=0.6,p_false_opening=0.2,p_wrong_branch=0.2,p_mirror_y=0.05,"
+               "p_unparseable=0.08,rho=0.5",
+               "imperfect:position_sigma=0.4,radius_log_sigma=0.25,corner_pull=0.15,p_drop_turn=0.3,p_uncapped=0.4,"
+               "p_wrong_branch=0.35,p_mirror_y=0.15,alpha=0.1,rho=0.7")
 #: error mixes no method was developed on: (A) small regions pulled to corners and false openings, (B) dropped
 #: turns growing with the span of a query, mirrored replies and wrong branches
 HELD_OUT_MIXES = ("imperfect:position_sigma=0.35,radius=0.3,radius_log_sigma=0.6,corner_pull=0.5,"
@@ -468,6 +477,21 @@ GRIDS = {g.name: g for g in (
                     table="data/results/corrector/centre_held_out_oracle.csv", out="held_out_oracle")),
         seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="809c7f3",
         table="data/results/corrector/centre_suite.csv", out="runs/corrector_centre_suite"),
+    ExperimentGrid(
+        "corrector-centre-fresh", "docs/corrector.md, 'Fresh layouts for the centre rule' (issue 39; fixed "
+        "2026-11-28 before it ran)", "point",
+        parts=(Part(("ours-corrector-polish", "ours"), FRESH_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/centre_fresh_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=FRESH_MAZES, goal_points="centre", workers=1, code="809c7f3",
+        table="data/results/corrector/centre_fresh.csv", out="runs/corrector_centre_fresh"),
+    ExperimentGrid(
+        "corrector-sampled-fresh", "docs/corrector.md, 'Fresh layouts for the centre rule' (issue 39; fixed "
+        "2026-11-28 before it ran)", "point",
+        parts=(Part(("ours-corrector-polish",), FRESH_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/sampled_fresh_oracle.csv",
+                    out="oracle")),
+        seeds=(0, 1), mazes=FRESH_MAZES, goal_points="sampled", workers=1, code="809c7f3",
+        table="data/results/corrector/sampled_fresh.csv", out="runs/corrector_sampled_fresh"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
