@@ -405,6 +405,25 @@ def test_the_centre_variant_is_judged_with_its_own_grids_references_and_against_
     assert "ours at its grids' code and settings" in "\n".join(cc.variant_markdown(vs))
 
 
+def test_the_fresh_layouts_put_polish_at_centre_beside_polish_at_sampled_points(tmp_path):
+    """Fresh layouts (described): per generated maze and mix, polish at centre points beside the same method at
+    sampled points, ours and both oracles; runs at 0 per method; the paired difference over the 16 cells."""
+    assert cc.fresh_study(tmp_path) is None
+    dead = (cc.table_name(cc.FRESH_MAZES[0]), cc.FRESH_MIXES[0])
+    lay_all_parts(tmp_path, "corrector-centre-fresh",
+                  lambda maze, m, p: 0.0 if (cc.table_name(maze), p) == dead and m == cc.POLISH else
+                  1.0 if p == "geometric" else {cc.POLISH: 1.0, "ours": 0.5}[m])
+    lay_all_parts(tmp_path, "corrector-sampled-fresh", lambda maze, m, p: 0.95 if m == cc.POLISH else 0.99)
+    fresh = cc.fresh_study(tmp_path)
+    assert fresh["runs"] == 16 and fresh["zero"] == {cc.CENTRE: 2, cc.POLISH: 0, "ours": 0}
+    first = fresh["per_maze"][0]
+    assert (first["mix"], first["success"], first["reference_success"]) == ("C", 0.0, 0.95)
+    assert first["ours"] == 0.5 and first["oracle"] == 1.0 and first["oracle_sampled"] == pytest.approx(0.99)
+    assert fresh["paired"]["n_cells"] == 16
+    assert fresh["paired"]["estimate"] == pytest.approx((14 * 0.05 - 2 * 0.95) / 16)
+    assert "runs at 0: ours-corrector-polish (centre) 2" in cc._fresh_text(fresh)
+
+
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"

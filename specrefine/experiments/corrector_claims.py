@@ -29,7 +29,16 @@ from ..core.results import newcombe_ci, wilson_ci
 from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
-from .grids import GRIDS, HELD_OUT_MAZES, HELD_OUT_MIXES, OTHER_POINT_MAZES, ROOT, SCALING_MAZES
+from .grids import (
+    FRESH_MAZES,
+    FRESH_MIXES,
+    GRIDS,
+    HELD_OUT_MAZES,
+    HELD_OUT_MIXES,
+    OTHER_POINT_MAZES,
+    ROOT,
+    SCALING_MAZES,
+)
 
 METHOD = "ours-corrector"
 LEVERS = ("ours-deeprepair", "ours-feasible", "ours-checked")
@@ -314,6 +323,7 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     if method in SELF_CONTAINED:
         study["oracle_versus_paper"] = _oracle_versus_paper(rows, root)
         study["every_episode"] = {p: zero_runs(rows, method, p, SCALING_MAZES, rate=1.0) for p in presets}
+        study["fresh"] = fresh_study(root)
     if "imperfect:severe" in grid.proposers:
         study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, method=method)
         study["severe_vs_repair"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, "ours-repair",
@@ -323,6 +333,60 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     return study
+
+
+FRESH_GRIDS = ("corrector-centre-fresh", "corrector-sampled-fresh")  # docs/corrector.md, "Fresh layouts ..."
+FRESH_NAMES = dict(zip(FRESH_MIXES, ("C", "D")))
+
+
+def fresh_study(root: Path = ROOT) -> dict | None:
+    """Described (docs/corrector.md, "Fresh layouts for the centre rule"): polish at centre points beside polish at
+    sampled points, ours (centre) and the oracle at both, per fresh layout and mix; runs at 0; the paired difference
+    of the two polish runs over the cells both ran (bootstrap over cells)."""
+    centre, sampled = (load(GRIDS[name].tables, root) for name in FRESH_GRIDS)
+    rows = [r | {"method": CENTRE} if r["method"] == POLISH else r for r in centre]
+    rows += [r | {"method": "oracle (sampled)"} if r["method"] == ORACLE[0] else r for r in sampled]
+    if not any(r["method"] == CENTRE for r in rows):
+        return None
+    mazes, seeds = tuple(table_name(m) for m in FRESH_MAZES), GRIDS[FRESH_GRIDS[0]].seeds
+    entries = []
+    for mix in FRESH_MIXES:
+        for e in per_maze(rows, mix, mazes, seeds, reference=(POLISH, "*"), method=CENTRE):
+            refs = (("ours", ("ours", mix)), ("oracle", ORACLE), ("oracle_sampled", ("oracle (sampled)", ORACLE[1])))
+            extra = {name: episodes_of(rows, e["maze"], *ref, seeds) for name, ref in refs}
+            entries.append(e | {"mix": FRESH_NAMES[mix]} | {k: c[0] / c[1] if c[1] else math.nan
+                                                              for k, c in extra.items()})
+    cells, failed = cmp.table_cells(rows, "point")
+    both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in FRESH_MIXES}
+    zero = {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in FRESH_MIXES) for m in (CENTRE, POLISH, "ours")}
+    return {"per_maze": entries, "zero": zero, "runs": sum(e["runs"] for e in entries),
+            "paired": cmp.paired_difference(both, set(), "both", CENTRE, POLISH, seeds,
+                                            [f"{maze} {p}" for p in FRESH_MIXES for maze in mazes])}
+
+
+def fresh_markdown(fresh: dict) -> list[str]:
+    lines = ["", "Fresh layouts for the centre rule (described; docs/corrector.md): per generated maze and mix "
+             f"(C, D), pooled over seeds; polish at centre - polish at sampled (Newcombe 95 %); {CENTRE} - "
+             f"{POLISH} paired over the cells: {_paired_text(fresh['paired'])}. Runs at 0: "
+             + ", ".join(f"{m} {z}" for m, z in fresh["zero"].items()) + f" (of {fresh['runs']} each).", "",
+             "| mix | maze | runs | polish (centre) | polish (sampled) | difference | ours (centre) | oracle (centre) "
+             "| oracle (sampled) |", "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
+              f"{_diff(e)} | {_num(e['ours'])} | {_num(e['oracle'])} | {_num(e['oracle_sampled'])} |"
+              for e in fresh["per_maze"]]
+    return lines
+
+
+def _fresh_text(fresh: dict) -> str:
+    done = [e for e in fresh["per_maze"] if e["runs"]]
+    both = [e for e in done if e["reference_runs"]]
+    text = (f"{min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix over "
+            f"{fresh['runs']} runs ({len(done)} of {len(fresh['per_maze'])} layouts and mixes run)")
+    if both:
+        text += (f"; at sampled points {min(e['reference_success'] for e in both):.3f}-"
+                 f"{max(e['reference_success'] for e in both):.3f}; centre - sampled "
+                 f"{_paired_text(fresh['paired'])}")
+    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in fresh["zero"].items())
 
 
 def _oracle_versus_paper(rows: list[dict], root: Path) -> dict:
@@ -674,6 +738,8 @@ def variant_markdown(vs: dict) -> list[str]:
                   f"| proposer | maze | runs (ours) | {short} | ours | difference |", "|---|---|---|---|---|---|"]
         lines += [f"| {e['proposer']} | {e['maze']} | {e['runs']} ({e['reference_runs']}) | {_num(e['success'])} | "
                   f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["versus_ours"]]
+    if vs.get("fresh"):
+        lines += fresh_markdown(vs["fresh"])
     if "oracle_versus_paper" in vs:
         lines += ["", "Described beside its rules: the oracle (ours, geometric) as this grid runs it, against the "
                   f"oracle at the paper's settings (grid taxonomy) {_paired_text(vs['oracle_versus_paper'])} "
@@ -796,7 +862,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     their ``VARIANTS`` name)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
-             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), ANT_BEFORE, ANT_GRID)
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, ANT_BEFORE,
+             ANT_GRID)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -833,6 +900,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             out[f"{name}-oracle"] = _paired_text(study["oracle_versus_paper"])
             out[f"{name}-runs"] = "; ".join(f"{p.split(':')[1]} {k} of {n}" for p, (k, n) in
                                             study["every_episode"].items())
+            out[f"{name}-fresh"] = _fresh_text(study["fresh"]) if study.get("fresh") else "not run yet"
             if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
                 k, n = study["severe_zero"][study["method"]]
                 out[f"{name}-severe-zero"] = f"{k} of {n}"
