@@ -463,6 +463,9 @@ GRIDS = {g.name: g for g in (
                     split="proposers"),
                Part(("ours",), ("geometric",), mazes=SCALING_MAZES),
                Part(("ours-corrector-polish", "ours-repair"), ("imperfect:severe",), mazes=SCALING_MAZES,
+                    table="data/results/corrector/centre_severe.csv", out="severe"),
+               # added 2026-11-28 after the parts above ran, before it ran: ours at severe, for the cost rule's pairs
+               Part(("ours",), ("imperfect:severe",), mazes=SCALING_MAZES,
                     table="data/results/corrector/centre_severe.csv", out="severe")),
         seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="809c7f3",
         table="data/results/corrector/centre.csv", out="runs/corrector_centre"),
