@@ -876,3 +876,12 @@ def test_the_offline_comparison_counts_its_rows_by_code():
     assert (f"**rows 1-{sum(first.values())}** (272 each of `ours`, `ours-nosearchvertex`, `ours-d1`, `vlm-oneshot`, "
             f"`vlm-oneshot-matched`) ran with commit **1461726**") in readme
     assert f"**rows {sum(first.values()) + 1}-{len(rows)}** (272 each of the redefined" in readme
+
+
+def test_the_corrector_s_ant_room_is_the_oracle_confirm_check():
+    """README's range for the oracle on U-chain 4-5 at the Ant corrector's settings is ant-oracle-confirm's check."""
+    check = (ROOT / "data/results/ant/oracle_confirm_check.md").read_text()
+    rates = [float(m) for m in re.findall(r"^\| u_chain_[45](?:_subgoals)? \| 3 \| ([0-9.]+) ", check, re.M)]
+    assert len(rates) == 4
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    assert f"U-chain 4 and 5 with and without subgoals reach {min(rates):.3f}-{max(rates):.3f} per maze" in readme
