@@ -1,0 +1,45 @@
+"""specrefine.experiments.aim_check: the per-leg loss by disc radius, its refusal of a folder with no run, and the
+sentences README and docs/corrector.md quote from the shipped check (data/results/corrector/diagnosis/aim.json)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from specrefine.experiments import aim_check
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_legs_are_binned_by_the_radius_of_the_disc_they_enter():
+    bins = aim_check.radius_bins([(0.1, 0.004), (0.15, 0.002), (0.25, 0.001), (0.5, 0.0), (None, 0.5)])
+    assert [b["legs"] for b in bins] == [2, 1, 0, 1]  # a leg into another region (None) is in no bin
+    assert bins[0]["loss"] == pytest.approx(0.003) and bins[1]["loss"] == pytest.approx(0.001)
+    assert math.isnan(bins[2]["loss"]) and bins[3]["loss"] == 0.0
+
+
+def test_a_folder_without_such_runs_is_one_line_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "aim.md"
+    with pytest.raises(SystemExit) as exc:
+        aim_check.main([str(tmp_path), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "no point-mass run folder" in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_readme_and_the_corrector_doc_quote_the_shipped_check():
+    check = json.loads((ROOT / "data/results/corrector/diagnosis/aim.json").read_text())
+    lost, bins = check["lost"], check["bins"]
+    (stop,) = {f"{d * 1000:.1f} mm" for d in check["stop_offset"]}  # the same rest offset at every point
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    doc = " ".join((ROOT / "docs/corrector.md").read_text().split())
+    assert f"{lost['timeout']} of the {sum(lost.values())} episodes" in readme
+    assert f"{lost['timeout']} of their {sum(lost.values())} lost episodes" in doc
+    for text in (readme, doc):
+        assert f"rest {stop} from the point it aims at" in text
+        assert f"{bins[0]['loss'] * 100:.2f} %" in text and f"{bins[2]['loss'] * 100:.2f} %" in text
+    assert f"by a median of {np.median(check['gaps']) * 1000:.1f} mm" in doc
