@@ -256,6 +256,18 @@ def corrector_suite_grid(name: str, section: str, method: str, stem: str, code: 
         out=f"runs/corrector_{stem}_suite")
 
 
+def fresh_grid(name: str, goal_points: str, methods: tuple) -> ExperimentGrid:
+    """``methods`` under the fresh error mixes and the oracle on the fresh layouts, seeds 0-1, with ``goal_points``
+    (docs/corrector.md, "Fresh layouts for the centre rule"), into data/results/corrector/GOAL_POINTS_fresh*.csv."""
+    table = f"data/results/corrector/{goal_points}_fresh"
+    return ExperimentGrid(
+        name, "docs/corrector.md, 'Fresh layouts for the centre rule' (issue 39; fixed 2026-11-28 before it ran)",
+        "point", parts=(Part(methods, FRESH_MIXES, split="proposers"),
+                        Part(("ours",), ("geometric",), table=f"{table}_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=FRESH_MAZES, goal_points=goal_points, workers=1, code="809c7f3", table=f"{table}.csv",
+        out=f"runs/{name.replace('-', '_')}")
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector"
                        ) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
@@ -480,21 +492,8 @@ GRIDS = {g.name: g for g in (
                     table="data/results/corrector/centre_held_out_oracle.csv", out="held_out_oracle")),
         seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="809c7f3",
         table="data/results/corrector/centre_suite.csv", out="runs/corrector_centre_suite"),
-    ExperimentGrid(
-        "corrector-centre-fresh", "docs/corrector.md, 'Fresh layouts for the centre rule' (issue 39; fixed "
-        "2026-11-28 before it ran)", "point",
-        parts=(Part(("ours-corrector-polish", "ours"), FRESH_MIXES, split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/centre_fresh_oracle.csv", out="oracle")),
-        seeds=(0, 1), mazes=FRESH_MAZES, goal_points="centre", workers=1, code="809c7f3",
-        table="data/results/corrector/centre_fresh.csv", out="runs/corrector_centre_fresh"),
-    ExperimentGrid(
-        "corrector-sampled-fresh", "docs/corrector.md, 'Fresh layouts for the centre rule' (issue 39; fixed "
-        "2026-11-28 before it ran)", "point",
-        parts=(Part(("ours-corrector-polish",), FRESH_MIXES, split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/sampled_fresh_oracle.csv",
-                    out="oracle")),
-        seeds=(0, 1), mazes=FRESH_MAZES, goal_points="sampled", workers=1, code="809c7f3",
-        table="data/results/corrector/sampled_fresh.csv", out="runs/corrector_sampled_fresh"),
+    fresh_grid("corrector-centre-fresh", "centre", ("ours-corrector-polish", "ours")),
+    fresh_grid("corrector-sampled-fresh", "sampled", ("ours-corrector-polish",)),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
