@@ -31,6 +31,16 @@ def test_a_folder_without_such_runs_is_one_line_and_writes_nothing(tmp_path, cap
     assert not out.exists()
 
 
+def test_a_json_beside_the_report_that_is_a_link_is_refused_before_any_work(tmp_path, capsys):
+    (tmp_path / "target.json").write_text("keep")
+    (tmp_path / "aim.json").symlink_to(tmp_path / "target.json")
+    with pytest.raises(SystemExit) as exc:
+        aim_check.main([str(tmp_path / "no_sweep"), "--out", str(tmp_path / "aim.md")])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "aim.json" in err and "no_sweep" not in err and err.count("\n") == 1
+    assert (tmp_path / "target.json").read_text() == "keep" and not (tmp_path / "aim.md").exists()
+
+
 def test_readme_and_the_corrector_doc_quote_the_shipped_check():
     check = json.loads((ROOT / "data/results/corrector/diagnosis/aim.json").read_text())
     lost, bins = check["lost"], check["bins"]

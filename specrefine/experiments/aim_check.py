@@ -1,7 +1,7 @@
 """Where a point-mass run's episodes are lost at the paper's sampled goal points, and the same found paths aimed at
 their regions' centres (docs/corrector.md, "Aimed at the centre"; exploration that informed grid corrector-centre).
 
-    python -m specrefine.experiments.aim_check runs/corrector_polish/cells --proposer imperfect:moderate \\
+    python -m specrefine.experiments.aim_check runs/corrector_polish --proposer imperfect:moderate \\
         --mazes u_chain_4 u_chain_4_subgoals u_chain_5 u_chain_5_subgoals --out data/results/corrector/diagnosis/aim.md
 
 From each run folder (its ``result.json``): how its measured episodes ended, and each leg's measured loss by the
@@ -21,21 +21,20 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
 from ..core.results import TIMEOUT
-from ..core.runfolder import write_atomic, writing_into
+from ..core.runfolder import output_file, write_atomic, writing_into
+from .taxonomy import read_runs
 
 RADII = (0.2, 0.3, 0.45)  # m: the disc-radius bins of the per-leg loss (below each, then the rest)
 SEED = 4242  # the re-measurement's episode seed
 
 
-def runs(cells: Path, proposer: str, mazes: list[str]) -> list[dict]:
-    """The ``result.json`` of every run folder under ``cells`` with that proposer and one of ``mazes``, in order."""
-    out = []
-    for result in sorted(cells.glob("*/result.json")):
-        data = json.loads(result.read_text())
-        if data.get("proposer") == proposer and data.get("maze") in mazes and data.get("agent") == "point":
-            out.append(data)
+def runs(sweep: Path, proposer: str, mazes: list[str]) -> list[dict]:
+    """The ``result.json`` of every finished point-mass run of the sweep folder (its ``cells/``) with that proposer
+    and one of ``mazes``, in order (``taxonomy.read_runs``: each checked as it is read)."""
+    out = [run.result for run in read_runs([sweep]) if run.result.get("agent") == "point"
+           and run.result.get("proposer") == proposer and run.result.get("maze") in mazes]
     if not out:
-        raise SpecrefineError(f"{cells}: no point-mass run folder with proposer {proposer} on {', '.join(mazes)}")
+        raise SpecrefineError(f"{sweep}: no point-mass run folder with proposer {proposer} on {', '.join(mazes)}")
     return out
 
 
@@ -59,14 +58,13 @@ def radius_bins(losses) -> list[dict]:
     return rows
 
 
-def remeasure(data: dict, episodes: int) -> dict:
+def remeasure(data: dict, policy, episodes: int) -> dict:
     """The found path on ``episodes`` fresh episodes aimed both ways; the timed-out episodes' gaps to their region."""
     from ..core.mazes import load_maze
     from ..evaluation.evaluator import Evaluator
-    from ..sim.policy import load_policy
 
     graph, path = TaskGraph.from_dict(data["graph"]), data["path"]
-    maze, policy = load_maze(data["maze"]), load_policy("point")
+    maze = load_maze(data["maze"])
     out = {}
     for rule in ("sampled", "centre"):
         res = Evaluator(maze, "point", policy, goal_points=rule).run_graph_path(graph, path, n=episodes, seed=SEED)
@@ -79,17 +77,16 @@ def remeasure(data: dict, episodes: int) -> dict:
     return out
 
 
-def stop_offset(n: int = 64) -> list[float]:
+def stop_offset(policy, n: int = 64) -> list[float]:
     """How far from the point it aims at the point mass comes to rest: the shipped policy on an open floor, each of
     ``n`` rollouts aiming at one fixed point for a whole horizon (its goal region is out of reach), per point."""
     from ..core.mazes import Maze
     from ..core.regions import Disc
     from ..evaluation.evaluator import Evaluator
-    from ..sim.policy import load_policy
 
     room = [[1] * 9, [1, "r", *[0] * 6, 1], *([1, *[0] * 7, 1] for _ in range(5)), [*[1] * 7, "g", 1], [1] * 9]
     maze = Maze.from_gymnasium(room, name="open_floor")
-    ev = Evaluator(maze, "point", load_policy("point"))
+    ev = Evaluator(maze, "point", policy)
     out = []
     for point in ((1.0, 0.0), (1.5, 0.5), (2.0, -1.0), (0.3, 0.3)):
         res = ev.run_compositional(Disc(0.0, 0.0, 0.3), [(Disc(50.0, 50.0, 0.01), maze.obstacles, point)], n=n,
@@ -100,18 +97,22 @@ def stop_offset(n: int = 64) -> list[float]:
 
 
 def check(data_runs: list[dict], episodes: int) -> dict:
+    from ..sim.policy import load_policy
+
+    policy = load_policy("point")
     lost = {k: 0 for k in ("avoid", "flipped", "timeout")}
     for d in data_runs:
         for k in lost:
             lost[k] += d["episode_outcomes"].get(k, 0)
     per_run = []
     for d in data_runs:
-        again = remeasure(d, episodes)
+        again = remeasure(d, policy, episodes)
         per_run.append({"maze": d["maze"], "seed": d["seed"], "legs": len(d["path"]) - 1,
                         "success": d["success_rate"], "episodes": d["episodes"], **again})
     gaps = [g for r in per_run for g in r["gaps"]]
     return {"runs": len(data_runs), "lost": lost, "bins": radius_bins([x for d in data_runs for x in leg_losses(d)]),
-            "per_run": per_run, "gaps": gaps, "episodes": episodes, "stop_offset": stop_offset()}
+            "per_run": per_run, "gaps": gaps, "episodes": episodes,
+            "stop_offset": stop_offset(policy)}
 
 
 def markdown(c: dict, proposer: str) -> str:
@@ -150,7 +151,7 @@ def _counts(counts: dict) -> str:
 
 def main(argv=None) -> int:
     p = OneLineParser(prog="python -m specrefine.experiments.aim_check", description=__doc__.split("\n")[0])
-    p.add_argument("cells", type=Path, help="a sweep's cells folder (one run folder per cell)")
+    p.add_argument("sweep", type=Path, help="a sweep folder (its cells/, one run folder per cell)")
     p.add_argument("--proposer", default="imperfect:moderate")
     p.add_argument("--mazes", nargs="+", default=["u_chain_4", "u_chain_4_subgoals", "u_chain_5", "u_chain_5_subgoals"])
     p.add_argument("--episodes", type=int, default=1000)
@@ -159,10 +160,11 @@ def main(argv=None) -> int:
     if args.episodes < 1:
         p.error("--episodes must be >= 1")
     try:
-        with writing_into(args.out) as out:  # checked before any work
-            result = check(runs(args.cells, args.proposer, args.mazes), args.episodes)
+        with writing_into(args.out) as out:  # both files checked before any work
+            data = output_file(out.with_suffix(".json"))
+            result = check(runs(args.sweep, args.proposer, args.mazes), args.episodes)
             write_atomic(out, markdown(result, args.proposer))
-            write_atomic(out.with_suffix(".json"), json.dumps(result, indent=1, default=float) + "\n")
+            write_atomic(data, json.dumps(result, indent=1, default=float) + "\n")
     except (SpecrefineError, OSError) as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     print(f"-> {args.out}")
