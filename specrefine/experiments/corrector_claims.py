@@ -296,12 +296,9 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         return None
     cells, failed = cmp.table_cells(rows, "point")
     presets = ("imperfect:mild", "imperfect:moderate")
-    both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in presets}
-    both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in presets}
     study = {"method": method, "grid": grid.name, "reference": ref, "per_maze": [], "rooms": [], "zero": [],
              "costs": [], "corrector_costs": [], "ratio": [],
-             "versus_corrector": cmp.paired_difference(both, both_failed, "both", method, ref, POINT_SEEDS,
-                                                       [f"{maze} {p}" for p in presets for maze in SCALING_MAZES])}
+             "versus_corrector": paired_across(cells, failed, presets, method, ref, POINT_SEEDS, SCALING_MAZES)}
     for proposer in presets:
         study["per_maze"] += per_maze(rows, proposer, SCALING_MAZES, POINT_SEEDS, method=method)
         study["rooms"].append(cmp.rooms_claim(cells, failed, proposer, method, POINT_SEEDS))
@@ -357,11 +354,9 @@ def fresh_study(root: Path = ROOT) -> dict | None:
             entries.append(e | {"mix": FRESH_NAMES[mix]} | {k: c[0] / c[1] if c[1] else math.nan
                                                               for k, c in extra.items()})
     cells, failed = cmp.table_cells(rows, "point")
-    both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in FRESH_MIXES}
     zero = {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in FRESH_MIXES) for m in (CENTRE, POLISH, "ours")}
     return {"per_maze": entries, "zero": zero, "runs": sum(e["runs"] for e in entries),
-            "paired": cmp.paired_difference(both, set(), "both", CENTRE, POLISH, seeds,
-                                            [f"{maze} {p}" for p in FRESH_MIXES for maze in mazes])}
+            "paired": paired_across(cells, failed, FRESH_MIXES, CENTRE, POLISH, seeds, mazes)}
 
 
 def fresh_markdown(fresh: dict) -> list[str]:
@@ -398,6 +393,15 @@ def _oracle_versus_paper(rows: list[dict], root: Path) -> dict:
     cells, failed = cmp.table_cells(mine + paper, "point")
     return cmp.paired_difference(cells, failed, ORACLE[1], "oracle (its settings)", "oracle (paper)", POINT_SEEDS,
                                  SCALING_MAZES)
+
+
+def paired_across(cells, failed, proposers, first, second, seeds, mazes) -> dict:
+    """``first`` - ``second`` paired over the cells of every proposer in ``proposers`` together, each (maze,
+    proposer, seed) one cell (``comparison.paired_difference``)."""
+    both = {(f"{maze} {p}", m, "both", s): v for (maze, m, p, s), v in cells.items() if p in proposers}
+    both_failed = {(f"{maze} {p}", m, "both", s) for (maze, m, p, s) in failed if p in proposers}
+    return cmp.paired_difference(both, both_failed, "both", first, second, seeds,
+                                 [f"{maze} {p}" for p in proposers for maze in mazes])
 
 
 def _base_rows(method: str, root: Path) -> list[dict]:
