@@ -385,3 +385,53 @@ def test_asking_again_stays_within_the_budget():
 def test_empty_retries_must_not_be_negative():
     with pytest.raises(ValueError, match="empty_retries"):
         SearchConfig(empty_retries=-1)
+
+
+# --- a dead path corrected until alive (SearchConfig.correct_while_dead): method ours-corrector-persist -----------
+class ReplyQueue(AnswerBook):
+    """Replies to the query for S -> G in turn (each a list of waypoint x's; the last one repeated)."""
+
+    def __init__(self, replies):
+        super().__init__({})
+        self.replies = replies
+
+    def propose_split(self, query, w, feedback=()):
+        self.queries.append(float(query.goal.centre()[0]))
+        answer = self.replies[min(len(self.queries) - 1, len(self.replies) - 1)]
+        return [[Disc(a, 0, 0.5) for a in answer]]
+
+
+DEAD = {(0.0, 10.0): 0.0, (0.0, 2.0): 0.0, (0.0, 3.0): 0.0}  # S -> G, and into 2 or 3, never succeed
+
+
+def test_a_dead_path_is_corrected_pass_after_pass_until_a_split_lives():
+    # the search's split (2) and the correction's first (3) have a dead first leg; the third reply (5) lives
+    book = ReplyQueue([[2], [3], [5]])
+    g, result = run(LegTable(DEAD), book, correct_rollouts=4, correct_while_dead=True)
+    assert xs(result) == [0.0, 5.0, 10.0] and result.predicted_success == pytest.approx(1.0)
+    assert len(book.queries) == 3 and check_refines(result.graph, g) == []
+    legs = [s for s in result.steps if s["event"] == "correct-leg"]
+    assert [(s["correct_pass"], s["accepted"]) for s in legs] == [(1, None), (2, "split")]
+
+
+def test_without_it_the_dead_path_ends_the_run_after_one_pass():
+    book = ReplyQueue([[2], [3], [5]])
+    _, result = run(LegTable(DEAD), book, correct_rollouts=4)
+    assert xs(result) == [0.0, 10.0] and result.predicted_success == 0.0 and len(book.queries) == 2
+
+
+def test_correcting_a_dead_path_stops_at_the_search_budget():
+    book = ReplyQueue([[2], [3]])  # never a live split
+    _, result = run(LegTable(DEAD), book, correct_rollouts=4, correct_while_dead=True, max_edge_splits=6)
+    assert xs(result) == [0.0, 10.0] and len(book.queries) == 6
+    assert result.edge_splits_generated == 6
+
+
+def test_a_live_path_gets_no_further_pass():
+    fresh = {(3.0, 6.0): 0.75}  # weak, not dead: the correction's one pass, as without the setting
+    calls = []
+    for setting in (False, True):
+        book = AnswerBook({(0.0, 10.0): [3, 6]})
+        _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_while_dead=setting)
+        calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
+    assert calls[0] == calls[1]

@@ -27,7 +27,7 @@ def test_the_built_in_methods_are_registered_with_what_they_are():
     asking = {"ours", "ours-novertex", "ours-nosearchvertex", "ours-notune", "ours-nofeedback", "ours-d1",
               "ours-repair", "ours-repair-tuned", "ours-corrector", "ours-corrector-gated", "ours-corrector-lean",
               "ours-corrector-precise", "ours-corrector-trim", "ours-corrector-recheck", "ours-corrector-frugal",
-              "ours-corrector-retry", "ours-corrector-thrift", "ours-corrector-polish", "ours-corrector-confirm",
+              "ours-corrector-retry", "ours-corrector-thrift", "ours-corrector-polish", "ours-corrector-persist", "ours-corrector-confirm",
               "ours-deeprepair",
               "ours-feasible", "ours-checked",
               "ours-polish", "ours-shortcut", "ours-tunecheck", "ours-confirm", "vlm-oneshot",

@@ -32,7 +32,7 @@ import numpy as np
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
 from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
-from .correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, correct, path_legs
+from .correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, correct, path_legs
 from .edge_split import SplitCandidate, edge_split
 from .polish import polish
 from .racing import Racing
@@ -77,6 +77,8 @@ class SearchConfig:
     correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
     correct_lean: bool = False  # the correction judges by posterior means and offers every waypoint its bypass
     correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
+    correct_while_dead: bool = False  # beyond the paper: further passes while the corrected path has a leg that never
+    #                                   succeeded on its fresh check, until the search's max_edge_splits are spent
     correct_first_win: bool = False  # the correction asks for a leg's alternatives cheapest first, stops at a win
     correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
@@ -420,14 +422,24 @@ class RefinementSearch:
         states, so a leg chosen on one pass's rollouts is judged again on rollouts that did not choose it), with a
         budget of its own."""
         for pass_ in range(self.cfg.correct_passes):
-            path = self._correct_pass(path, pass_)
+            path, check = self._correct_pass(path, pass_)
+        pass_ = self.cfg.correct_passes
+        while self.cfg.correct_while_dead and check.p <= 0.0 and self.splits_generated < self.cfg.max_edge_splits:
+            asked = self.splits_generated
+            path, check = self._correct_pass(path, pass_, budget=self.cfg.max_edge_splits)
+            pass_ += 1
+            if self.splits_generated == asked:  # nothing left to ask about (no fresh rollout reaches the dead leg)
+                break
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
         return path
 
-    def _correct_pass(self, path: list[str], pass_: int) -> list[str]:
-        n, budget = self.evaluator.n, self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg *
-                                                                         (len(path) - 1))
+    def _correct_pass(self, path: list[str], pass_: int, budget: int | None = None) -> tuple[list[str], Check]:
+        """One pass of the correction on its own fresh draw -> (the path, its fresh check). ``budget``: the Algorithm
+        1 calls the search may have made when the pass ends (None: the calls so far plus its share per leg)."""
+        n = self.evaluator.n
+        if budget is None:
+            budget = self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg * (len(path) - 1))
 
         split_once = functools.partial(self._split_leg, d=self.cfg.correct_rounds)
 
@@ -441,15 +453,15 @@ class RefinementSearch:
             return best
 
         reach = self.cfg.correct_reach or 0.0
-        log = self._log if self.cfg.correct_passes == 1 else \
+        log = self._log if self.cfg.correct_passes == 1 and not self.cfg.correct_while_dead else \
             (lambda event, **detail: self._log(event, **detail, correct_pass=pass_ + 1))
-        self.graph, path, _ = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
+        self.graph, path, check = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
                                       seed=self.cfg.seed + CHECK_SEED_OFFSET + pass_ * PASS_SEED_STEP,
                                       split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
                                       min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win)
-        return path
+        return path, check
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
     def _shortcut(self, path: list[str]) -> list[str]:
