@@ -218,6 +218,15 @@ HELD_OUT_MIXES = ("imperfect:position_sigma=0.35,radius=0.3,radius_log_sigma=0.6
                   "p_false_opening=0.3,p_wrong_branch=0.1,p_drop_turn=0.1,p_uncapped=0.3,p_unparseable=0.05,rho=0.5",
                   "imperfect:position_sigma=0.2,radius_log_sigma=0.3,p_drop_turn=0.35,p_uncapped=0.7,alpha=0.2,"
                   "p_mirror_y=0.1,p_wrong_branch=0.3,rho=0.3")
+#: layouts and error mixes no run had used before grid corrector-persist-new (docs/corrector.md, "Corrected until
+#: alive"): four larger generated corridor mazes, and two mixes: E (large offsets and regions, false openings,
+#: unparseable replies, errors growing with the turns a query spans) and F (coordinates rounded to half cells, wrong
+#: branches, mirrored replies, dropped turns)
+NEW_MAZES = ("random:6x5:8", "random:5x6:3", "random:4x6:29", "random:6x4:17")
+NEW_MIXES = ("imperfect:position_sigma=0.3,radius=0.5,radius_log_sigma=0.4,corner_pull=0.25,p_drop_turn=0.25,"
+             "p_false_opening=0.35,p_uncapped=0.5,p_unparseable=0.15,alpha=0.15,rho=0.4",
+             "imperfect:position_sigma=0.3,coord_grid=0.5,radius=0.35,radius_log_sigma=0.35,p_wrong_branch=0.4,"
+             "p_mirror_y=0.2,p_drop_turn=0.2,p_uncapped=0.5,alpha=0.25,rho=0.6")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -494,6 +503,31 @@ GRIDS = {g.name: g for g in (
         table="data/results/corrector/centre_suite.csv", out="runs/corrector_centre_suite"),
     fresh_grid("corrector-centre-fresh", "centre", ("ours-corrector-polish", "ours")),
     fresh_grid("corrector-sampled-fresh", "sampled", ("ours-corrector-polish",)),
+    # docs/corrector.md, "Corrected until alive" (fixed 2026-11-28 03:55 UTC, before any cell but its pilot ran)
+    ExperimentGrid(
+        "corrector-persist-new", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it "
+        "ran): polish and persist on layouts and mixes no run had used", "point",
+        parts=(Part(("ours-corrector-persist", "ours-corrector-polish", "ours"), NEW_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/persist_new_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=NEW_MAZES, goal_points="centre", workers=1, code="ebc78e2",
+        table="data/results/corrector/persist_new.csv", out="runs/corrector_persist_new"),
+    ExperimentGrid(
+        "corrector-persist", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it ran)",
+        "point",
+        parts=(Part(("ours-corrector-persist",), ("imperfect:severe",), mazes=SCALING_MAZES,
+                    table="data/results/corrector/persist_severe.csv", out="severe"),
+               Part(("ours-corrector-persist",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                    split="seeds")),
+        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="ebc78e2",
+        table="data/results/corrector/persist.csv", out="runs/corrector_persist"),
+    ExperimentGrid(
+        "corrector-persist-suite", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it "
+        "ran)", "point",
+        parts=(Part(("ours-corrector-persist",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
+               Part(("ours-corrector-persist",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
+                    table="data/results/corrector/persist_held_out.csv", out="held_out")),
+        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="ebc78e2",
+        table="data/results/corrector/persist_suite.csv", out="runs/corrector_persist_suite"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
