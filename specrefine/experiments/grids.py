@@ -503,7 +503,7 @@ GRIDS = {g.name: g for g in (
         table="data/results/corrector/centre_suite.csv", out="runs/corrector_centre_suite"),
     fresh_grid("corrector-centre-fresh", "centre", ("ours-corrector-polish", "ours")),
     fresh_grid("corrector-sampled-fresh", "sampled", ("ours-corrector-polish",)),
-    # docs/corrector.md, "Corrected until alive" (fixed 2026-11-28 03:55 UTC, before any cell but its pilot ran)
+    # docs/corrector.md, "Corrected until alive" (fixed 2026-11-28 03:18 UTC, before any cell but its pilot ran)
     ExperimentGrid(
         "corrector-persist-new", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it "
         "ran): polish and persist on layouts and mixes no run had used", "point",
