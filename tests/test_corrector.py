@@ -6,6 +6,8 @@ what the stub's proposer answers decides what each lever can do.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import pytest
 from test_refine_search import _Arrive, _chain_graph, _Query
 
@@ -435,3 +437,26 @@ def test_a_live_path_gets_no_further_pass():
         _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_while_dead=setting)
         calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
     assert calls[0] == calls[1]
+
+
+# --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------
+@dataclass
+class SnapQuery(_Query):
+    snap: float = 0.0
+
+
+class SnapSeen(AnswerBook):
+    def propose_split(self, query, w, feedback=()):
+        self.snaps = getattr(self, "snaps", []) + [query.snap]
+        return super().propose_split(query, w, feedback)
+
+
+@pytest.mark.parametrize("setting,snap", [(False, 0.0), (True, 0.25)])
+def test_the_search_asks_its_proposer_to_snap_by_the_agents_clearance_only_when_set(setting, snap):
+    ev = LegTable(LUCKY)
+    ev.clearance = 0.25
+    book = SnapSeen({(0.0, 10.0): [3, 6]})
+    config = SearchConfig(w=1, d=1, vertex_refinement=False, snap_waypoints=setting)
+    RefinementSearch(_chain_graph(), ev, proposer=book, config=config,
+                     query_for=lambda graph, u, v, r: SnapQuery(graph, u, v)).run()
+    assert book.snaps == [snap]

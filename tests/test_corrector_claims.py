@@ -424,6 +424,48 @@ def test_the_fresh_layouts_put_polish_at_centre_beside_polish_at_sampled_points(
     assert "runs at 0: ours-corrector-polish (centre) 2" in cc._fresh_text(fresh)
 
 
+def persist_rate(maze, method, proposer):
+    """polish at centre points at 0 on U-chain 5 at severe; persist lifts it; elsewhere both at 0.99."""
+    if method == cc.PERSIST:
+        return 0.98 if proposer == "imperfect:severe" else 0.99
+    if method == cc.POLISH and proposer == "imperfect:severe" and maze == "u_chain_5":
+        return 0.0
+    return centre_rate(maze, method, proposer)
+
+
+def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids_references(tmp_path):
+    """corrector-persist runs persist only: its oracle, ours (U-chains and suite), ours-repair and the one-shot are
+    corrector-centre's and corrector-centre-suite's rows, polish at centre points its reference; the adoption rule
+    counts runs at 0 over the severe and new cells together."""
+    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite"):
+        lay_all_parts(tmp_path, name, persist_rate)
+    assert cc.new_study(tmp_path) is None
+    vs = cc.variant_study(cc.PERSIST, tmp_path)
+    assert vs["reference"] == cc.CENTRE and vs["versus_corrector"]["estimate"] == pytest.approx(0.0)
+    assert vs["versus_corrector"]["n_cells"] == 72
+    assert all(e["reference_success"] == pytest.approx(1.0) for e in vs["per_maze"])
+    assert len(vs["versus_ours"]) == 34 and all(e["reference_success"] == pytest.approx(0.9)
+                                                for e in vs["versus_ours"])
+    assert vs["severe_zero"] == {cc.PERSIST: (0, 36), cc.CENTRE: (4, 36)}
+    assert len(vs["held_out"]) == 12 and all(e["reference_success"] == pytest.approx(0.99) for e in vs["held_out"])
+    assert "fresh" not in vs and "oracle_versus_paper" not in vs
+    a = vs["adoption"]
+    assert a["no_worse"] and a["zero"] == {cc.PERSIST: 0, cc.CENTRE: 4} and a["fewer_zero"]
+    assert a["paired"]["n_cells"] == 36 and not a["complete"] and not a["adopted"]  # the new cells missing
+    lay_all_parts(tmp_path, "corrector-persist-new", lambda maze, m, p: 0.0 if m == cc.POLISH and
+                  cc.table_name(maze) == cc.table_name(cc.NEW_MAZES[0]) else persist_rate(maze, m, p))
+    vs = cc.variant_study(cc.PERSIST, tmp_path)
+    new, a = vs["new"], vs["adoption"]
+    assert new["runs"] == 16 and new["zero"] == {cc.PERSIST: 0, cc.CENTRE: 4, "ours": 0}
+    assert new["per_maze"][0]["mix"] == "E" and new["per_maze"][0]["reference_success"] == 0.0
+    assert a["zero"] == {cc.PERSIST: 0, cc.CENTRE: 8} and a["paired"]["n_cells"] == 52 and a["adopted"]
+    assert a["paired"]["estimate"] == pytest.approx((4 * 0.98 + 32 * -0.01 + 4 * 0.99) / 52)
+    rules = {r["rule"]: r["verdict"] for r in cc.variant_verdicts(vs)}
+    assert rules[f"{cc.PERSIST}: adopted (README's rules table reads it)"] == "adopted"
+    assert "runs at 0: ours-corrector-persist 0" in cc._new_text(new)
+    assert "Layouts and mixes no run had used" in "\n".join(cc.variant_markdown(vs))
+
+
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"

@@ -18,9 +18,10 @@ import time
 import zlib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from specrefine.core.errors import ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
+from specrefine.core.errors import ProposalRejected, ReplayMiss, SpecrefineError, VLMConfigError, VLMUnavailable
 from specrefine.core.graph import check_refines
 from specrefine.core.mazes import load_maze, parse_maze
 from specrefine.core.regions import Disc
@@ -371,8 +372,6 @@ def test_graph_reply_becomes_task_graph(maze):
     assert check_refines(g, original) == []  # this reply happens to be a true refinement
     bad = json.loads(graph_reply(maze))
     bad["edges"].append({"u": "G", "v": "S"})
-    from specrefine.core.errors import ProposalRejected
-
     with pytest.raises(ProposalRejected, match="cycle"):
         parse_graph(json.dumps(bad), maze, original)
     bad = json.loads(graph_reply(maze))
@@ -477,3 +476,38 @@ def test_a_reply_longer_than_the_cap_is_a_bad_answer_recorded_capped(srv, tmp_pa
     assert record.stat().st_size < MAX_REPLY_CHARS + 100_000
     replay = make_proposer(f"replay:{record}")
     assert replay.propose_split(query, 1) == out and replay.bad_replies == 1
+
+
+# --- snapping a waypoint centred in a wall (EdgeQuery.snap; method ours-corrector-snap) -----------------------------
+def test_a_waypoint_centred_in_a_wall_is_moved_clear_of_it_when_asked_to_snap(maze):
+    from specrefine.proposers.schema import parse_split
+
+    with pytest.raises(ProposalRejected, match="inside a wall"):
+        parse_split(IN_WALL, maze)
+    (moved,), _ = parse_split(IN_WALL, maze, snap=0.11)
+    assert isinstance(moved, Disc) and moved.r == pytest.approx(0.4)
+    centre = np.asarray(moved.centre())
+    assert float(maze.obstacles.signed_distance(centre[None])[0]) >= 0.11
+    assert 0 < np.hypot(*centre) <= maze.cell_size * np.sqrt(2)  # the nearest clear point, within one cell
+    assert parse_split(GOOD, maze, snap=0.11) == parse_split(GOOD, maze)  # a valid reply is untouched
+
+
+def test_a_waypoint_with_no_clear_point_within_a_cell_is_still_rejected():
+    from specrefine.proposers.schema import parse_split
+
+    solid = parse_maze("#######\n#S...G#\n#######\n#######\n#######\n#######\n#######", "solid")
+    x, y = solid.cell_to_xy(5, 3)  # three cells below the corridor: every point within one cell is in a wall
+    reply = json.dumps({"waypoints": [{"type": "disc", "center": [float(x), float(y)], "radius": 0.3}]})
+    with pytest.raises(ProposalRejected, match="inside a wall"):
+        parse_split(reply, solid, snap=0.11)
+
+
+def test_the_proposer_snaps_only_when_the_query_asks(srv, tmp_path, query):
+    from dataclasses import replace
+
+    srv.script[:] = [[IN_WALL], [IN_WALL]]
+    assert proposer(srv, tmp_path).propose_split(query, 1) == []
+    srv.script[:] = [[IN_WALL]]
+    (waypoints,) = proposer(srv, tmp_path).propose_split(replace(query, snap=0.11), 1)
+    assert len(waypoints) == 1 and float(query.maze.obstacles.signed_distance(
+        np.asarray(waypoints[0].centre())[None])[0]) >= 0.11

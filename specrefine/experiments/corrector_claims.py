@@ -35,6 +35,8 @@ from .grids import (
     GRIDS,
     HELD_OUT_MAZES,
     HELD_OUT_MIXES,
+    NEW_MAZES,
+    NEW_MIXES,
     OTHER_POINT_MAZES,
     ROOT,
     SCALING_MAZES,
@@ -53,27 +55,28 @@ RETRY = "ours-corrector-retry"
 THRIFT = "ours-corrector-thrift"
 POLISH = "ours-corrector-polish"
 CENTRE = "ours-corrector-polish (centre)"  # polish with every leg aimed at its region's centre (its grid's rows)
+PERSIST = "ours-corrector-persist"  # polish at centre points, corrected until no leg is dead (its grids' rows)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
-                 POLISH: "corrector-polish", CENTRE: "corrector-centre"}
+                 POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
-                     THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH}
+                     THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
-                 CENTRE: "corrector-centre-suite"}
+                 CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE}
+SELF_CONTAINED = {CENTRE, PERSIST}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE}
+            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
@@ -312,14 +315,17 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                               SCALING_MAZES, POINT_SEEDS, first=ref))
     if method in VARIANT_SUITE:
         suite = rows + named(load(GRIDS[VARIANT_SUITE[method]].tables, root), method)
+        if method in SELF_CONTAINED and ref in VARIANT_SUITE:  # ours at the same settings: the reference's suite grid
+            suite += [r for r in named(load(GRIDS[VARIANT_SUITE[ref]].tables, root), ref) if r["method"] == "ours"]
         study["versus_ours"] = [e for p in presets for e in per_maze(suite, p, SCALING_MAZES + OTHER_POINT_MAZES,
                                                                      POINT_SEEDS, reference=("ours", "*"),
                                                                      method=method)]
     study["held_out"] = variant_held_out(method, root)
     study["held_out_costs"] = variant_held_out_costs(method, root)
     if method in SELF_CONTAINED:
-        study["oracle_versus_paper"] = _oracle_versus_paper(rows, root)
         study["every_episode"] = {p: zero_runs(rows, method, p, SCALING_MAZES, rate=1.0) for p in presets}
+    if method == CENTRE:
+        study["oracle_versus_paper"] = _oracle_versus_paper(rows, root)
         study["fresh"] = fresh_study(root)
     if "imperfect:severe" in grid.proposers:
         study["severe"] = per_maze(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, method=method)
@@ -329,7 +335,66 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                              POINT_SEEDS, SCALING_MAZES)
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
+    if method == PERSIST:
+        study["new"] = new_study(root)
+        study["adoption"] = persist_adoption(study, cells, failed, root)
     return study
+
+
+NEW_GRID = "corrector-persist-new"  # docs/corrector.md, "Corrected until alive"
+NEW_NAMES = dict(zip(NEW_MIXES, ("E", "F")))
+
+
+def new_study(root: Path = ROOT) -> dict | None:
+    """Described (docs/corrector.md, "Corrected until alive"): persist beside polish at centre points, ours and the
+    oracle on the layouts and mixes no run had used; runs at 0; persist - polish paired over the cells."""
+    rows = _new_rows(root)
+    if not any(r["method"] == PERSIST for r in rows):
+        return None
+    mazes, seeds = tuple(table_name(m) for m in NEW_MAZES), GRIDS[NEW_GRID].seeds
+    entries = []
+    for mix in NEW_MIXES:
+        for e in per_maze(rows, mix, mazes, seeds, reference=(CENTRE, "*"), method=PERSIST):
+            extra = {name: episodes_of(rows, e["maze"], *ref, seeds) for name, ref in (("ours", ("ours", mix)),
+                                                                                      ("oracle", ORACLE))}
+            entries.append(e | {"mix": NEW_NAMES[mix]} | {k: c[0] / c[1] if c[1] else math.nan
+                                                          for k, c in extra.items()})
+    cells, failed = cmp.table_cells(rows, "point")
+    zero = {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in NEW_MIXES) for m in (PERSIST, CENTRE, "ours")}
+    return {"per_maze": entries, "zero": zero, "runs": sum(e["runs"] for e in entries),
+            "paired": paired_across(cells, failed, NEW_MIXES, PERSIST, CENTRE, seeds, mazes)}
+
+
+def _new_rows(root: Path) -> list[dict]:
+    """The new layouts' rows, polish named as the centre variant it is."""
+    return named(load(GRIDS[NEW_GRID].tables, root), CENTRE)
+
+
+def persist_adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
+    """The adoption rule of "Corrected until alive": (1) no worse than polish at centre points on the U-chains at mild
+    and moderate (paired lower end >= -NON_INFERIORITY) and below ours on no suite maze; (2) fewer runs at 0 than
+    polish over the severe U-chain cells and the new cells together, and their paired difference >= 0."""
+    new_cells, new_failed = cmp.table_cells(_new_rows(root), "point")
+    groups = [(cells, failed, "imperfect:severe", SCALING_MAZES, POINT_SEEDS)]
+    groups += [(new_cells, new_failed, mix, tuple(table_name(m) for m in NEW_MAZES), GRIDS[NEW_GRID].seeds)
+               for mix in NEW_MIXES]
+    both = {(f"{maze} {p} s{seed}", m, "all", 0): v for c, _, p, mazes, seeds in groups
+            for (maze, m, q, seed), v in c.items() if q == p and maze in mazes and seed in seeds}
+    both_failed = {(f"{maze} {p} s{seed}", m, "all", 0) for _, f, p, mazes, seeds in groups
+                   for (maze, m, q, seed) in f if q == p}
+    labels = [f"{maze} {p} s{seed}" for _, _, p, mazes, seeds in groups for maze in mazes for seed in seeds]
+    paired = cmp.paired_difference(both, both_failed, "all", PERSIST, CENTRE, (0,), labels)
+    severe = study.get("severe_zero", {})
+    new_zero = (study.get("new") or {}).get("zero", {})
+    zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (PERSIST, CENTRE)}
+    versus, suite = study["versus_corrector"], study.get("versus_ours", [])
+    below = [e for p in ("imperfect:mild", "imperfect:moderate") for e in _below_ours(suite, p)]
+    first = (not math.isnan(versus["estimate"]) and versus["ci_low"] >= -NON_INFERIORITY and not below)
+    second = zero[PERSIST] < zero[CENTRE] and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
+    suite_done = bool(suite) and all(e["runs"] == len(POINT_SEEDS) for e in suite)
+    complete = versus["complete"] and paired["complete"] and suite_done
+    return {"no_worse": first, "fewer_zero": second, "zero": zero, "paired": paired, "below_ours": below,
+            "complete": complete, "adopted": first and second and complete}
 
 
 FRESH_GRIDS = ("corrector-centre-fresh", "corrector-sampled-fresh")  # docs/corrector.md, "Fresh layouts ..."
@@ -370,6 +435,34 @@ def fresh_markdown(fresh: dict) -> list[str]:
               f"{_diff(e)} | {_num(e['ours'])} | {_num(e['oracle'])} | {_num(e['oracle_sampled'])} |"
               for e in fresh["per_maze"]]
     return lines
+
+
+def new_markdown(new: dict) -> list[str]:
+    lines = ["", f"Layouts and mixes no run had used (grid `{NEW_GRID}`; docs/corrector.md, 'Corrected until alive'): "
+             f"per generated maze and mix (E, F), pooled over seeds; {PERSIST} - {CENTRE} (Newcombe 95 %), paired "
+             f"over the cells: {_paired_text(new['paired'])}. Runs at 0: "
+             + ", ".join(f"{m} {z}" for m, z in new["zero"].items()) + f" (of {new['runs']} each).", "",
+             "| mix | maze | runs | persist | polish (centre) | difference | ours (centre) | oracle (centre) |",
+             "|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
+              f"{_diff(e)} | {_num(e['ours'])} | {_num(e['oracle'])} |" for e in new["per_maze"]]
+    return lines
+
+
+def _new_text(new: dict) -> str:
+    done = [e for e in new["per_maze"] if e["runs"]]
+    both = [e for e in done if e["reference_runs"]]
+    text = (f"persist {min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix "
+            f"over {new['runs']} runs ({len(done)} of {len(new['per_maze'])} layouts and mixes run)")
+    if both:
+        text += (f", polish {min(e['reference_success'] for e in both):.3f}-"
+                 f"{max(e['reference_success'] for e in both):.3f}; persist - polish {_paired_text(new['paired'])}")
+    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in new["zero"].items())
+
+
+def _adoption_text(study: dict) -> str:
+    rows = _adoption_rows(study)
+    return "; ".join(f"{r['value']} ({r['verdict']})" for r in rows[:2]) + f": **{rows[2]['verdict']}**"
 
 
 def _fresh_text(fresh: dict) -> str:
@@ -715,7 +808,26 @@ def variant_verdicts(vs: dict) -> list[dict]:
             ("no worse" if severe["verdict"] != "lower" else "worse") + ("" if severe["complete"] else " (partial)")
         out.append({"rule": f"{method}, imperfect:severe: no worse than ours-repair (paired, U-chains)",
                     "value": _paired_text(severe), "verdict": verdict})
+    if "adoption" in vs:
+        out += _adoption_rows(vs)
     return out
+
+
+def _adoption_rows(vs: dict) -> list[dict]:
+    """The two parts of persist's adoption rule (docs/corrector.md, "Corrected until alive") and its outcome."""
+    a, method, ref = vs["adoption"], vs["method"], vs["reference"]
+    pending = "" if a["complete"] else " (partial)"
+    below = f"; below ours on {', '.join(a['below_ours'])}" if a["below_ours"] else "; below ours on no suite maze"
+    return [{"rule": f"{method}, adoption 1: no worse than {ref} (U-chains, mild and moderate) and below ours on no "
+                     "suite maze", "value": _paired_text(vs["versus_corrector"]) + below,
+             "verdict": ("holds" if a["no_worse"] else "does not hold") + pending},
+            {"rule": f"{method}, adoption 2: fewer runs at 0 than {ref} over the severe and new cells, paired "
+                     "difference >= 0", "value": f"runs at 0: {a['zero'][method]} against {a['zero'][ref]}; "
+                                                 f"{_paired_text(a['paired'])}",
+             "verdict": ("holds" if a["fewer_zero"] else "does not hold") + pending},
+            {"rule": f"{method}: adopted (README's rules table reads it)", "value": "both parts hold"
+             if a["no_worse"] and a["fewer_zero"] else "not both parts",
+             "verdict": ("adopted" if a["adopted"] else "not adopted") + pending}]
 
 
 def variant_markdown(vs: dict) -> list[str]:
@@ -744,6 +856,8 @@ def variant_markdown(vs: dict) -> list[str]:
                   f"{_num(e['reference_success'])} | {_diff(e)} |" for e in vs["versus_ours"]]
     if vs.get("fresh"):
         lines += fresh_markdown(vs["fresh"])
+    if vs.get("new"):
+        lines += new_markdown(vs["new"])
     if "oracle_versus_paper" in vs:
         lines += ["", "Described beside its rules: the oracle (ours, geometric) as this grid runs it, against the "
                   f"oracle at the paper's settings (grid taxonomy) {_paired_text(vs['oracle_versus_paper'])} "
@@ -866,8 +980,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     their ``VARIANTS`` name)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
-             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, ANT_BEFORE,
-             ANT_GRID)
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, NEW_GRID,
+             ANT_BEFORE, ANT_GRID)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -908,6 +1022,9 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
                 k, n = study["severe_zero"][study["method"]]
                 out[f"{name}-severe-zero"] = f"{k} of {n}"
+        if study and "adoption" in study:
+            out[f"{name}-new"] = _new_text(study["new"]) if study.get("new") else "not run yet"
+            out[f"{name}-adoption"] = _adoption_text(study)
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["table"] = rules_table(variants.get(REPORTED), point, ant)
     if held_out:

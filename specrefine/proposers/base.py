@@ -35,6 +35,7 @@ class EdgeQuery:
     image_png: bytes | None  # the map with start/goal and the evaluated trajectories
     graph: TaskGraph | None = None  # the task graph the edge belongs to (context only)
     facts: EvaluationFacts | None = None  # what the evaluator does (default: an Evaluator's default settings)
+    snap: float = 0.0  # > 0: a reply's waypoint centred in a wall is moved this far clear of it (schema.snapped)
 
 
 @dataclass

@@ -185,8 +185,29 @@ def check_region(region: Region, maze, what: str = "waypoint") -> str | None:
     return None
 
 
-def parse_split(text: str | None, maze, *, max_waypoints: int = 32) -> tuple[list[Region], str]:
-    """Validate one edge-split reply: ``(waypoint regions, reasoning)`` or ProposalRejected."""
+def snapped(region: Region, maze, clearance: float) -> Region | None:
+    """``region`` moved so that its centre is the nearest point at least ``clearance`` from the maze's walls and
+    hazards within one cell of where it was (on a grid of 1/20 cell); None if there is no such point."""
+    c = np.asarray(region.centre(), dtype=float)
+    step = maze.cell_size / 20
+    offsets = np.arange(-20, 21) * step
+    grid = c + np.stack(np.meshgrid(offsets, offsets), axis=-1).reshape(-1, 2)
+    x0, y0, x1, y1 = maze.bounds()
+    inside = (grid[:, 0] >= x0) & (grid[:, 0] <= x1) & (grid[:, 1] >= y0) & (grid[:, 1] <= y1)
+    clear = grid[inside][maze.obstacles.signed_distance(grid[inside]) >= clearance]
+    if not len(clear):
+        return None
+    dx, dy = clear[np.argmin(np.sum((clear - c) ** 2, axis=1))] - c
+    if isinstance(region, Disc):
+        return Disc(region.cx + dx, region.cy + dy, region.r)
+    return Box(region.xmin + dx, region.ymin + dy, region.xmax + dx, region.ymax + dy)
+
+
+def parse_split(text: str | None, maze, *, max_waypoints: int = 32, snap: float = 0.0
+                ) -> tuple[list[Region], str]:
+    """Validate one edge-split reply: ``(waypoint regions, reasoning)`` or ProposalRejected. ``snap`` > 0 (beyond the
+    paper): a waypoint whose centre lies in a wall or hazard is moved to the nearest point that far from them within
+    one cell (:func:`snapped`), and the reply is rejected only if there is none."""
     data = parse_json(text)
     if isinstance(data, list):  # a bare list of waypoints
         data = {"waypoints": data}
@@ -200,6 +221,8 @@ def parse_split(text: str | None, maze, *, max_waypoints: int = 32) -> tuple[lis
     for i, spec in enumerate(prop.waypoints, start=1):
         region = spec.to_region()
         why = check_region(region, maze, f"waypoint {i}")
+        if why and snap > 0 and " lies inside a " in why and (moved := snapped(region, maze, snap)) is not None:
+            region, why = moved, check_region(moved, maze, f"waypoint {i}")
         if why:
             raise ProposalRejected(why)
         regions.append(region)

@@ -52,7 +52,7 @@ class VLMProposer(Proposer):
 
     def split(self, q: EdgeQuery, w: int, feedback: Sequence[CandidateFeedback] = ()) -> list[list[Region]]:
         messages = split_messages(q, feedback)
-        parse = lambda text: parse_split(text, q.maze, max_waypoints=self.max_waypoints)  # noqa: E731
+        parse = lambda text: parse_split(text, q.maze, max_waypoints=self.max_waypoints, snap=q.snap)  # noqa: E731
         return self._ask(messages, w, parse, "edge split", round_=1 + bool(feedback))
 
     def graph(self, q: GraphQuery, w: int, feedback: Sequence[GraphFeedback] = ()) -> list[TaskGraph]:

@@ -25,7 +25,7 @@ import functools
 import json
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -81,6 +81,8 @@ class SearchConfig:
     #                                   succeeded on its fresh check, until the search's max_edge_splits are spent
     correct_first_win: bool = False  # the correction asks for a leg's alternatives cheapest first, stops at a win
     correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
+    snap_waypoints: bool = False  # beyond the paper: a reply's waypoint centred in a wall is moved clear of it
+    #                               (by the agent's clearance, within one cell) instead of the reply being rejected
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -325,7 +327,10 @@ class RefinementSearch:
         """Algorithm 1 on a -> b of ``chain_graph`` (a leg of a candidate or of the found path), from ``start``, in
         ``d`` proposer rounds (None: the configuration's)."""
         self.splits_generated += 1
-        return edge_split(self.evaluator, self.proposer, self.query_for(chain_graph, a, b, result), start=start,
+        query = self.query_for(chain_graph, a, b, result)
+        if self.cfg.snap_waypoints:
+            query = replace(query, snap=float(getattr(self.evaluator, "clearance", 0.0)))
+        return edge_split(self.evaluator, self.proposer, query, start=start,
                           goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
                           rng=self.rng, picture=self.picture, racing=self.racing,
                           feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning,

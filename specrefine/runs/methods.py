@@ -246,11 +246,16 @@ register_method("ours-corrector-polish", ours_variant(**CORRECTOR | THRIFT | dic
                 "waypoint whose leg in fails at least twice in 512 fresh rollouts is narrowed by Algorithm 2 (k "
                 "subsets of its region) where that raises its two legs' product (ours-polish's step)",
                 colour="#4a148c")
-register_method("ours-corrector-persist", ours_variant(**CORRECTOR | THRIFT | dict(polish_rollouts=512,
-                                                                        correct_while_dead=True)),
+#: ours-corrector-persist: polish, corrected until no leg is dead (docs/corrector.md, "Corrected until alive")
+PERSIST = dict(polish_rollouts=512, correct_while_dead=True)
+register_method("ours-corrector-persist", ours_variant(**CORRECTOR | THRIFT | PERSIST),
                 "beyond the paper: ours-corrector-polish whose correction goes on while the path it leaves has a "
                 "leg that never succeeded on its fresh check: pass after pass, each on a fresh draw, until no leg is "
                 "dead or the search's budget of 30 edge splits is spent", colour="#880e4f")
+register_method("ours-corrector-snap", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(snap_waypoints=True)),
+                "beyond the paper: ours-corrector-persist taking a reply whose waypoint is centred in a wall with "
+                "that waypoint moved to the nearest point clear of walls by the agent's clearance (within one cell), "
+                "instead of rejecting the reply", colour="#ad1457")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
