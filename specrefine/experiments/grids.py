@@ -227,6 +227,15 @@ NEW_MIXES = ("imperfect:position_sigma=0.3,radius=0.5,radius_log_sigma=0.4,corne
              "p_false_opening=0.35,p_uncapped=0.5,p_unparseable=0.15,alpha=0.15,rho=0.4",
              "imperfect:position_sigma=0.3,coord_grid=0.5,radius=0.35,radius_log_sigma=0.35,p_wrong_branch=0.4,"
              "p_mirror_y=0.2,p_drop_turn=0.2,p_uncapped=0.5,alpha=0.25,rho=0.6")
+#: layouts and error mixes no run had used before grid corrector-snap-new (docs/corrector.md, "Snapped out of the
+#: wall"): four more generated mazes, and two mixes: G (large offsets rounded to quarter cells, small regions pulled
+#: to corners, false openings, unparseable replies) and H (coordinates rounded to whole cells, wrong branches,
+#: mirrored replies, dropped turns growing with the turns a query spans)
+SNAP_MAZES = ("random:5x5:64", "random:6x6:12", "random:4x7:3", "random:7x4:21")
+SNAP_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.3,radius_log_sigma=0.5,corner_pull=0.3,"
+              "p_drop_turn=0.15,p_false_opening=0.2,p_uncapped=0.4,p_unparseable=0.1,rho=0.5",
+              "imperfect:position_sigma=0.2,coord_grid=1.0,radius=0.45,radius_log_sigma=0.3,p_wrong_branch=0.25,"
+              "p_mirror_y=0.1,p_drop_turn=0.3,alpha=0.2,p_uncapped=0.6,rho=0.5")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -528,6 +537,34 @@ GRIDS = {g.name: g for g in (
                     table="data/results/corrector/persist_held_out.csv", out="held_out")),
         seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="ebc78e2",
         table="data/results/corrector/persist_suite.csv", out="runs/corrector_persist_suite"),
+    # docs/corrector.md, "Snapped out of the wall" (fixed 2026-11-28 03:31 UTC, before any cell but its pilot ran)
+    ExperimentGrid(
+        "corrector-snap-new", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it "
+        "ran): snap, persist, polish and ours on layouts and mixes no run had used", "point",
+        parts=(Part(("ours-corrector-snap", "ours-corrector-persist", "ours-corrector-polish", "ours"), SNAP_MIXES,
+                    split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/snap_new_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=SNAP_MAZES, goal_points="centre", workers=1, code="8d73398",
+        table="data/results/corrector/snap_new.csv", out="runs/corrector_snap_new"),
+    ExperimentGrid(
+        "corrector-snap", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it ran)",
+        "point",
+        parts=(Part(("ours-corrector-snap",), NEW_MIXES, seeds=(0, 1), mazes=NEW_MAZES,
+                    table="data/results/corrector/snap_persist_new.csv", out="persist_new"),
+               Part(("ours-corrector-snap",), ("imperfect:severe",), mazes=SCALING_MAZES,
+                    table="data/results/corrector/snap_severe.csv", out="severe"),
+               Part(("ours-corrector-snap",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
+                    split="seeds")),
+        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="8d73398",
+        table="data/results/corrector/snap.csv", out="runs/corrector_snap"),
+    ExperimentGrid(
+        "corrector-snap-suite", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it "
+        "ran)", "point",
+        parts=(Part(("ours-corrector-snap",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
+               Part(("ours-corrector-snap",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
+                    table="data/results/corrector/snap_held_out.csv", out="held_out")),
+        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="8d73398",
+        table="data/results/corrector/snap_suite.csv", out="runs/corrector_snap_suite"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
