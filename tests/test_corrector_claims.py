@@ -439,7 +439,7 @@ def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids
     counts runs at 0 over the severe and new cells together."""
     for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite"):
         lay_all_parts(tmp_path, name, persist_rate)
-    assert cc.new_study(tmp_path) is None
+    assert cc.new_study(cc.PERSIST, tmp_path) is None
     vs = cc.variant_study(cc.PERSIST, tmp_path)
     assert vs["reference"] == cc.CENTRE and vs["versus_corrector"]["estimate"] == pytest.approx(0.0)
     assert vs["versus_corrector"]["n_cells"] == 72
@@ -464,6 +464,36 @@ def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids
     assert rules[f"{cc.PERSIST}: adopted (README's rules table reads it)"] == "adopted"
     assert "runs at 0: ours-corrector-persist 0" in cc._new_text(new)
     assert "Layouts and mixes no run had used" in "\n".join(cc.variant_markdown(vs))
+
+
+def test_snap_is_judged_against_persist_with_the_centre_grids_references_and_its_own_new_layouts(tmp_path):
+    """corrector-snap's references: persist (its rows), and through persist the centre grids' oracle, ours and
+    ours-repair; its new layouts put snap, persist, polish and ours side by side; it is adopted only where persist
+    is no worse than polish."""
+    def rate(maze, method, proposer):
+        if method == cc.SNAP:
+            return 0.99
+        if method == cc.PERSIST and proposer in cc.SNAP_MIXES and cc.table_name(maze) == "random:6x6:12":
+            return 0.0
+        return persist_rate(maze, method, proposer)
+
+    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
+                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new"):
+        lay_all_parts(tmp_path, name, rate)
+    studies = cc.variant_studies(tmp_path)
+    vs, persist = studies["snap"], studies["persist"]
+    assert vs["reference"] == cc.PERSIST and vs["versus_corrector"]["n_cells"] == 72
+    assert all(e["reference_success"] == pytest.approx(1.0) for e in vs["per_maze"])  # the centre grid's oracle
+    assert all(e["reference_success"] == pytest.approx(0.9) for e in vs["versus_ours"])  # its ours
+    assert vs["severe_vs_repair"]["estimate"] == pytest.approx(0.29)
+    assert all(e["ours"] == pytest.approx(0.9) for e in vs["held_out"])
+    new = vs["new"]
+    assert new["zero"] == {cc.SNAP: 0, cc.PERSIST: 4, cc.CENTRE: 0, "ours": 0} and new["names"] == ["G", "H"]
+    assert new["reference_paired"]["n_cells"] == 16 and new["per_maze"][1]["polish"] == pytest.approx(0.99)
+    assert vs["adoption"]["zero"] == {cc.SNAP: 0, cc.PERSIST: 4} and vs["adoption"]["fewer_zero"]
+    assert persist["adoption"]["no_worse"] and vs["adoption"]["reference_no_worse"]
+    assert "| mix | maze | runs | ours-corrector-snap | ours-corrector-persist | difference | polish (centre) |" in \
+        "\n".join(cc.variant_markdown(vs))
 
 
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):

@@ -40,6 +40,8 @@ from .grids import (
     OTHER_POINT_MAZES,
     ROOT,
     SCALING_MAZES,
+    SNAP_MAZES,
+    SNAP_MIXES,
 )
 
 METHOD = "ours-corrector"
@@ -56,28 +58,34 @@ THRIFT = "ours-corrector-thrift"
 POLISH = "ours-corrector-polish"
 CENTRE = "ours-corrector-polish (centre)"  # polish with every leg aimed at its region's centre (its grid's rows)
 PERSIST = "ours-corrector-persist"  # polish at centre points, corrected until no leg is dead (its grids' rows)
+SNAP = "ours-corrector-snap"  # persist, a reply's waypoint centred in a wall moved clear of it (its grids' rows)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
-                 POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist"}
+                 POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
+                 SNAP: "corrector-snap"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
-                     THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE}
+                     THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
+                     SNAP: PERSIST}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
-                 CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite"}
+                 CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
+                 SNAP: "corrector-snap-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
-            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST}
-REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre")
+            "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
+            "snap": SNAP}
+REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
+ADOPTABLE = ("snap", "persist")  # ... a later variant is adopted by its rule, the latest first (reported())
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -315,8 +323,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                               SCALING_MAZES, POINT_SEEDS, first=ref))
     if method in VARIANT_SUITE:
         suite = rows + named(load(GRIDS[VARIANT_SUITE[method]].tables, root), method)
-        if method in SELF_CONTAINED and ref in VARIANT_SUITE:  # ours at the same settings: the reference's suite grid
-            suite += [r for r in named(load(GRIDS[VARIANT_SUITE[ref]].tables, root), ref) if r["method"] == "ours"]
+        if method in SELF_CONTAINED:  # ours at the same settings: the suite grid of the variant whose grids run it
+            suite += [r for r in load(GRIDS[VARIANT_SUITE[CENTRE]].tables, root) if r["method"] == "ours"]
         study["versus_ours"] = [e for p in presets for e in per_maze(suite, p, SCALING_MAZES + OTHER_POINT_MAZES,
                                                                      POINT_SEEDS, reference=("ours", "*"),
                                                                      method=method)]
@@ -335,62 +343,73 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                              POINT_SEEDS, SCALING_MAZES)
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
-    if method == PERSIST:
-        study["new"] = new_study(root)
-        study["adoption"] = persist_adoption(study, cells, failed, root)
+    if method in NEW_STUDIES:
+        study["new"] = new_study(method, root)
+        study["adoption"] = adoption(study, cells, failed, root)
     return study
 
 
-NEW_GRID = "corrector-persist-new"  # docs/corrector.md, "Corrected until alive"
-NEW_NAMES = dict(zip(NEW_MIXES, ("E", "F")))
+#: a variant run on layouts and mixes no run had used, beside its reference: (grid, mazes, mixes, mix names)
+NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F")),
+               SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H"))}
+NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 
 
-def new_study(root: Path = ROOT) -> dict | None:
-    """Described (docs/corrector.md, "Corrected until alive"): persist beside polish at centre points, ours and the
-    oracle on the layouts and mixes no run had used; runs at 0; persist - polish paired over the cells."""
-    rows = _new_rows(root)
-    if not any(r["method"] == PERSIST for r in rows):
+def new_study(method: str, root: Path = ROOT) -> dict | None:
+    """Described (docs/corrector.md, "Corrected until alive", "Snapped out of the wall"): the variant beside its
+    reference, polish at centre points, ours and the oracle on layouts and mixes no run had used; runs at 0; the
+    variant - its reference paired over the cells (and the reference - polish where polish is not it)."""
+    grid, mazes, mixes, names = NEW_STUDIES[method]
+    rows, ref = _new_rows(grid, root), reference_of(method)
+    if not any(r["method"] == method for r in rows):
         return None
-    mazes, seeds = tuple(table_name(m) for m in NEW_MAZES), GRIDS[NEW_GRID].seeds
+    mazes, seeds = tuple(table_name(m) for m in mazes), GRIDS[grid].seeds
+    others = [("ours", "ours"), ("oracle", ORACLE)] + ([("polish", CENTRE)] if ref != CENTRE else [])
     entries = []
-    for mix in NEW_MIXES:
-        for e in per_maze(rows, mix, mazes, seeds, reference=(CENTRE, "*"), method=PERSIST):
-            extra = {name: episodes_of(rows, e["maze"], *ref, seeds) for name, ref in (("ours", ("ours", mix)),
-                                                                                      ("oracle", ORACLE))}
-            entries.append(e | {"mix": NEW_NAMES[mix]} | {k: c[0] / c[1] if c[1] else math.nan
-                                                          for k, c in extra.items()})
+    for mix, name in zip(mixes, names):
+        for e in per_maze(rows, mix, mazes, seeds, reference=(ref, "*"), method=method):
+            extra = {key: episodes_of(rows, e["maze"], *((m, mix) if isinstance(m, str) else m), seeds)
+                     for key, m in others}
+            entries.append(e | {"mix": name} | {k: c[0] / c[1] if c[1] else math.nan for k, c in extra.items()})
     cells, failed = cmp.table_cells(rows, "point")
-    zero = {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in NEW_MIXES) for m in (PERSIST, CENTRE, "ours")}
-    return {"per_maze": entries, "zero": zero, "runs": sum(e["runs"] for e in entries),
-            "paired": paired_across(cells, failed, NEW_MIXES, PERSIST, CENTRE, seeds, mazes)}
+    shown = (method, ref) + ((CENTRE,) if ref != CENTRE else ()) + ("ours",)
+    study = {"grid": grid, "method": method, "reference": ref, "names": list(names), "per_maze": entries,
+             "zero": {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in mixes) for m in shown},
+             "runs": sum(e["runs"] for e in entries),
+             "paired": paired_across(cells, failed, mixes, method, ref, seeds, mazes)}
+    if ref != CENTRE:
+        study["reference_paired"] = paired_across(cells, failed, mixes, ref, CENTRE, seeds, mazes)
+    return study
 
 
-def _new_rows(root: Path) -> list[dict]:
-    """The new layouts' rows, polish named as the centre variant it is."""
-    return named(load(GRIDS[NEW_GRID].tables, root), CENTRE)
+def _new_rows(grid: str, root: Path) -> list[dict]:
+    """A new-layout grid's rows, polish named as the centre variant it is."""
+    return named(load(GRIDS[grid].tables, root), CENTRE)
 
 
-def persist_adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
-    """The adoption rule of "Corrected until alive": (1) no worse than polish at centre points on the U-chains at mild
-    and moderate (paired lower end >= -NON_INFERIORITY) and below ours on no suite maze; (2) fewer runs at 0 than
-    polish over the severe U-chain cells and the new cells together, and their paired difference >= 0."""
-    new_cells, new_failed = cmp.table_cells(_new_rows(root), "point")
+def adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
+    """A variant's adoption rule against its reference (docs/corrector.md, "Corrected until alive" and "Snapped out
+    of the wall"): (1) no worse on the U-chains at mild and moderate (paired lower end >= -NON_INFERIORITY) and below
+    ours on no suite maze; (2) fewer runs at 0 over the severe U-chain cells and its new cells together, and their
+    paired difference >= 0."""
+    method, ref = study["method"], study["reference"]
+    grid, mazes, mixes, _ = NEW_STUDIES[method]
+    new_cells, new_failed = cmp.table_cells(_new_rows(grid, root), "point")
     groups = [(cells, failed, "imperfect:severe", SCALING_MAZES, POINT_SEEDS)]
-    groups += [(new_cells, new_failed, mix, tuple(table_name(m) for m in NEW_MAZES), GRIDS[NEW_GRID].seeds)
-               for mix in NEW_MIXES]
-    both = {(f"{maze} {p} s{seed}", m, "all", 0): v for c, _, p, mazes, seeds in groups
-            for (maze, m, q, seed), v in c.items() if q == p and maze in mazes and seed in seeds}
-    both_failed = {(f"{maze} {p} s{seed}", m, "all", 0) for _, f, p, mazes, seeds in groups
+    groups += [(new_cells, new_failed, mix, tuple(table_name(m) for m in mazes), GRIDS[grid].seeds) for mix in mixes]
+    both = {(f"{maze} {p} s{seed}", m, "all", 0): v for c, _, p, names, seeds in groups
+            for (maze, m, q, seed), v in c.items() if q == p and maze in names and seed in seeds}
+    both_failed = {(f"{maze} {p} s{seed}", m, "all", 0) for _, f, p, names, seeds in groups
                    for (maze, m, q, seed) in f if q == p}
-    labels = [f"{maze} {p} s{seed}" for _, _, p, mazes, seeds in groups for maze in mazes for seed in seeds]
-    paired = cmp.paired_difference(both, both_failed, "all", PERSIST, CENTRE, (0,), labels)
+    labels = [f"{maze} {p} s{seed}" for _, _, p, names, seeds in groups for maze in names for seed in seeds]
+    paired = cmp.paired_difference(both, both_failed, "all", method, ref, (0,), labels)
     severe = study.get("severe_zero", {})
     new_zero = (study.get("new") or {}).get("zero", {})
-    zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (PERSIST, CENTRE)}
+    zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (method, ref)}
     versus, suite = study["versus_corrector"], study.get("versus_ours", [])
     below = [e for p in ("imperfect:mild", "imperfect:moderate") for e in _below_ours(suite, p)]
     first = (not math.isnan(versus["estimate"]) and versus["ci_low"] >= -NON_INFERIORITY and not below)
-    second = zero[PERSIST] < zero[CENTRE] and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
+    second = zero[method] < zero[ref] and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
     suite_done = bool(suite) and all(e["runs"] == len(POINT_SEEDS) for e in suite)
     complete = versus["complete"] and paired["complete"] and suite_done
     return {"no_worse": first, "fewer_zero": second, "zero": zero, "paired": paired, "below_ours": below,
@@ -438,31 +457,38 @@ def fresh_markdown(fresh: dict) -> list[str]:
 
 
 def new_markdown(new: dict) -> list[str]:
-    lines = ["", f"Layouts and mixes no run had used (grid `{NEW_GRID}`; docs/corrector.md, 'Corrected until alive'): "
-             f"per generated maze and mix (E, F), pooled over seeds; {PERSIST} - {CENTRE} (Newcombe 95 %), paired "
-             f"over the cells: {_paired_text(new['paired'])}. Runs at 0: "
-             + ", ".join(f"{m} {z}" for m, z in new["zero"].items()) + f" (of {new['runs']} each).", "",
-             "| mix | maze | runs | persist | polish (centre) | difference | ours (centre) | oracle (centre) |",
-             "|---|---|---|---|---|---|---|---|"]
+    method, ref = new["method"], new["reference"]
+    polish = " | polish (centre)" if "reference_paired" in new else ""
+    lines = ["", f"Layouts and mixes no run had used (grid `{new['grid']}`; docs/corrector.md): per generated maze and "
+             f"mix ({', '.join(new['names'])}), pooled over seeds; {method} - {ref} (Newcombe 95 %), paired over the "
+             f"cells: {_paired_text(new['paired'])}"
+             + (f"; {ref} - {CENTRE}: {_paired_text(new['reference_paired'])}" if "reference_paired" in new else "")
+             + ". Runs at 0: " + ", ".join(f"{m} {z}" for m, z in new["zero"].items()) + f" (of {new['runs']} each).",
+             "", f"| mix | maze | runs | {method} | {ref} | difference{polish} | ours (centre) | oracle (centre) |",
+             "|---|---|---|---|---|---|" + "---|" * (2 + bool(polish))]
     lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
-              f"{_diff(e)} | {_num(e['ours'])} | {_num(e['oracle'])} |" for e in new["per_maze"]]
+              f"{_diff(e)}" + (f" | {_num(e['polish'])}" if polish else "") + f" | {_num(e['ours'])} | "
+              f"{_num(e['oracle'])} |" for e in new["per_maze"]]
     return lines
 
 
 def _new_text(new: dict) -> str:
     done = [e for e in new["per_maze"] if e["runs"]]
     both = [e for e in done if e["reference_runs"]]
-    text = (f"persist {min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix "
-            f"over {new['runs']} runs ({len(done)} of {len(new['per_maze'])} layouts and mixes run)")
+    short = lambda m: m.removeprefix(f"{METHOD}-")  # noqa: E731
+    text = (f"{short(new['method'])} {min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per "
+            f"layout and mix over {new['runs']} runs ({len(done)} of {len(new['per_maze'])} layouts and mixes run)")
     if both:
-        text += (f", polish {min(e['reference_success'] for e in both):.3f}-"
-                 f"{max(e['reference_success'] for e in both):.3f}; persist - polish {_paired_text(new['paired'])}")
+        text += (f", {short(new['reference'])} {min(e['reference_success'] for e in both):.3f}-"
+                 f"{max(e['reference_success'] for e in both):.3f}; {short(new['method'])} - "
+                 f"{short(new['reference'])} {_paired_text(new['paired'])}")
     return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in new["zero"].items())
 
 
 def _adoption_text(study: dict) -> str:
     rows = _adoption_rows(study)
-    return "; ".join(f"{r['value']} ({r['verdict']})" for r in rows[:2]) + f": **{rows[2]['verdict']}**"
+    return (f"(1) no worse on the U-chains, {rows[0]['value']} ({rows[0]['verdict']}); (2) {rows[1]['value']} "
+            f"({rows[1]['verdict']}): **{rows[2]['verdict']}**")
 
 
 def _fresh_text(fresh: dict) -> str:
@@ -505,7 +531,12 @@ def _base_rows(method: str, root: Path) -> list[dict]:
 
 def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
     """Every variant's study by its short name (README's marker, claims.json's key)."""
-    return {name: variant_study(method, root) for name, method in VARIANTS.items()}
+    studies = {name: variant_study(method, root) for name, method in VARIANTS.items()}
+    snap, persist = studies.get("snap"), studies.get("persist")
+    if snap:  # snap is adopted only where persist is, or would be but for its second part ("Snapped out of the wall")
+        held = bool(persist) and persist["adoption"]["no_worse"]
+        snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
+    return studies
 
 
 def named(rows: list[dict], method: str) -> list[dict]:
@@ -525,7 +556,10 @@ def _reference_rows(method: str, root: Path, held_out: bool = False) -> list[dic
     ref = reference_of(method)
     if ref == METHOD:
         return []
-    return named(load(_held_out_tables(ref) if held_out else GRIDS[VARIANT_GRIDS[ref]].tables, root), ref)
+    rows = named(load(_held_out_tables(ref) if held_out else GRIDS[VARIANT_GRIDS[ref]].tables, root), ref)
+    if ref in SELF_CONTAINED and reference_of(ref) in SELF_CONTAINED:  # its oracle, ours, ... are its reference's
+        rows += _reference_rows(ref, root, held_out)
+    return rows
 
 
 def _held_out_tables(method: str) -> tuple:
@@ -980,7 +1014,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     their ``VARIANTS`` name)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
-             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, NEW_GRID,
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
              ANT_BEFORE, ANT_GRID)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
@@ -1022,11 +1056,12 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
                 k, n = study["severe_zero"][study["method"]]
                 out[f"{name}-severe-zero"] = f"{k} of {n}"
-        if study and "adoption" in study:
-            out[f"{name}-new"] = _new_text(study["new"]) if study.get("new") else "not run yet"
-            out[f"{name}-adoption"] = _adoption_text(study)
+        if VARIANTS[name] in NEW_STUDIES:
+            out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
+            out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
-    out["table"] = rules_table(variants.get(REPORTED), point, ant)
+    out["table"] = rules_table(variants.get(reported(variants)), point, ant)
+    out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -1036,6 +1071,12 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
     return out
+
+
+def reported(variants: dict) -> str:
+    """The variant README's rules table reads: the latest of ``ADOPTABLE`` adopted by its rule, else ``REPORTED``."""
+    return next((name for name in ADOPTABLE if (variants.get(name) or {}).get("adoption", {}).get("adopted")),
+                REPORTED)
 
 
 def _known(variants: dict) -> None:
