@@ -492,6 +492,11 @@ def test_snap_is_judged_against_persist_with_the_centre_grids_references_and_its
     assert new["reference_paired"]["n_cells"] == 16 and new["per_maze"][1]["polish"] == pytest.approx(0.99)
     assert vs["adoption"]["zero"] == {cc.SNAP: 0, cc.PERSIST: 4} and vs["adoption"]["fewer_zero"]
     assert persist["adoption"]["no_worse"] and vs["adoption"]["reference_no_worse"]
+    assert not any(e["reference_runs"] for e in vs["informed"]["per_maze"])  # persist's new cells not laid yet
+    lay_all_parts(tmp_path, "corrector-persist-new", rate)
+    informed = cc.variant_studies(tmp_path)["snap"]["informed"]
+    assert informed["runs"] == 16 and informed["names"] == ["E", "F"]
+    assert all(e["success"] == 0.99 and e["reference_success"] == 0.99 for e in informed["per_maze"])
     assert "| mix | maze | runs | ours-corrector-snap | ours-corrector-persist | difference | polish (centre) |" in \
         "\n".join(cc.variant_markdown(vs))
 

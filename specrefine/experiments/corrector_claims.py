@@ -343,6 +343,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                              POINT_SEEDS, SCALING_MAZES)
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
+    if method == SNAP:  # on persist's new cells, which informed it (described)
+        study["informed"] = new_study(SNAP, root, on=PERSIST)
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -355,12 +357,14 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 
 
-def new_study(method: str, root: Path = ROOT) -> dict | None:
+def new_study(method: str, root: Path = ROOT, on: str | None = None) -> dict | None:
     """Described (docs/corrector.md, "Corrected until alive", "Snapped out of the wall"): the variant beside its
     reference, polish at centre points, ours and the oracle on layouts and mixes no run had used; runs at 0; the
     variant - its reference paired over the cells (and the reference - polish where polish is not it)."""
-    grid, mazes, mixes, names = NEW_STUDIES[method]
+    grid, mazes, mixes, names = NEW_STUDIES[on or method]
     rows, ref = _new_rows(grid, root), reference_of(method)
+    if on:  # the variant's own cells there come from its grid's part on them
+        rows += [r for r in load(GRIDS[VARIANT_GRIDS[method]].tables, root) if r["proposer"] in mixes]
     if not any(r["method"] == method for r in rows):
         return None
     mazes, seeds = tuple(table_name(m) for m in mazes), GRIDS[grid].seeds
@@ -456,10 +460,11 @@ def fresh_markdown(fresh: dict) -> list[str]:
     return lines
 
 
-def new_markdown(new: dict) -> list[str]:
+def new_markdown(new: dict, informed: bool = False) -> list[str]:
     method, ref = new["method"], new["reference"]
     polish = " | polish (centre)" if "reference_paired" in new else ""
-    lines = ["", f"Layouts and mixes no run had used (grid `{new['grid']}`; docs/corrector.md): per generated maze and "
+    what = "The cells that informed it, not held out" if informed else "Layouts and mixes no run had used"
+    lines = ["", f"{what} (grid `{new['grid']}`; docs/corrector.md): per generated maze and "
              f"mix ({', '.join(new['names'])}), pooled over seeds; {method} - {ref} (Newcombe 95 %), paired over the "
              f"cells: {_paired_text(new['paired'])}"
              + (f"; {ref} - {CENTRE}: {_paired_text(new['reference_paired'])}" if "reference_paired" in new else "")
@@ -892,6 +897,8 @@ def variant_markdown(vs: dict) -> list[str]:
         lines += fresh_markdown(vs["fresh"])
     if vs.get("new"):
         lines += new_markdown(vs["new"])
+    if vs.get("informed"):
+        lines += new_markdown(vs["informed"], informed=True)
     if "oracle_versus_paper" in vs:
         lines += ["", "Described beside its rules: the oracle (ours, geometric) as this grid runs it, against the "
                   f"oracle at the paper's settings (grid taxonomy) {_paired_text(vs['oracle_versus_paper'])} "
@@ -1059,6 +1066,9 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         if VARIANTS[name] in NEW_STUDIES:
             out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
             out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
+        if VARIANTS[name] == SNAP:
+            out[f"{name}-informed"] = _new_text(study["informed"]) if study and study.get("informed") else \
+                "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["table"] = rules_table(variants.get(reported(variants)), point, ant)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
