@@ -236,6 +236,15 @@ SNAP_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.3,radius_l
               "p_drop_turn=0.15,p_false_opening=0.2,p_uncapped=0.4,p_unparseable=0.1,rho=0.5",
               "imperfect:position_sigma=0.2,coord_grid=1.0,radius=0.45,radius_log_sigma=0.3,p_wrong_branch=0.25,"
               "p_mirror_y=0.1,p_drop_turn=0.3,alpha=0.2,p_uncapped=0.6,rho=0.5")
+#: layouts and error mixes no run had used before grid corrector-snap-check (docs/corrector.md, "A last check on
+#: layouts and mixes no run had used"): four larger generated mazes, and two mixes: I (coordinates rounded to half
+#: cells, large regions, false openings, dropped turns) and J (small regions pulled to corners, mirrored replies,
+#: wrong branches, errors growing fast with the turns a query spans)
+CHECK_MAZES = ("random:3x8:2", "random:8x3:9", "random:6x7:5", "random:7x6:40")
+CHECK_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.5,radius_log_sigma=0.2,corner_pull=0.2,"
+               "p_drop_turn=0.3,p_false_opening=0.25,p_uncapped=0.6,p_unparseable=0.05,alpha=0.1,rho=0.5",
+               "imperfect:position_sigma=0.25,radius=0.2,radius_log_sigma=0.6,corner_pull=0.45,p_wrong_branch=0.35,"
+               "p_mirror_y=0.25,p_drop_turn=0.2,p_uncapped=0.3,p_unparseable=0.1,alpha=0.3,rho=0.4")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -565,6 +574,14 @@ GRIDS = {g.name: g for g in (
                     table="data/results/corrector/snap_held_out.csv", out="held_out")),
         seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="8d73398",
         table="data/results/corrector/snap_suite.csv", out="runs/corrector_snap_suite"),
+    # docs/corrector.md, "A last check on layouts and mixes no run had used" (fixed 2026-11-28 04:48 UTC, before it ran)
+    ExperimentGrid(
+        "corrector-snap-check", "docs/corrector.md, 'A last check on layouts and mixes no run had used' (issue 39; "
+        "fixed 2026-11-28 after snap's adoption, before it ran)", "point",
+        parts=(Part(("ours-corrector-snap", "ours"), CHECK_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/snap_check_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=CHECK_MAZES, goal_points="centre", workers=1, code="8d73398",
+        table="data/results/corrector/snap_check.csv", out="runs/corrector_snap_check"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
