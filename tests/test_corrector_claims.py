@@ -497,6 +497,12 @@ def test_snap_is_judged_against_persist_with_the_centre_grids_references_and_its
     informed = cc.variant_studies(tmp_path)["snap"]["informed"]
     assert informed["runs"] == 16 and informed["names"] == ["E", "F"]
     assert all(e["success"] == 0.99 and e["reference_success"] == 0.99 for e in informed["per_maze"])
+    assert cc.variant_studies(tmp_path)["snap"]["check"] is None  # the last check not laid yet
+    lay_all_parts(tmp_path, "corrector-snap-check", rate)
+    check = cc.variant_studies(tmp_path)["snap"]["check"]
+    assert check["reference"] == "ours" and check["names"] == ["I", "J"] and check["runs"] == 16
+    assert check["zero"] == {cc.SNAP: 0, "ours": 0} and "reference_paired" not in check
+    assert all(e["reference_success"] == pytest.approx(0.9) and e["oracle"] == 1.0 for e in check["per_maze"])
     assert "| mix | maze | runs | ours-corrector-snap | ours-corrector-persist | difference | polish (centre) |" in \
         "\n".join(cc.variant_markdown(vs))
 

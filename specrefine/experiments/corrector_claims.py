@@ -30,6 +30,8 @@ from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import (
+    CHECK_MAZES,
+    CHECK_MIXES,
     FRESH_MAZES,
     FRESH_MIXES,
     GRIDS,
@@ -343,8 +345,9 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
                                                              POINT_SEEDS, SCALING_MAZES)
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
-    if method == SNAP:  # on persist's new cells, which informed it (described)
+    if method == SNAP:  # on persist's new cells, which informed it, and a last check (described)
         study["informed"] = new_study(SNAP, root, on=PERSIST)
+        study["check"] = new_study(SNAP, root, on="check", reference="ours")
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -353,22 +356,23 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
 
 #: a variant run on layouts and mixes no run had used, beside its reference: (grid, mazes, mixes, mix names)
 NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F")),
-               SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H"))}
+               SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H")),
+               "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J"))}  # a last check, described
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 
 
-def new_study(method: str, root: Path = ROOT, on: str | None = None) -> dict | None:
+def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
     """Described (docs/corrector.md, "Corrected until alive", "Snapped out of the wall"): the variant beside its
     reference, polish at centre points, ours and the oracle on layouts and mixes no run had used; runs at 0; the
     variant - its reference paired over the cells (and the reference - polish where polish is not it)."""
     grid, mazes, mixes, names = NEW_STUDIES[on or method]
-    rows, ref = _new_rows(grid, root), reference_of(method)
-    if on:  # the variant's own cells there come from its grid's part on them
+    rows, ref = _new_rows(grid, root), reference or reference_of(method)
+    if on in VARIANTS.values():  # the variant's own cells there come from its grid's part on them
         rows += [r for r in load(GRIDS[VARIANT_GRIDS[method]].tables, root) if r["proposer"] in mixes]
     if not any(r["method"] == method for r in rows):
         return None
     mazes, seeds = tuple(table_name(m) for m in mazes), GRIDS[grid].seeds
-    others = [("ours", "ours"), ("oracle", ORACLE)] + ([("polish", CENTRE)] if ref != CENTRE else [])
+    others = [("ours", "ours"), ("oracle", ORACLE)] + ([("polish", CENTRE)] if ref not in (CENTRE, "ours") else [])
     entries = []
     for mix, name in zip(mixes, names):
         for e in per_maze(rows, mix, mazes, seeds, reference=(ref, "*"), method=method):
@@ -376,12 +380,12 @@ def new_study(method: str, root: Path = ROOT, on: str | None = None) -> dict | N
                      for key, m in others}
             entries.append(e | {"mix": name} | {k: c[0] / c[1] if c[1] else math.nan for k, c in extra.items()})
     cells, failed = cmp.table_cells(rows, "point")
-    shown = (method, ref) + ((CENTRE,) if ref != CENTRE else ()) + ("ours",)
+    shown = tuple(dict.fromkeys((method, ref) + ((CENTRE,) if ref not in (CENTRE, "ours") else ()) + ("ours",)))
     study = {"grid": grid, "method": method, "reference": ref, "names": list(names), "per_maze": entries,
              "zero": {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in mixes) for m in shown},
              "runs": sum(e["runs"] for e in entries),
              "paired": paired_across(cells, failed, mixes, method, ref, seeds, mazes)}
-    if ref != CENTRE:
+    if ref not in (CENTRE, "ours"):
         study["reference_paired"] = paired_across(cells, failed, mixes, ref, CENTRE, seeds, mazes)
     return study
 
@@ -899,6 +903,8 @@ def variant_markdown(vs: dict) -> list[str]:
         lines += new_markdown(vs["new"])
     if vs.get("informed"):
         lines += new_markdown(vs["informed"], informed=True)
+    if vs.get("check"):
+        lines += new_markdown(vs["check"])
     if "oracle_versus_paper" in vs:
         lines += ["", "Described beside its rules: the oracle (ours, geometric) as this grid runs it, against the "
                   f"oracle at the paper's settings (grid taxonomy) {_paired_text(vs['oracle_versus_paper'])} "
@@ -1067,8 +1073,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
             out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
         if VARIANTS[name] == SNAP:
-            out[f"{name}-informed"] = _new_text(study["informed"]) if study and study.get("informed") else \
-                "not run yet"
+            for part in ("informed", "check"):
+                out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["table"] = rules_table(variants.get(reported(variants)), point, ant)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
