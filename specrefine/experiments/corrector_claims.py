@@ -482,16 +482,22 @@ def new_markdown(new: dict, informed: bool = False) -> list[str]:
 
 
 def _new_text(new: dict) -> str:
-    done = [e for e in new["per_maze"] if e["runs"]]
-    both = [e for e in done if e["reference_runs"]]
     short = lambda m: m.removeprefix(f"{METHOD}-")  # noqa: E731
-    text = (f"{short(new['method'])} {min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per "
-            f"layout and mix over {new['runs']} runs ({len(done)} of {len(new['per_maze'])} layouts and mixes run)")
+    mine, ref = short(new["method"]), short(new["reference"])
+    return _layouts_text(new, f"{mine} ", f", {ref} ", f"; {mine} - {ref} ")
+
+
+def _layouts_text(study: dict, first: str, second: str, paired: str) -> str:
+    """A new-layout or fresh study in one line: the first method's range per layout and mix, the second's, their
+    paired difference and the runs at 0 (``first``, ``second``, ``paired``: the words before each)."""
+    done = [e for e in study["per_maze"] if e["runs"]]
+    both = [e for e in done if e["reference_runs"]]
+    text = (f"{first}{min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix "
+            f"over {study['runs']} runs ({len(done)} of {len(study['per_maze'])} layouts and mixes run)")
     if both:
-        text += (f", {short(new['reference'])} {min(e['reference_success'] for e in both):.3f}-"
-                 f"{max(e['reference_success'] for e in both):.3f}; {short(new['method'])} - "
-                 f"{short(new['reference'])} {_paired_text(new['paired'])}")
-    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in new["zero"].items())
+        text += (f"{second}{min(e['reference_success'] for e in both):.3f}-"
+                 f"{max(e['reference_success'] for e in both):.3f}{paired}{_paired_text(study['paired'])}")
+    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in study["zero"].items())
 
 
 def _adoption_text(study: dict) -> str:
@@ -501,15 +507,7 @@ def _adoption_text(study: dict) -> str:
 
 
 def _fresh_text(fresh: dict) -> str:
-    done = [e for e in fresh["per_maze"] if e["runs"]]
-    both = [e for e in done if e["reference_runs"]]
-    text = (f"{min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix over "
-            f"{fresh['runs']} runs ({len(done)} of {len(fresh['per_maze'])} layouts and mixes run)")
-    if both:
-        text += (f"; at sampled points {min(e['reference_success'] for e in both):.3f}-"
-                 f"{max(e['reference_success'] for e in both):.3f}; centre - sampled "
-                 f"{_paired_text(fresh['paired'])}")
-    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in fresh["zero"].items())
+    return _layouts_text(fresh, "", "; at sampled points ", "; centre - sampled ")
 
 
 def _oracle_versus_paper(rows: list[dict], root: Path) -> dict:

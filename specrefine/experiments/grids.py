@@ -295,6 +295,26 @@ def fresh_grid(name: str, goal_points: str, methods: tuple) -> ExperimentGrid:
         out=f"runs/{name.replace('-', '_')}")
 
 
+def centre_variant_grids(name: str, section: str, method: str, stem: str, code: str, informed: Part | None = None
+                         ) -> tuple[ExperimentGrid, ExperimentGrid]:
+    """A variant of the corrector at centre goal points (issue 39, docs/corrector.md SECTION): grid NAME, ``informed``
+    (the cells that informed it, if any) then severe on the U-chains (STEM_severe.csv) then mild and moderate seed by
+    seed (STEM.csv); grid NAME-suite, the other 8 suite mazes at mild and moderate (STEM_suite.csv), then the held-out
+    cells (STEM_held_out.csv)."""
+    table = f"data/results/corrector/{stem}"
+    doc = f"docs/corrector.md, '{section}' (issue 39; fixed 2026-11-28 before it"
+    u_chains = (Part((method,), ("imperfect:severe",), mazes=SCALING_MAZES, table=f"{table}_severe.csv", out="severe"),
+                Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES, split="seeds"))
+    suite = (Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
+             Part((method,), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES, table=f"{table}_held_out.csv",
+                  out="held_out"))
+    common = dict(seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code=code)
+    return (ExperimentGrid(name, f"{doc} ran)", "point", parts=(*([informed] if informed else []), *u_chains),
+                           table=f"{table}.csv", out=f"runs/{name.replace('-', '_')}", **common),
+            ExperimentGrid(f"{name}-suite", f"{doc} ran)", "point", parts=suite, table=f"{table}_suite.csv",
+                           out=f"runs/{name.replace('-', '_')}_suite", **common))
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector"
                        ) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
@@ -529,23 +549,8 @@ GRIDS = {g.name: g for g in (
                Part(("ours",), ("geometric",), table="data/results/corrector/persist_new_oracle.csv", out="oracle")),
         seeds=(0, 1), mazes=NEW_MAZES, goal_points="centre", workers=1, code="ebc78e2",
         table="data/results/corrector/persist_new.csv", out="runs/corrector_persist_new"),
-    ExperimentGrid(
-        "corrector-persist", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it ran)",
-        "point",
-        parts=(Part(("ours-corrector-persist",), ("imperfect:severe",), mazes=SCALING_MAZES,
-                    table="data/results/corrector/persist_severe.csv", out="severe"),
-               Part(("ours-corrector-persist",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
-                    split="seeds")),
-        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="ebc78e2",
-        table="data/results/corrector/persist.csv", out="runs/corrector_persist"),
-    ExperimentGrid(
-        "corrector-persist-suite", "docs/corrector.md, 'Corrected until alive' (issue 39; fixed 2026-11-28 before it "
-        "ran)", "point",
-        parts=(Part(("ours-corrector-persist",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
-               Part(("ours-corrector-persist",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
-                    table="data/results/corrector/persist_held_out.csv", out="held_out")),
-        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="ebc78e2",
-        table="data/results/corrector/persist_suite.csv", out="runs/corrector_persist_suite"),
+    *centre_variant_grids("corrector-persist", "Corrected until alive", "ours-corrector-persist", "persist",
+                          code="ebc78e2"),
     # docs/corrector.md, "Snapped out of the wall" (fixed 2026-11-28 03:31 UTC, before any cell but its pilot ran)
     ExperimentGrid(
         "corrector-snap-new", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it "
@@ -555,25 +560,9 @@ GRIDS = {g.name: g for g in (
                Part(("ours",), ("geometric",), table="data/results/corrector/snap_new_oracle.csv", out="oracle")),
         seeds=(0, 1), mazes=SNAP_MAZES, goal_points="centre", workers=1, code="8d73398",
         table="data/results/corrector/snap_new.csv", out="runs/corrector_snap_new"),
-    ExperimentGrid(
-        "corrector-snap", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it ran)",
-        "point",
-        parts=(Part(("ours-corrector-snap",), NEW_MIXES, seeds=(0, 1), mazes=NEW_MAZES,
-                    table="data/results/corrector/snap_persist_new.csv", out="persist_new"),
-               Part(("ours-corrector-snap",), ("imperfect:severe",), mazes=SCALING_MAZES,
-                    table="data/results/corrector/snap_severe.csv", out="severe"),
-               Part(("ours-corrector-snap",), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES,
-                    split="seeds")),
-        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="8d73398",
-        table="data/results/corrector/snap.csv", out="runs/corrector_snap"),
-    ExperimentGrid(
-        "corrector-snap-suite", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it "
-        "ran)", "point",
-        parts=(Part(("ours-corrector-snap",), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
-               Part(("ours-corrector-snap",), HELD_OUT_MIXES, seeds=(0, 1), mazes=HELD_OUT_MAZES,
-                    table="data/results/corrector/snap_held_out.csv", out="held_out")),
-        seeds=(0, 1, 2, 3), goal_points="centre", workers=1, code="8d73398",
-        table="data/results/corrector/snap_suite.csv", out="runs/corrector_snap_suite"),
+    *centre_variant_grids("corrector-snap", "Snapped out of the wall", "ours-corrector-snap", "snap", code="8d73398",
+                          informed=Part(("ours-corrector-snap",), NEW_MIXES, seeds=(0, 1), mazes=NEW_MAZES,
+                                        table="data/results/corrector/snap_persist_new.csv", out="persist_new")),
     # docs/corrector.md, "A last check on layouts and mixes no run had used" (fixed 2026-11-28 04:48 UTC, before it ran)
     ExperimentGrid(
         "corrector-snap-check", "docs/corrector.md, 'A last check on layouts and mixes no run had used' (issue 39; "
