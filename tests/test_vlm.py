@@ -479,12 +479,14 @@ def test_a_reply_longer_than_the_cap_is_a_bad_answer_recorded_capped(srv, tmp_pa
 
 
 # --- snapping a waypoint centred in a wall (EdgeQuery.snap; method ours-corrector-snap) -----------------------------
-def test_a_waypoint_centred_in_a_wall_is_moved_clear_of_it_when_asked_to_snap(maze):
+def test_a_waypoint_centred_in_a_wall_is_moved_clear_of_it_when_asked_to_snap(maze, caplog):
     from specrefine.proposers.schema import parse_split
 
     with pytest.raises(ProposalRejected, match="inside a wall"):
         parse_split(IN_WALL, maze)
-    (moved,), _ = parse_split(IN_WALL, maze, snap=0.11)
+    with caplog.at_level(logging.WARNING):
+        (moved,), _ = parse_split(IN_WALL, maze, snap=0.11)
+    assert "waypoint 1 centre (0, 0) lies inside a wall" in caplog.text and "moved to (" in caplog.text
     assert isinstance(moved, Disc) and moved.r == pytest.approx(0.4)
     centre = np.asarray(moved.centre())
     assert float(maze.obstacles.signed_distance(centre[None])[0]) >= 0.11

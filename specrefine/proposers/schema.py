@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import re
 from typing import Annotated, Any, Literal
 
@@ -18,6 +19,8 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationEr
 from ..core.errors import ProposalRejected
 from ..core.graph import TaskGraph, infer_parents
 from ..core.regions import Box, Disc, Region, union
+
+log = logging.getLogger(__name__)
 
 _TYPE_ALIASES = {"circle": "disc", "disk": "disc", "ball": "disc", "rectangle": "box", "rect": "box",
                  "square": "box", "aabb": "box"}
@@ -222,6 +225,8 @@ def parse_split(text: str | None, maze, *, max_waypoints: int = 32, snap: float 
         region = spec.to_region()
         why = check_region(region, maze, f"waypoint {i}")
         if why and snap > 0 and " lies inside a " in why and (moved := snapped(region, maze, snap)) is not None:
+            x, y = moved.centre()
+            log.warning("%s: moved to (%.3g, %.3g), %.3g m clear of walls (snap)", why, x, y, snap)
             region, why = moved, check_region(moved, maze, f"waypoint {i}")
         if why:
             raise ProposalRejected(why)
