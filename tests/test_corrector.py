@@ -429,6 +429,38 @@ def test_correcting_a_dead_path_stops_at_the_search_budget():
     assert result.edge_splits_generated == 6
 
 
+def test_a_dead_path_may_go_past_the_search_budget_up_to_the_dead_budget():
+    book = ReplyQueue([[2], [3], [3], [3], [3], [3], [3], [5]])  # the eighth reply lives
+    _, result = run(LegTable(DEAD), book, correct_rollouts=4, correct_while_dead=True, max_edge_splits=6,
+                    dead_budget=10)
+    assert xs(result) == [0.0, 5.0, 10.0] and len(book.queries) == 8 and result.edge_splits_generated == 8
+    extended = [s for s in result.steps if s["event"] == "budget-extended"]
+    assert len(extended) == 1 and extended[0]["splits"] == [6, 10]
+    assert result.steps[-1]["dead_budget"] == 10
+
+
+def test_the_dead_budget_is_a_cap_too():
+    book = ReplyQueue([[2], [3]])  # never a live split
+    _, result = run(LegTable(DEAD), book, correct_rollouts=4, correct_while_dead=True, max_edge_splits=6,
+                    dead_budget=9)
+    assert xs(result) == [0.0, 10.0] and len(book.queries) == 9
+
+
+def test_a_live_path_never_spends_the_dead_budget():
+    fresh = {(3.0, 6.0): 0.75}  # weak, not dead: snap's one pass at snap's cost
+    calls = []
+    for budget in (None, 90):
+        book = AnswerBook({(0.0, 10.0): [3, 6]})
+        _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_while_dead=True, dead_budget=budget)
+        calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
+    assert calls[0] == calls[1]
+
+
+def test_dead_budget_must_be_positive():
+    with pytest.raises(ValueError, match="dead_budget"):
+        SearchConfig(dead_budget=0)
+
+
 def test_a_live_path_gets_no_further_pass():
     fresh = {(3.0, 6.0): 0.75}  # weak, not dead: the correction's one pass, as without the setting
     calls = []

@@ -79,6 +79,9 @@ class SearchConfig:
     correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
     correct_while_dead: bool = False  # beyond the paper: further passes while the corrected path has a leg that never
     #                                   succeeded on its fresh check, until the search's max_edge_splits are spent
+    dead_budget: int | None = None  # beyond the paper: while the path still has such a dead leg, those passes go on
+    #                                 up to this many Algorithm 1 calls in all (None: max_edge_splits; the budget
+    #                                 grows only where the run would otherwise end at 0: ours-corrector-extend)
     correct_first_win: bool = False  # the correction asks for a leg's alternatives cheapest first, stops at a win
     correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
     snap_waypoints: bool = False  # beyond the paper: a reply's waypoint centred in a wall is moved clear of it
@@ -93,6 +96,8 @@ class SearchConfig:
             raise ValueError(f"correct_passes must be at least 1, got {self.correct_passes!r}")
         if self.empty_retries < 0:
             raise ValueError(f"empty_retries must be at least 0, got {self.empty_retries!r}")
+        if self.dead_budget is not None and self.dead_budget < 1:
+            raise ValueError(f"dead_budget must be at least 1 (or None: max_edge_splits), got {self.dead_budget!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
@@ -184,6 +189,7 @@ class RefinementSearch:
         self.accepted = 0
         self.splits_generated = 0
         self.vertex_generated = 0
+        self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -214,7 +220,8 @@ class RefinementSearch:
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
                   probabilities=probs, splits_generated=self.splits_generated,
-                  max_edge_splits=self.cfg.max_edge_splits)
+                  max_edge_splits=self.cfg.max_edge_splits,
+                  **({"dead_budget": self.cfg.dead_budget} if self.cfg.dead_budget is not None else {}))
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
                             self.vertex_generated)
 
@@ -428,16 +435,23 @@ class RefinementSearch:
         budget of its own."""
         for pass_ in range(self.cfg.correct_passes):
             path, check = self._correct_pass(path, pass_)
-        pass_ = self.cfg.correct_passes
-        while self.cfg.correct_while_dead and check.p <= 0.0 and self.splits_generated < self.cfg.max_edge_splits:
+        pass_, limit = self.cfg.correct_passes, self._dead_limit()
+        while self.cfg.correct_while_dead and check.p <= 0.0 and self.splits_generated < limit:
+            if self.splits_generated >= self.cfg.max_edge_splits and not self._extended:
+                self._extended = True
+                self._log("budget-extended", splits=[self.splits_generated, limit], reason="the path has a dead leg")
             asked = self.splits_generated
-            path, check = self._correct_pass(path, pass_, budget=self.cfg.max_edge_splits)
+            path, check = self._correct_pass(path, pass_, budget=limit)
             pass_ += 1
             if self.splits_generated == asked:  # nothing left to ask about (no fresh rollout reaches the dead leg)
                 break
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
         return path
+
+    def _dead_limit(self) -> int:
+        """The Algorithm 1 calls the correction of a dead path may reach: ``dead_budget``, else the search's."""
+        return self.cfg.max_edge_splits if self.cfg.dead_budget is None else self.cfg.dead_budget
 
     def _correct_pass(self, path: list[str], pass_: int, budget: int | None = None) -> tuple[list[str], Check]:
         """One pass of the correction on its own fresh draw -> (the path, its fresh check). ``budget``: the Algorithm

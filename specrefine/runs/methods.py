@@ -256,6 +256,13 @@ register_method("ours-corrector-snap", ours_variant(**CORRECTOR | THRIFT | PERSI
                 "beyond the paper: ours-corrector-persist taking a reply whose waypoint is centred in a wall with "
                 "that waypoint moved to the nearest point clear of walls by the agent's clearance (within one cell), "
                 "instead of rejecting the reply", colour="#ad1457")
+#: ours-corrector-extend: snap, whose correction of a dead path may go on to 3x the search's budget (docs/corrector.md,
+#: "A budget that grows where the run would end at 0")
+EXTEND = dict(snap_waypoints=True, dead_budget=90)
+register_method("ours-corrector-extend", ours_variant(**CORRECTOR | THRIFT | PERSIST | EXTEND),
+                "beyond the paper: ours-corrector-snap whose correction of a path with a dead leg may go on past the "
+                "search's budget of 30 edge splits, up to 90 in all; a path with no dead leg is corrected as snap "
+                "corrects it, at the same cost", colour="#6a1b9a")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
