@@ -245,6 +245,16 @@ CHECK_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.5,radius_l
                "p_drop_turn=0.3,p_false_opening=0.25,p_uncapped=0.6,p_unparseable=0.05,alpha=0.1,rho=0.5",
                "imperfect:position_sigma=0.25,radius=0.2,radius_log_sigma=0.6,corner_pull=0.45,p_wrong_branch=0.35,"
                "p_mirror_y=0.25,p_drop_turn=0.2,p_uncapped=0.3,p_unparseable=0.1,alpha=0.3,rho=0.4")
+#: layouts and error mixes no run had used before grid corrector-extend-new (docs/corrector.md, "A budget that grows
+#: where the run would end at 0"): four larger generated mazes, and two mixes: K (offsets rounded to half cells, false
+#: openings, wrong branches, dropped turns, unparseable replies, errors growing with the turns a query spans) and L
+#: (small regions pulled to corners, wrong branches, mirrored replies, dropped turns, errors growing fast with turns)
+EXTEND_MAZES = ("random:7x7:11", "random:5x8:27", "random:8x5:33", "random:6x8:50")
+EXTEND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.4,radius_log_sigma=0.4,corner_pull=0.3,"
+                "p_drop_turn=0.25,p_false_opening=0.3,p_wrong_branch=0.2,p_uncapped=0.5,p_unparseable=0.1,alpha=0.2,"
+                "rho=0.5",
+                "imperfect:position_sigma=0.3,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,p_wrong_branch=0.4,"
+                "p_mirror_y=0.2,p_drop_turn=0.3,p_uncapped=0.4,alpha=0.35,rho=0.6")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -571,6 +581,18 @@ GRIDS = {g.name: g for g in (
                Part(("ours",), ("geometric",), table="data/results/corrector/snap_check_oracle.csv", out="oracle")),
         seeds=(0, 1), mazes=CHECK_MAZES, goal_points="centre", workers=1, code="8d73398",
         table="data/results/corrector/snap_check.csv", out="runs/corrector_snap_check"),
+    # docs/corrector.md, "A budget that grows where the run would end at 0" (fixed 2026-11-28 06:50 UTC, before it ran)
+    ExperimentGrid(
+        "corrector-extend-new", "docs/corrector.md, 'A budget that grows where the run would end at 0' (issue 39; "
+        "fixed 2026-11-28 before it ran)", "point",
+        parts=(Part(("ours-corrector-extend", "ours-corrector-snap", "ours"), EXTEND_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/extend_new_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=EXTEND_MAZES, goal_points="centre", workers=1, code="1fa15b9",
+        table="data/results/corrector/extend_new.csv", out="runs/corrector_extend_new"),
+    *centre_variant_grids("corrector-extend", "A budget that grows where the run would end at 0",
+                          "ours-corrector-extend", "extend", code="1fa15b9",
+                          informed=Part(("ours-corrector-extend",), CHECK_MIXES, seeds=(0, 1), mazes=CHECK_MAZES,
+                                        table="data/results/corrector/extend_check.csv", out="check")),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
