@@ -507,6 +507,48 @@ def test_snap_is_judged_against_persist_with_the_centre_grids_references_and_its
         "\n".join(cc.variant_markdown(vs))
 
 
+def test_extend_is_judged_against_snap_on_its_new_layouts_and_the_check_cells_that_informed_it(tmp_path):
+    """corrector-extend's references: snap (its rows), and through snap and persist the centre grids' oracle, ours and
+    ours-repair; its new layouts put extend, snap and ours side by side (no polish: its grid runs none); the last
+    check's cells are its informed part; it is adopted only where snap is."""
+    def rate(maze, method, proposer):
+        if method == cc.EXTEND:
+            return 0.99
+        if method == cc.SNAP and proposer in cc.EXTEND_MIXES + cc.CHECK_MIXES and \
+                cc.table_name(maze) in ("random:7x7:11", "random:7x6:40"):
+            return 0.0
+        return 0.99 if method == cc.SNAP else persist_rate(maze, method, proposer)
+
+    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
+                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-extend",
+                 "corrector-extend-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["extend"]
+    assert vs["reference"] == cc.SNAP and vs["versus_corrector"]["n_cells"] == 72
+    assert all(e["reference_success"] == pytest.approx(1.0) for e in vs["per_maze"])  # the centre grid's oracle
+    assert all(e["reference_success"] == pytest.approx(0.9) for e in vs["versus_ours"])  # its ours
+    assert vs["new"] is None  # extend's new grid not laid yet
+    assert not any(e["reference_runs"] for e in vs["informed"]["per_maze"])  # snap's last check not laid yet
+    assert not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
+    lay_all_parts(tmp_path, "corrector-snap-check", rate)
+    lay_all_parts(tmp_path, "corrector-extend-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["extend"]
+    informed, new = vs["informed"], vs["new"]
+    assert informed["names"] == ["I", "J"] and informed["runs"] == 16 and informed["reference"] == cc.SNAP
+    assert informed["zero"] == {cc.EXTEND: 0, cc.SNAP: 4, "ours": 0} and "reference_paired" not in informed
+    assert new["names"] == ["K", "L"] and new["zero"] == {cc.EXTEND: 0, cc.SNAP: 4, "ours": 0}
+    assert "polish" not in new["per_maze"][0] and new["paired"]["n_cells"] == 16
+    a = vs["adoption"]
+    assert a["zero"] == {cc.EXTEND: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
+    assert a["adopted"] == a["reference_adopted"]
+    assert cc.reported(studies) == ("extend" if a["adopted"] else cc.reported({**studies, "extend": None}))
+    assert cc._new_text(new).startswith("extend 0.990-0.990 per layout and mix over 16 runs")
+    assert "runs at 0: ours-corrector-extend 0, ours-corrector-snap 4" in cc._new_text(informed)
+    assert cc.INFORMED_PARTS[cc.EXTEND] == ("informed",)  # README's marker extend-informed
+
+
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"

@@ -32,6 +32,8 @@ from . import comparison as cmp
 from .grids import (
     CHECK_MAZES,
     CHECK_MIXES,
+    EXTEND_MAZES,
+    EXTEND_MIXES,
     FRESH_MAZES,
     FRESH_MIXES,
     GRIDS,
@@ -61,33 +63,34 @@ POLISH = "ours-corrector-polish"
 CENTRE = "ours-corrector-polish (centre)"  # polish with every leg aimed at its region's centre (its grid's rows)
 PERSIST = "ours-corrector-persist"  # polish at centre points, corrected until no leg is dead (its grids' rows)
 SNAP = "ours-corrector-snap"  # persist, a reply's waypoint centred in a wall moved clear of it (its grids' rows)
+EXTEND = "ours-corrector-extend"  # snap, a dead path corrected past the search's budget, up to 3x (its grids' rows)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
-                 SNAP: "corrector-snap"}
+                 SNAP: "corrector-snap", EXTEND: "corrector-extend"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
-                     SNAP: PERSIST}
+                     SNAP: PERSIST, EXTEND: SNAP}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
                  CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
-                 SNAP: "corrector-snap-suite"}
+                 SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
-            "snap": SNAP}
+            "snap": SNAP, "extend": EXTEND}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
-ADOPTABLE = ("snap", "persist")  # ... a later variant is adopted by its rule, the latest first (reported())
+ADOPTABLE = ("extend", "snap", "persist")  # ... a later variant is adopted by its rule, the latest first (reported())
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -348,6 +351,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     if method == SNAP:  # on persist's new cells, which informed it, and a last check (described)
         study["informed"] = new_study(SNAP, root, on=PERSIST)
         study["check"] = new_study(SNAP, root, on="check", reference="ours")
+    if method == EXTEND:  # on the last check's cells, which informed it
+        study["informed"] = new_study(EXTEND, root, on="check")
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -357,8 +362,11 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
 #: a variant run on layouts and mixes no run had used, beside its reference: (grid, mazes, mixes, mix names)
 NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F")),
                SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H")),
+               EXTEND: ("corrector-extend-new", EXTEND_MAZES, EXTEND_MIXES, ("K", "L")),
                "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J"))}  # a last check, described
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
+#: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
+INFORMED_PARTS = {SNAP: ("informed", "check"), EXTEND: ("informed",)}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -367,12 +375,13 @@ def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: 
     variant - its reference paired over the cells (and the reference - polish where polish is not it)."""
     grid, mazes, mixes, names = NEW_STUDIES[on or method]
     rows, ref = _new_rows(grid, root), reference or reference_of(method)
-    if on in VARIANTS.values():  # the variant's own cells there come from its grid's part on them
+    if on:  # the variant's own cells there come from its grid's part on them
         rows += [r for r in load(GRIDS[VARIANT_GRIDS[method]].tables, root) if r["proposer"] in mixes]
     if not any(r["method"] == method for r in rows):
         return None
     mazes, seeds = tuple(table_name(m) for m in mazes), GRIDS[grid].seeds
-    others = [("ours", "ours"), ("oracle", ORACLE)] + ([("polish", CENTRE)] if ref not in (CENTRE, "ours") else [])
+    polish = ref not in (CENTRE, "ours") and any(r["method"] == CENTRE for r in rows)  # a grid that ran polish
+    others = [("ours", "ours"), ("oracle", ORACLE)] + ([("polish", CENTRE)] if polish else [])
     entries = []
     for mix, name in zip(mixes, names):
         for e in per_maze(rows, mix, mazes, seeds, reference=(ref, "*"), method=method):
@@ -380,12 +389,12 @@ def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: 
                      for key, m in others}
             entries.append(e | {"mix": name} | {k: c[0] / c[1] if c[1] else math.nan for k, c in extra.items()})
     cells, failed = cmp.table_cells(rows, "point")
-    shown = tuple(dict.fromkeys((method, ref) + ((CENTRE,) if ref not in (CENTRE, "ours") else ()) + ("ours",)))
+    shown = tuple(dict.fromkeys((method, ref) + ((CENTRE,) if polish else ()) + ("ours",)))
     study = {"grid": grid, "method": method, "reference": ref, "names": list(names), "per_maze": entries,
              "zero": {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in mixes) for m in shown},
              "runs": sum(e["runs"] for e in entries),
              "paired": paired_across(cells, failed, mixes, method, ref, seeds, mazes)}
-    if ref not in (CENTRE, "ours"):
+    if polish:
         study["reference_paired"] = paired_across(cells, failed, mixes, ref, CENTRE, seeds, mazes)
     return study
 
@@ -539,10 +548,13 @@ def _base_rows(method: str, root: Path) -> list[dict]:
 def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
     """Every variant's study by its short name (README's marker, claims.json's key)."""
     studies = {name: variant_study(method, root) for name, method in VARIANTS.items()}
-    snap, persist = studies.get("snap"), studies.get("persist")
+    snap, persist, extend = studies.get("snap"), studies.get("persist"), studies.get("extend")
     if snap:  # snap is adopted only where persist is, or would be but for its second part ("Snapped out of the wall")
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
+    if extend:  # extend is adopted only where snap is ("A budget that grows where the run would end at 0")
+        held = bool(snap) and snap["adoption"]["adopted"]
+        extend["adoption"] |= {"reference_adopted": held, "adopted": extend["adoption"]["adopted"] and held}
     return studies
 
 
@@ -1070,9 +1082,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         if VARIANTS[name] in NEW_STUDIES:
             out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
             out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
-        if VARIANTS[name] == SNAP:
-            for part in ("informed", "check"):
-                out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
+        for part in INFORMED_PARTS.get(VARIANTS[name], ()):
+            out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["table"] = rules_table(variants.get(reported(variants)), point, ant)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
