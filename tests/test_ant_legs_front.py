@@ -1,8 +1,10 @@
 """Issue 42's sentence on README's front page and the slow-turn checks' table re-derive from their files
 (data/results/ant/switching_checks, scripts/switching_table.py)."""
 
+import contextlib
 import csv
 import importlib.util
+import io
 import json
 import re
 import shutil
@@ -162,3 +164,36 @@ def test_readme_names_the_cells_whose_outcome_the_tuning_check_changed():
     changed = [c for c in common if lever[c] != base[c]]
     cells = ", ".join(f"{m} seed {s}: {lever[(m, s)]:.3f} against {base[(m, s)]:.3f}" for m, s in changed)
     assert front("tunecheck changed") == f"{len(changed)} of the {len(common)} cells run, {cells}"
+
+
+STAGE9 = ROOT / "data" / "results" / "ant" / "stage9_checks"
+
+
+def chain_outcome(path: Path) -> tuple[int, int, int]:
+    """Episodes that reached every goal, episodes, and timeouts of one chain check's file."""
+    c = json.loads(path.read_text())
+    return round(c["success_rate"] * c["episodes"]), c["episodes"], int(sum(c["timed_out"]))
+
+
+def test_front_stage9_recomputes():
+    for marker, stem in (("stage9 chain", "chain8"), ("stage9 turning", "turn_chain8")):
+        nine, five = chain_outcome(STAGE9 / f"{stem}_stage9.json"), chain_outcome(STAGE9 / f"{stem}_stage5.json")
+        assert front(marker) == f"{nine[0]} against {five[0]} of {five[1]}, timeouts {nine[2]} against {five[2]}"
+    device = STAGE9 / "device_stage5"
+    held = {where: sum(json.loads(p.read_text())["walls"]["success"] for p in sorted(folder.glob(
+        "u_chain_2_s?_centre_stage5.json"))) for where, folder in (("device", device), ("here", STAGE9))}
+    turning = {where: chain_outcome(folder / "turn_chain8_stage5.json") for where, folder in (("device", device),
+                                                                                              ("here", STAGE9))}
+    assert front("stage9 device") == (f"{held['device']} against {held['here']} of 900 on the held-out paths, "
+                                      f"{turning['device'][0]} against {turning['here'][0]} of "
+                                      f"{turning['here'][1]} on the turning goals")
+
+
+def test_stage9_checks_table_regenerates():
+    spec = importlib.util.spec_from_file_location("ant_stage8_summary", ROOT / "scripts" / "ant_stage8_summary.py")
+    summary = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(summary)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        summary.main(STAGE9, "stage9", "stage5")
+    assert out.getvalue() == (STAGE9 / "checks.md").read_text()
