@@ -15,6 +15,7 @@ from specrefine.core.graph import check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
 from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP
+from specrefine.refine.search import live_start
 
 
 class LegTable:
@@ -469,6 +470,40 @@ def test_a_live_path_gets_no_further_pass():
         _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_while_dead=setting)
         calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
     assert calls[0] == calls[1]
+
+
+# --- a declined split taken where the found path is dead (SearchConfig.keep_declined): ours-corrector-keep -----------
+TAIL_DEAD = {(0.0, 10.0): 0.0, (6.0, 10.0): 0.0}  # S -> G never succeeds; the split 3, 6 dies on its last leg
+
+
+def test_a_dead_path_takes_the_declined_split_and_the_correction_repairs_its_dead_leg():
+    for keep, found in ((False, [0.0, 10.0]), (True, [0.0, 3.0, 6.0, 8.0, 10.0])):
+        book = AnswerBook({(0.0, 10.0): [3, 6], (6.0, 10.0): [8]})
+        g, result = run(LegTable(TAIL_DEAD), book, correct_rollouts=4, keep_declined=keep)
+        assert xs(result) == found and check_refines(result.graph, g) == []
+        kept = [s for s in result.steps if s["event"] == "declined-kept"]
+        assert len(kept) == keep and (not keep or (kept[0]["legs"], kept[0]["alive"]) == (3, 2))
+    assert result.predicted_success == pytest.approx(1.0) and book.queries.count((6.0, 10.0)) == 1
+
+
+def test_a_split_dead_from_its_first_leg_is_not_taken():
+    book = AnswerBook({(0.0, 10.0): [3, 6]})
+    _, result = run(LegTable({(0.0, 10.0): 0.0, (0.0, 3.0): 0.0}), book, correct_rollouts=4, keep_declined=True)
+    assert xs(result) == [0.0, 10.0] and not any(s["event"] == "declined-kept" for s in result.steps)
+
+
+def test_a_live_path_never_takes_a_declined_split():
+    fresh = {(3.0, 6.0): 0.75}
+    calls = []
+    for keep in (False, True):
+        book = AnswerBook({(0.0, 10.0): [3, 6]})
+        _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, keep_declined=keep)
+        calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
+    assert calls[0] == calls[1]
+
+
+def test_live_start_counts_the_legs_before_the_first_dead_one():
+    assert [live_start(p) for p in ([1.0, 0.5, 0.0, 1.0], [0.0], [0.9, 0.9], [])] == [2, 0, 2, 0]
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

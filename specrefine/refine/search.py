@@ -86,6 +86,9 @@ class SearchConfig:
     correct_rounds: int | None = None  # proposer rounds of the correction's Algorithm 1 calls (None: d)
     snap_waypoints: bool = False  # beyond the paper: a reply's waypoint centred in a wall is moved clear of it
     #                               (by the agent's clearance, within one cell) instead of the reply being rejected
+    keep_declined: bool = False  # beyond the paper: a dead edge of the found path is replaced by its declined edge
+    #                              split with the most legs alive before its first dead one, so that the correction
+    #                              repairs that split's dead legs instead of asking for the whole edge again
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -213,6 +216,8 @@ class RefinementSearch:
         path = self._trace(final)
         if path and self.cfg.shortcut_reach:
             path = self._shortcut(path)
+        if path and self.cfg.keep_declined:
+            path = self._take_declined(path)
         if path and self.cfg.polish_rollouts:
             self._polish(path)
         if path and self.cfg.correct_rollouts:
@@ -411,6 +416,29 @@ class RefinementSearch:
                 if v not in f.closed:
                     self._relax(u, v)
 
+    # --- beyond the paper: a declined split taken where the found path is dead ------------------
+    def _take_declined(self, path: list[str]) -> list[str]:
+        """Each edge of the found path that never succeeded, replaced by the split of it the search declined with the
+        longest live start (a refinement of the graph, so Theorem 4.1 holds); an edge with no such split stays."""
+        g = self.graph
+        for a, b in list(zip(path, path[1:])):
+            if self.results[(a, b)].p > 0.0:
+                continue
+            splits = [r for r in self.memo.values() if r is not None and r.kind == "split" and (r.u, r.v) == (a, b)]
+            best = max(splits, key=lambda r: live_start(r.data.probabilities), default=None)
+            if best is None or live_start(best.data.probabilities) == 0:
+                continue
+            names = g.split_edge(a, b, best.data.waypoints)
+            self.results.pop((a, b), None)
+            chain = [a, *names, b]
+            self.results.update(zip(zip(chain, chain[1:]), best.data.results))
+            i = path.index(a)
+            path = path[:i + 1] + names + path[i + 1:]
+            self._log("declined-kept", edge=[a, b], legs=len(best.data.results),
+                      alive=live_start(best.data.probabilities), waypoints=[x.to_dict() for x in best.data.waypoints])
+        assert_refines(g, self.original)
+        return path
+
     # --- beyond the paper: polishing the found path (polish.py) --------------------------
     def _polish(self, path: list[str]) -> None:
         g = self.graph
@@ -539,3 +567,8 @@ def shortest_path(graph: TaskGraph, evaluator: SubtaskEvaluator, seed: int = 0) 
     """DiRL: no refinement, just the lazy shortest-path search over the input graph."""
     cfg = SearchConfig(edge_refinement=False, vertex_refinement=False, seed=seed)
     return RefinementSearch(graph, evaluator, config=cfg).run()
+
+
+def live_start(probabilities) -> int:
+    """How many legs succeed at all before the first that never does."""
+    return next((i for i, p in enumerate(probabilities) if p <= 0.0), len(probabilities))

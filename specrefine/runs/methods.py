@@ -263,6 +263,12 @@ register_method("ours-corrector-extend", ours_variant(**CORRECTOR | THRIFT | PER
                 "beyond the paper: ours-corrector-snap whose correction of a path with a dead leg may go on past the "
                 "search's budget of 30 edge splits, up to 90 in all; a path with no dead leg is corrected as snap "
                 "corrects it, at the same cost", colour="#6a1b9a")
+register_method("ours-corrector-keep", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(snap_waypoints=True,
+                                                                                   keep_declined=True)),
+                "beyond the paper: ours-corrector-snap whose found path, where an edge of it never succeeded, takes "
+                "the split of that edge the search declined with the most legs alive before its first dead one, so "
+                "that the correction repairs that split's dead legs instead of asking for the whole edge again",
+                colour="#4527a0")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
