@@ -255,6 +255,16 @@ EXTEND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.4,radius_l
                 "rho=0.5",
                 "imperfect:position_sigma=0.3,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,p_wrong_branch=0.4,"
                 "p_mirror_y=0.2,p_drop_turn=0.3,p_uncapped=0.4,alpha=0.35,rho=0.6")
+#: layouts and error mixes no run had used before grid corrector-keep-new (docs/corrector.md, "A declined split kept
+#: where the path is dead"): four more generated mazes, and two mixes: M (offsets rounded to quarter cells, small
+#: cornered regions, false openings, wrong branches, dropped turns, errors growing with the turns a query spans) and
+#: N (coordinates rounded to whole cells, wrong branches, mirrored replies, dropped turns, errors growing fast)
+KEEP_MAZES = ("random:7x5:19", "random:5x7:44", "random:8x6:3", "random:6x8:71")
+KEEP_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.25,radius=0.3,radius_log_sigma=0.45,corner_pull=0.35,"
+              "p_drop_turn=0.3,p_false_opening=0.25,p_wrong_branch=0.3,p_uncapped=0.5,p_unparseable=0.1,alpha=0.25,"
+              "rho=0.5",
+              "imperfect:position_sigma=0.25,coord_grid=1.0,radius=0.35,radius_log_sigma=0.35,corner_pull=0.25,"
+              "p_wrong_branch=0.35,p_mirror_y=0.15,p_drop_turn=0.25,p_uncapped=0.5,alpha=0.3,rho=0.6")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -593,6 +603,18 @@ GRIDS = {g.name: g for g in (
                           "ours-corrector-extend", "extend", code="1fa15b9",
                           informed=Part(("ours-corrector-extend",), CHECK_MIXES, seeds=(0, 1), mazes=CHECK_MAZES,
                                         table="data/results/corrector/extend_check.csv", out="check")),
+    # docs/corrector.md, "A declined split kept where the path is dead" (fixed 2026-11-28 07:15 UTC, before it ran)
+    ExperimentGrid(
+        "corrector-keep-new", "docs/corrector.md, 'A declined split kept where the path is dead' (issue 39; fixed "
+        "2026-11-28 before it ran)", "point",
+        parts=(Part(("ours-corrector-keep", "ours-corrector-snap", "ours"), KEEP_MIXES, split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/keep_new_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=KEEP_MAZES, goal_points="centre", workers=1, code="fe494db",
+        table="data/results/corrector/keep_new.csv", out="runs/corrector_keep_new"),
+    *centre_variant_grids("corrector-keep", "A declined split kept where the path is dead", "ours-corrector-keep",
+                          "keep", code="fe494db",
+                          informed=Part(("ours-corrector-keep",), EXTEND_MIXES, seeds=(0, 1), mazes=EXTEND_MAZES,
+                                        table="data/results/corrector/keep_extend_new.csv", out="extend_new")),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
