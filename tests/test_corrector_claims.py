@@ -549,6 +549,35 @@ def test_extend_is_judged_against_snap_on_its_new_layouts_and_the_check_cells_th
     assert cc.INFORMED_PARTS[cc.EXTEND] == ("informed",)  # README's marker extend-informed
 
 
+def test_keep_is_judged_against_snap_on_its_new_layouts_and_extends_cells_that_informed_it(tmp_path):
+    """corrector-keep: snap its reference (through snap and persist the centre grids' oracle and ours); its new
+    layouts (M, N) put keep, snap and ours side by side; extend's new cells are its informed part; adopted only where
+    snap is."""
+    def rate(maze, method, proposer):
+        if method == cc.KEEP:
+            return 0.99
+        dead = cc.table_name(maze) in ("random:7x7:11", "random:8x6:3")
+        if method in (cc.SNAP, cc.EXTEND) and proposer in cc.EXTEND_MIXES + cc.KEEP_MIXES and dead:
+            return 0.0
+        return 0.99 if method in (cc.SNAP, cc.EXTEND) else persist_rate(maze, method, proposer)
+
+    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
+                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-extend-new",
+                 "corrector-keep", "corrector-keep-suite", "corrector-keep-new"):
+        lay_all_parts(tmp_path, name, rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["keep"]
+    assert vs["reference"] == cc.SNAP and vs["versus_corrector"]["n_cells"] == 72
+    informed, new = vs["informed"], vs["new"]
+    assert informed["names"] == ["K", "L"] and informed["grid"] == "corrector-extend-new"
+    assert informed["zero"] == {cc.KEEP: 0, cc.SNAP: 4, "ours": 0}
+    assert new["names"] == ["M", "N"] and new["zero"] == {cc.KEEP: 0, cc.SNAP: 4, "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.KEEP: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
+    assert "runs at 0: ours-corrector-keep 0, ours-corrector-snap 4" in cc._new_text(informed)
+
+
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"

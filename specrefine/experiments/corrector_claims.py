@@ -39,6 +39,8 @@ from .grids import (
     GRIDS,
     HELD_OUT_MAZES,
     HELD_OUT_MIXES,
+    KEEP_MAZES,
+    KEEP_MIXES,
     NEW_MAZES,
     NEW_MIXES,
     OTHER_POINT_MAZES,
@@ -64,33 +66,36 @@ CENTRE = "ours-corrector-polish (centre)"  # polish with every leg aimed at its 
 PERSIST = "ours-corrector-persist"  # polish at centre points, corrected until no leg is dead (its grids' rows)
 SNAP = "ours-corrector-snap"  # persist, a reply's waypoint centred in a wall moved clear of it (its grids' rows)
 EXTEND = "ours-corrector-extend"  # snap, a dead path corrected past the search's budget, up to 3x (its grids' rows)
+KEEP = "ours-corrector-keep"  # snap, a dead path's edge replaced by its declined split with the longest live start
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
                  TRIM: "corrector-trim", SPREAD: "corrector-precise-spread", RECHECK: "corrector-recheck",
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
-                 SNAP: "corrector-snap", EXTEND: "corrector-extend"}
+                 SNAP: "corrector-snap", EXTEND: "corrector-extend",
+                 KEEP: "corrector-keep"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
-                     SNAP: PERSIST, EXTEND: SNAP}
+                     SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
                  CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
-                 SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite"}
+                 SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite",
+                 KEEP: "corrector-keep-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
-            "snap": SNAP, "extend": EXTEND}
+            "snap": SNAP, "extend": EXTEND, "keep": KEEP}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
-ADOPTABLE = ("extend", "snap", "persist")  # ... a later variant is adopted by its rule, the latest first (reported())
+ADOPTABLE = ("keep", "extend", "snap", "persist")  # ... a later one is adopted by its rule, latest first (reported())
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -351,8 +356,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     if method == SNAP:  # on persist's new cells, which informed it, and a last check (described)
         study["informed"] = new_study(SNAP, root, on=PERSIST)
         study["check"] = new_study(SNAP, root, on="check", reference="ours")
-    if method == EXTEND:  # on the last check's cells, which informed it
-        study["informed"] = new_study(EXTEND, root, on="check")
+    if method in INFORMED_ON:  # on the cells that informed it
+        study["informed"] = new_study(method, root, on=INFORMED_ON[method])
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -363,10 +368,13 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
 NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F")),
                SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H")),
                EXTEND: ("corrector-extend-new", EXTEND_MAZES, EXTEND_MIXES, ("K", "L")),
+               KEEP: ("corrector-keep-new", KEEP_MAZES, KEEP_MIXES, ("M", "N")),
                "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J"))}  # a last check, described
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), EXTEND: ("informed",)}
+INFORMED_PARTS = {SNAP: ("informed", "check"), EXTEND: ("informed",), KEEP: ("informed",)}
+#: the new-layout study whose cells informed a variant (beside snap's, which names its own)
+INFORMED_ON = {EXTEND: "check", KEEP: EXTEND}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -548,13 +556,14 @@ def _base_rows(method: str, root: Path) -> list[dict]:
 def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
     """Every variant's study by its short name (README's marker, claims.json's key)."""
     studies = {name: variant_study(method, root) for name, method in VARIANTS.items()}
-    snap, persist, extend = studies.get("snap"), studies.get("persist"), studies.get("extend")
+    snap, persist = studies.get("snap"), studies.get("persist")
     if snap:  # snap is adopted only where persist is, or would be but for its second part ("Snapped out of the wall")
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
-    if extend:  # extend is adopted only where snap is ("A budget that grows where the run would end at 0")
-        held = bool(snap) and snap["adoption"]["adopted"]
-        extend["adoption"] |= {"reference_adopted": held, "adopted": extend["adoption"]["adopted"] and held}
+    for later in (studies.get("extend"), studies.get("keep")):  # adopted only where snap is (their sections)
+        if later:
+            held = bool(snap) and snap["adoption"]["adopted"]
+            later["adoption"] |= {"reference_adopted": held, "adopted": later["adoption"]["adopted"] and held}
     return studies
 
 
