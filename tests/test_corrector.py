@@ -502,6 +502,37 @@ def test_a_live_path_never_takes_a_declined_split():
     assert calls[0] == calls[1]
 
 
+class EdgeQueue(AnswerBook):
+    """Per (start, goal) of the query, its replies in turn (the last one repeated)."""
+
+    def propose_split(self, query, w, feedback=()):
+        key = (float(query.graph.region(query.u).centre()[0]), float(query.goal.centre()[0]))
+        self.queries.append(key)
+        replies = self.book[key]
+        return [[Disc(a, 0, 0.5) for a in replies[min(self.queries.count(key) - 1, len(replies) - 1)]]]
+
+
+STUCK_TAIL = {(0.0, 10.0): 0.0, (6.0, 10.0): 0.0, (6.0, 8.0): 0.0}  # the kept split's last leg never lives
+REPLIES = {(0.0, 10.0): [[3, 6], [5]], (6.0, 10.0): [[8]]}  # S -> G asked again: 5, which lives
+
+
+def test_a_kept_split_still_dead_at_half_the_budget_falls_back_to_the_edge_it_replaced():
+    book = EdgeQueue(REPLIES)
+    g, result = run(LegTable(STUCK_TAIL), book, correct_rollouts=4, correct_while_dead=True, keep_declined=True,
+                    keep_fallback=True, max_edge_splits=10)
+    dropped = [s for s in result.steps if s["event"] == "declined-dropped"]
+    assert len(dropped) == 1 and dropped[0]["path"] == ["S", "G"] and dropped[0]["splits"][0] <= 6
+    assert xs(result) == [0.0, 5.0, 10.0] and check_refines(result.graph, g) == []
+
+
+def test_without_the_fallback_the_kept_split_is_corrected_to_the_end():
+    book = EdgeQueue(REPLIES)
+    _, result = run(LegTable(STUCK_TAIL), book, correct_rollouts=4, correct_while_dead=True, keep_declined=True,
+                    max_edge_splits=10)
+    assert result.predicted_success == 0.0 and result.edge_splits_generated == 10
+    assert "declined-dropped" not in [s["event"] for s in result.steps]
+
+
 def test_live_start_counts_the_legs_before_the_first_dead_one():
     assert [live_start(p) for p in ([1.0, 0.5, 0.0, 1.0], [0.0], [0.9, 0.9], [])] == [2, 0, 2, 0]
 

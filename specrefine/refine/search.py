@@ -89,6 +89,8 @@ class SearchConfig:
     keep_declined: bool = False  # beyond the paper: a dead edge of the found path is replaced by its declined edge
     #                              split with the most legs alive before its first dead one, so that the correction
     #                              repairs that split's dead legs instead of asking for the whole edge again
+    keep_fallback: bool = False  # with keep_declined: where the kept split's correction leaves the path dead at half
+    #                              the budget left, the path goes back to the edge it replaced, corrected as before
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -193,6 +195,7 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
+        self._alive = False  # the last correction's fresh check found no dead leg
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -216,12 +219,17 @@ class RefinementSearch:
         path = self._trace(final)
         if path and self.cfg.shortcut_reach:
             path = self._shortcut(path)
+        before = (self.graph.copy(), list(path), dict(self.results)) if path else None
         if path and self.cfg.keep_declined:
             path = self._take_declined(path)
+        kept = bool(path) and path != before[1]
         if path and self.cfg.polish_rollouts:
             self._polish(path)
         if path and self.cfg.correct_rollouts:
-            path = self._correct(path)
+            if kept and self.cfg.keep_fallback:
+                path = self._correct_kept(path, before)
+            else:
+                path = self._correct(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
                   probabilities=probs, splits_generated=self.splits_generated,
@@ -457,13 +465,26 @@ class RefinementSearch:
             self.results[edge] = result
 
     # --- beyond the paper: correcting the found path on fresh rollouts (correct.py) ------
-    def _correct(self, path: list[str]) -> list[str]:
+    def _correct_kept(self, path: list[str], before: tuple) -> list[str]:
+        """The correction of a path that took a declined split (keep_fallback): up to half the budget left, and where
+        the path is still dead then, back to the graph, path and estimates before the split was taken, corrected
+        within the rest as a path without it would have been."""
+        limit = self._dead_limit()
+        path = self._correct(path, limit=self.splits_generated + (limit - self.splits_generated) // 2)
+        if self._alive or self.splits_generated >= limit:
+            return path
+        self.graph, path, self.results = before[0], list(before[1]), dict(before[2])
+        self._log("declined-dropped", path=path, splits=[self.splits_generated, limit],
+                  reason="the kept split's path is still dead")
+        return self._correct(path)
+
+    def _correct(self, path: list[str], limit: int | None = None) -> list[str]:
         """The correction (correct.py), ``correct_passes`` times: each pass on its own fresh draw (new first
         states, so a leg chosen on one pass's rollouts is judged again on rollouts that did not choose it), with a
         budget of its own."""
         for pass_ in range(self.cfg.correct_passes):
             path, check = self._correct_pass(path, pass_)
-        pass_, limit = self.cfg.correct_passes, self._dead_limit()
+        pass_, limit = self.cfg.correct_passes, limit or self._dead_limit()
         while self.cfg.correct_while_dead and check.p <= 0.0 and self.splits_generated < limit:
             if self.splits_generated >= self.cfg.max_edge_splits and not self._extended:
                 self._extended = True
@@ -473,6 +494,7 @@ class RefinementSearch:
             pass_ += 1
             if self.splits_generated == asked:  # nothing left to ask about (no fresh rollout reaches the dead leg)
                 break
+        self._alive = check.p > 0.0
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
         return path

@@ -269,6 +269,11 @@ register_method("ours-corrector-keep", ours_variant(**CORRECTOR | THRIFT | PERSI
                 "the split of that edge the search declined with the most legs alive before its first dead one, so "
                 "that the correction repairs that split's dead legs instead of asking for the whole edge again",
                 colour="#4527a0")
+register_method("ours-corrector-fallback", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(
+                    snap_waypoints=True, keep_declined=True, keep_fallback=True)),
+                "beyond the paper: ours-corrector-keep whose path, where the kept split is still dead after half the "
+                "budget left, goes back to the edge it replaced and is corrected as snap corrects it with the rest",
+                colour="#283593")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
