@@ -265,6 +265,16 @@ KEEP_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.25,radius=0.3,radius_l
               "rho=0.5",
               "imperfect:position_sigma=0.25,coord_grid=1.0,radius=0.35,radius_log_sigma=0.35,corner_pull=0.25,"
               "p_wrong_branch=0.35,p_mirror_y=0.15,p_drop_turn=0.25,p_uncapped=0.5,alpha=0.3,rho=0.6")
+#: layouts and error mixes no run had used before grid corrector-fallback-new (docs/corrector.md, "Given up at half the
+#: budget"): four more generated mazes, and two mixes: O (offsets rounded to half cells, wrong branches, false
+#: openings, dropped turns, unparseable replies, errors growing with the turns a query spans) and P (large cornered
+#: regions, wrong branches, mirrored replies, dropped turns)
+FALLBACK_MAZES = ("random:6x6:77", "random:7x6:13", "random:5x9:8", "random:8x7:26")
+FALLBACK_MIXES = ("imperfect:position_sigma=0.3,coord_grid=0.5,radius=0.3,radius_log_sigma=0.5,corner_pull=0.3,"
+                  "p_drop_turn=0.25,p_false_opening=0.2,p_wrong_branch=0.35,p_uncapped=0.5,p_unparseable=0.1,"
+                  "alpha=0.3,rho=0.5",
+                  "imperfect:position_sigma=0.4,radius=0.35,radius_log_sigma=0.4,corner_pull=0.35,p_wrong_branch=0.3,"
+                  "p_mirror_y=0.2,p_drop_turn=0.3,p_uncapped=0.4,alpha=0.25,rho=0.6")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -615,6 +625,19 @@ GRIDS = {g.name: g for g in (
                           "keep", code="fe494db",
                           informed=Part(("ours-corrector-keep",), EXTEND_MIXES, seeds=(0, 1), mazes=EXTEND_MAZES,
                                         table="data/results/corrector/keep_extend_new.csv", out="extend_new")),
+    # docs/corrector.md, "Given up at half the budget" (fixed 2026-11-28 07:20 UTC, before it ran)
+    ExperimentGrid(
+        "corrector-fallback-new", "docs/corrector.md, 'Given up at half the budget' (issue 39; fixed 2026-11-28 "
+        "before it ran)", "point",
+        parts=(Part(("ours-corrector-fallback", "ours-corrector-snap", "ours-corrector-keep", "ours"), FALLBACK_MIXES,
+                    split="proposers"),
+               Part(("ours",), ("geometric",), table="data/results/corrector/fallback_new_oracle.csv", out="oracle")),
+        seeds=(0, 1), mazes=FALLBACK_MAZES, goal_points="centre", workers=1, code="c6a590c",
+        table="data/results/corrector/fallback_new.csv", out="runs/corrector_fallback_new"),
+    *centre_variant_grids("corrector-fallback", "Given up at half the budget", "ours-corrector-fallback", "fallback",
+                          code="c6a590c",
+                          informed=Part(("ours-corrector-fallback",), KEEP_MIXES, seeds=(0, 1), mazes=KEEP_MAZES,
+                                        table="data/results/corrector/fallback_keep_new.csv", out="keep_new")),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
