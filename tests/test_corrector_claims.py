@@ -578,6 +578,17 @@ def test_keep_is_judged_against_snap_on_its_new_layouts_and_extends_cells_that_i
     assert "runs at 0: ours-corrector-keep 0, ours-corrector-snap 4" in cc._new_text(informed)
 
 
+def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
+    assert cc._unseen_text(cc.unseen(tmp_path)) == "not run yet"
+    lay_all_parts(tmp_path, "corrector-keep-new", lambda maze, m, p: 0.0 if m == cc.SNAP and
+                  cc.table_name(maze) == "random:8x6:3" else 1.0)
+    lay_all_parts(tmp_path, "corrector-snap-new", lambda maze, m, p: 0.995 if p == "geometric" else 1.0)
+    sets = cc.unseen(tmp_path)
+    assert [(e["mixes"], e["zero"], e["runs"]) for e in sets] == [("G/H", 0, 16), ("M/N", 4, 16)]
+    assert cc._unseen_text(sets) == "G/H 0 of 16; M/N 4 of 16 (the oracle at least 0.995 on every one of those " \
+        "runs' cells)"
+
+
 def test_fill_rewrites_each_marked_passage_keeping_a_tables_list_indentation(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("- a <!-- front corrector ant -->old<!-- /front corrector ant -->.\n"

@@ -370,10 +370,10 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
 #: a variant run on layouts and mixes no run had used, beside its reference: (grid, mazes, mixes, mix names)
 NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F")),
                SNAP: ("corrector-snap-new", SNAP_MAZES, SNAP_MIXES, ("G", "H")),
+               "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J")),  # a last check, described
                EXTEND: ("corrector-extend-new", EXTEND_MAZES, EXTEND_MIXES, ("K", "L")),
                KEEP: ("corrector-keep-new", KEEP_MAZES, KEEP_MIXES, ("M", "N")),
-               FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P")),
-               "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J"))}  # a last check, described
+               FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {SNAP: ("informed", "check"), **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
@@ -1099,6 +1099,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         for part in INFORMED_PARTS.get(VARIANTS[name], ()):
             out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
+    out["unseen"] = _unseen_text(unseen(root))
     out["table"] = rules_table(variants.get(reported(variants)), point, ant)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     if held_out:
@@ -1110,6 +1111,29 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
     return out
+
+
+def unseen(root: Path = ROOT, method: str = SNAP) -> list[dict]:
+    """``method`` (README's reported corrector) on every set of new layouts and mixes that ran it, in the order the
+    sets were made: its runs at 0 and done, the oracle's lowest success there."""
+    out = []
+    for grid, mazes, mixes, names in NEW_STUDIES.values():
+        rows = load(GRIDS[grid].tables, root)
+        if not any(r["method"] == method for r in rows):
+            continue
+        mazes = tuple(table_name(m) for m in mazes)
+        zero = [zero_runs(rows, method, mix, mazes) for mix in mixes]
+        oracle = [float(r["success_rate"]) for r in rows if (r["method"], r["proposer"]) == ORACLE and cmp.is_done(r)]
+        out.append({"grid": grid, "mixes": "/".join(names), "zero": sum(z for z, _ in zero),
+                    "runs": sum(n for _, n in zero), "oracle_min": min(oracle) if oracle else math.nan})
+    return out
+
+
+def _unseen_text(sets: list[dict]) -> str:
+    if not sets:
+        return "not run yet"
+    return "; ".join(f"{e['mixes']} {e['zero']} of {e['runs']}" for e in sets) + " (the oracle at least " + \
+        f"{min(e['oracle_min'] for e in sets):.3f} on every one of those runs' cells)"
 
 
 def reported(variants: dict) -> str:
