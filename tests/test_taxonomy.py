@@ -9,6 +9,8 @@ import sys
 
 import pytest
 
+from specrefine.core.mazes import random_name
+from specrefine.experiments import taxonomy as tx
 from specrefine.experiments.taxonomy import CAUSES, classify, read_runs
 
 
@@ -89,3 +91,11 @@ def test_a_folder_another_command_is_writing_is_refused_in_one_line(sweep):
                               text=True)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "in use" in proc.stderr
     assert sorted(p.name for p in out.iterdir()) == []
+
+
+def test_the_oracle_of_a_generated_layout_is_found_under_the_name_its_runs_record(tmp_path):
+    table = tmp_path / "oracle.csv"
+    table.write_text("maze,method,proposer,status,success_rate\nrandom:5x7:44,ours,geometric,ok,1.0\n"
+                     "random:5x7:44,ours,geometric,ok,0.99\nu_chain_2,ours,geometric,ok,0.9\n")
+    assert tx.oracle_means(table) == pytest.approx({"random_5x7_s44": 0.995, "u_chain_2": 0.9})
+    assert random_name(" Random:5X7:44 ") == "random_5x7_s44" and random_name("unseen/zigzag") == "unseen/zigzag"

@@ -353,6 +353,13 @@ def _unknown_name(name: str) -> str:
             f"a path to a .maze file)")
 
 
+def random_name(spec: str) -> str:
+    """The name a generated maze's spec gives its Maze (``random:RxC:SEED`` -> ``random_RxC_sSEED``, as a run's
+    result.json records it); any other spec as it is (a sweep table records the spec)."""
+    found = re.fullmatch(r"random:(\d+)x(\d+):(\d+)", spec.strip().lower())
+    return f"random_{found[1]}x{found[2]}_s{found[3]}" if found else spec
+
+
 def _random_from_text(text: str, cell_size: float) -> Maze:
     try:
         rooms, seed = text.removeprefix(RANDOM_PREFIX).split(":")

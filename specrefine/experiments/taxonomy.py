@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
+from ..core.mazes import random_name
 from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import ensure_dir, locked, write_atomic
@@ -78,7 +79,7 @@ def oracle_means(table: Path) -> dict[str, float]:
     with open(table, newline="") as fh:
         for row in csv.DictReader(fh):
             if row.get("method") == "ours" and row.get("proposer") == "geometric" and row.get("status") == "ok":
-                rates[row["maze"]].append(float(row["success_rate"]))
+                rates[random_name(row["maze"])].append(float(row["success_rate"]))  # as result.json names it
     if not rates:
         raise SpecrefineError(f"{table}: no finished ours x geometric rows to take the oracle from")
     return {maze: sum(v) / len(v) for maze, v in rates.items()}
