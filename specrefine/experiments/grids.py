@@ -345,6 +345,18 @@ def centre_variant_grids(name: str, section: str, method: str, stem: str, code: 
                            out=f"runs/{name.replace('-', '_')}_suite", **common))
 
 
+def new_layouts_grid(name: str, source: str, methods: tuple, mazes: tuple, mixes: tuple, stem: str, code: str
+                     ) -> ExperimentGrid:
+    """``methods`` on generated layouts and error mixes no run had used (issue 39, docs/corrector.md), seeds 0-1,
+    centre goal points, into data/results/corrector/STEM.csv, and the oracle on the same layouts (STEM_oracle.csv)."""
+    table = f"data/results/corrector/{stem}"
+    return ExperimentGrid(name, source, "point",
+                          parts=(Part(methods, mixes, split="proposers"),
+                                 Part(("ours",), ("geometric",), table=f"{table}_oracle.csv", out="oracle")),
+                          seeds=(0, 1), mazes=mazes, goal_points="centre", workers=1, code=code, table=f"{table}.csv",
+                          out=f"runs/{name.replace('-', '_')}")
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector"
                        ) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
@@ -582,14 +594,10 @@ GRIDS = {g.name: g for g in (
     *centre_variant_grids("corrector-persist", "Corrected until alive", "ours-corrector-persist", "persist",
                           code="ebc78e2"),
     # docs/corrector.md, "Snapped out of the wall" (fixed 2026-11-28 03:31 UTC, before any cell but its pilot ran)
-    ExperimentGrid(
-        "corrector-snap-new", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 before it "
-        "ran): snap, persist, polish and ours on layouts and mixes no run had used", "point",
-        parts=(Part(("ours-corrector-snap", "ours-corrector-persist", "ours-corrector-polish", "ours"), SNAP_MIXES,
-                    split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/snap_new_oracle.csv", out="oracle")),
-        seeds=(0, 1), mazes=SNAP_MAZES, goal_points="centre", workers=1, code="8d73398",
-        table="data/results/corrector/snap_new.csv", out="runs/corrector_snap_new"),
+    new_layouts_grid("corrector-snap-new", "docs/corrector.md, 'Snapped out of the wall' (issue 39; fixed 2026-11-28 "
+                     "before it ran): snap, persist, polish and ours on layouts and mixes no run had used",
+                     ("ours-corrector-snap", "ours-corrector-persist", "ours-corrector-polish", "ours"), SNAP_MAZES,
+                     SNAP_MIXES, "snap_new", code="8d73398"),
     *centre_variant_grids("corrector-snap", "Snapped out of the wall", "ours-corrector-snap", "snap", code="8d73398",
                           informed=Part(("ours-corrector-snap",), NEW_MIXES, seeds=(0, 1), mazes=NEW_MAZES,
                                         table="data/results/corrector/snap_persist_new.csv", out="persist_new")),
@@ -602,38 +610,27 @@ GRIDS = {g.name: g for g in (
         seeds=(0, 1), mazes=CHECK_MAZES, goal_points="centre", workers=1, code="8d73398",
         table="data/results/corrector/snap_check.csv", out="runs/corrector_snap_check"),
     # docs/corrector.md, "A budget that grows where the run would end at 0" (fixed 2026-11-28 06:50 UTC, before it ran)
-    ExperimentGrid(
-        "corrector-extend-new", "docs/corrector.md, 'A budget that grows where the run would end at 0' (issue 39; "
-        "fixed 2026-11-28 before it ran)", "point",
-        parts=(Part(("ours-corrector-extend", "ours-corrector-snap", "ours"), EXTEND_MIXES, split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/extend_new_oracle.csv", out="oracle")),
-        seeds=(0, 1), mazes=EXTEND_MAZES, goal_points="centre", workers=1, code="1fa15b9",
-        table="data/results/corrector/extend_new.csv", out="runs/corrector_extend_new"),
+    new_layouts_grid("corrector-extend-new", "docs/corrector.md, 'A budget that grows where the run would end at 0' "
+                     "(issue 39; fixed 2026-11-28 before it ran)", ("ours-corrector-extend", "ours-corrector-snap",
+                                                                    "ours"), EXTEND_MAZES, EXTEND_MIXES, "extend_new",
+                     code="1fa15b9"),
     *centre_variant_grids("corrector-extend", "A budget that grows where the run would end at 0",
                           "ours-corrector-extend", "extend", code="1fa15b9",
                           informed=Part(("ours-corrector-extend",), CHECK_MIXES, seeds=(0, 1), mazes=CHECK_MAZES,
                                         table="data/results/corrector/extend_check.csv", out="check")),
     # docs/corrector.md, "A declined split kept where the path is dead" (fixed 2026-11-28 07:15 UTC, before it ran)
-    ExperimentGrid(
-        "corrector-keep-new", "docs/corrector.md, 'A declined split kept where the path is dead' (issue 39; fixed "
-        "2026-11-28 before it ran)", "point",
-        parts=(Part(("ours-corrector-keep", "ours-corrector-snap", "ours"), KEEP_MIXES, split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/keep_new_oracle.csv", out="oracle")),
-        seeds=(0, 1), mazes=KEEP_MAZES, goal_points="centre", workers=1, code="fe494db",
-        table="data/results/corrector/keep_new.csv", out="runs/corrector_keep_new"),
+    new_layouts_grid("corrector-keep-new", "docs/corrector.md, 'A declined split kept where the path is dead' (issue "
+                     "39; fixed 2026-11-28 before it ran)", ("ours-corrector-keep", "ours-corrector-snap", "ours"),
+                     KEEP_MAZES, KEEP_MIXES, "keep_new", code="fe494db"),
     *centre_variant_grids("corrector-keep", "A declined split kept where the path is dead", "ours-corrector-keep",
                           "keep", code="fe494db",
                           informed=Part(("ours-corrector-keep",), EXTEND_MIXES, seeds=(0, 1), mazes=EXTEND_MAZES,
                                         table="data/results/corrector/keep_extend_new.csv", out="extend_new")),
     # docs/corrector.md, "Given up at half the budget" (fixed 2026-11-28 07:20 UTC, before it ran)
-    ExperimentGrid(
-        "corrector-fallback-new", "docs/corrector.md, 'Given up at half the budget' (issue 39; fixed 2026-11-28 "
-        "before it ran)", "point",
-        parts=(Part(("ours-corrector-fallback", "ours-corrector-snap", "ours-corrector-keep", "ours"), FALLBACK_MIXES,
-                    split="proposers"),
-               Part(("ours",), ("geometric",), table="data/results/corrector/fallback_new_oracle.csv", out="oracle")),
-        seeds=(0, 1), mazes=FALLBACK_MAZES, goal_points="centre", workers=1, code="c6a590c",
-        table="data/results/corrector/fallback_new.csv", out="runs/corrector_fallback_new"),
+    new_layouts_grid("corrector-fallback-new", "docs/corrector.md, 'Given up at half the budget' (issue 39; fixed "
+                     "2026-11-28 before it ran)", ("ours-corrector-fallback", "ours-corrector-snap",
+                                                   "ours-corrector-keep", "ours"), FALLBACK_MAZES, FALLBACK_MIXES,
+                     "fallback_new", code="c6a590c"),
     *centre_variant_grids("corrector-fallback", "Given up at half the budget", "ours-corrector-fallback", "fallback",
                           code="c6a590c",
                           informed=Part(("ours-corrector-fallback",), KEEP_MIXES, seeds=(0, 1), mazes=KEEP_MAZES,
