@@ -307,7 +307,11 @@ def random_maze(rooms: tuple[int, int], seed: int, loops: float = 0.25, cell_siz
         r, c = inner[k]
         grid[r][c] = "."
     grid[1][1], grid[2 * rows - 1][2 * cols - 1] = "S", "G"
-    return Maze(f"random_{rows}x{cols}_s{seed}", tuple("".join(line) for line in grid), cell_size)
+    return Maze(_random_maze_name(rows, cols, seed), tuple("".join(line) for line in grid), cell_size)
+
+
+def _random_maze_name(rows: int, cols: int, seed: int) -> str:
+    return f"random_{rows}x{cols}_s{seed}"
 
 
 RANDOM_PREFIX = "random:"
@@ -356,11 +360,17 @@ def _unknown_name(name: str) -> str:
 def random_name(spec: str) -> str:
     """The name a generated maze's spec gives its Maze (``random:RxC:SEED`` -> ``random_RxC_sSEED``, as a run's
     result.json records it); any other spec as it is (a sweep table records the spec)."""
-    found = re.fullmatch(r"random:(\d+)x(\d+):(\d+)", spec.strip().lower())
-    return f"random_{found[1]}x{found[2]}_s{found[3]}" if found else spec
+    text = spec.strip().lower()
+    if not text.startswith(RANDOM_PREFIX):
+        return spec
+    try:
+        return _random_maze_name(*_random_spec(text))
+    except MazeError:
+        return spec
 
 
-def _random_from_text(text: str, cell_size: float) -> Maze:
+def _random_spec(text: str) -> tuple[int, int, int]:
+    """``random:RxC:SEED`` -> (R, C, SEED); a one-line MazeError otherwise."""
     try:
         rooms, seed = text.removeprefix(RANDOM_PREFIX).split(":")
         r, c = (int(k) for k in rooms.lower().split("x"))
@@ -369,6 +379,11 @@ def _random_from_text(text: str, cell_size: float) -> Maze:
         raise MazeError(f"random maze {text!r}: expected random:RxC:SEED, e.g. random:4x6:0") from None
     if seed < 0:
         raise MazeError(f"random maze {text!r}: the seed must be >= 0")
+    return r, c, seed
+
+
+def _random_from_text(text: str, cell_size: float) -> Maze:
+    r, c, seed = _random_spec(text)
     return random_maze((r, c), seed, cell_size=cell_size)
 
 

@@ -195,7 +195,6 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
-        self._alive = False  # the last correction's fresh check found no dead leg
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -219,17 +218,18 @@ class RefinementSearch:
         path = self._trace(final)
         if path and self.cfg.shortcut_reach:
             path = self._shortcut(path)
-        before = (self.graph.copy(), list(path), dict(self.results)) if path else None
+        before = None
         if path and self.cfg.keep_declined:
+            if self.cfg.keep_fallback:  # what the kept split replaces, for its fallback
+                before = (self.graph.copy(), list(path), dict(self.results))
             path = self._take_declined(path)
-        kept = bool(path) and path != before[1]
         if path and self.cfg.polish_rollouts:
             self._polish(path)
         if path and self.cfg.correct_rollouts:
-            if kept and self.cfg.keep_fallback:
+            if before is not None and path != before[1]:
                 path = self._correct_kept(path, before)
             else:
-                path = self._correct(path)
+                path, _ = self._correct(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
                   probabilities=probs, splits_generated=self.splits_generated,
@@ -470,18 +470,18 @@ class RefinementSearch:
         the path is still dead then, back to the graph, path and estimates before the split was taken, corrected
         within the rest as a path without it would have been."""
         limit = self._dead_limit()
-        path = self._correct(path, limit=self.splits_generated + (limit - self.splits_generated) // 2)
-        if self._alive or self.splits_generated >= limit:
+        path, alive = self._correct(path, limit=self.splits_generated + (limit - self.splits_generated) // 2)
+        if alive or self.splits_generated >= limit:
             return path
         self.graph, path, self.results = before[0], list(before[1]), dict(before[2])
         self._log("declined-dropped", path=path, splits=[self.splits_generated, limit],
                   reason="the kept split's path is still dead")
-        return self._correct(path)
+        return self._correct(path)[0]
 
-    def _correct(self, path: list[str], limit: int | None = None) -> list[str]:
+    def _correct(self, path: list[str], limit: int | None = None) -> tuple[list[str], bool]:
         """The correction (correct.py), ``correct_passes`` times: each pass on its own fresh draw (new first
         states, so a leg chosen on one pass's rollouts is judged again on rollouts that did not choose it), with a
-        budget of its own."""
+        budget of its own -> (the path, whether its last fresh check found no dead leg)."""
         for pass_ in range(self.cfg.correct_passes):
             path, check = self._correct_pass(path, pass_)
         pass_, limit = self.cfg.correct_passes, limit or self._dead_limit()
@@ -494,10 +494,9 @@ class RefinementSearch:
             pass_ += 1
             if self.splits_generated == asked:  # nothing left to ask about (no fresh rollout reaches the dead leg)
                 break
-        self._alive = check.p > 0.0
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
-        return path
+        return path, check.p > 0.0
 
     def _dead_limit(self) -> int:
         """The Algorithm 1 calls the correction of a dead path may reach: ``dead_budget``, else the search's."""

@@ -252,25 +252,30 @@ register_method("ours-corrector-persist", ours_variant(**CORRECTOR | THRIFT | PE
                 "beyond the paper: ours-corrector-polish whose correction goes on while the path it leaves has a "
                 "leg that never succeeded on its fresh check: pass after pass, each on a fresh draw, until no leg is "
                 "dead or the search's budget of 30 edge splits is spent", colour="#880e4f")
-register_method("ours-corrector-snap", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(snap_waypoints=True)),
+#: ours-corrector-snap: persist, a waypoint centred in a wall moved clear of it (docs/corrector.md, "Snapped out of
+#: the wall")
+SNAP = dict(snap_waypoints=True)
+register_method("ours-corrector-snap", ours_variant(**CORRECTOR | THRIFT | PERSIST | SNAP),
                 "beyond the paper: ours-corrector-persist taking a reply whose waypoint is centred in a wall with "
                 "that waypoint moved to the nearest point clear of walls by the agent's clearance (within one cell), "
                 "instead of rejecting the reply", colour="#ad1457")
 #: ours-corrector-extend: snap, whose correction of a dead path may go on to 3x the search's budget (docs/corrector.md,
 #: "A budget that grows where the run would end at 0")
-EXTEND = dict(snap_waypoints=True, dead_budget=90)
+EXTEND = SNAP | dict(dead_budget=90)
 register_method("ours-corrector-extend", ours_variant(**CORRECTOR | THRIFT | PERSIST | EXTEND),
                 "beyond the paper: ours-corrector-snap whose correction of a path with a dead leg may go on past the "
                 "search's budget of 30 edge splits, up to 90 in all; a path with no dead leg is corrected as snap "
                 "corrects it, at the same cost", colour="#6a1b9a")
-register_method("ours-corrector-keep", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(snap_waypoints=True,
-                                                                                   keep_declined=True)),
+#: ours-corrector-keep: snap, a dead edge of the found path replaced by its declined split (docs/corrector.md, "A
+#: declined split kept where the path is dead"); ours-corrector-fallback gives it up at half the budget left
+KEEP = SNAP | dict(keep_declined=True)
+register_method("ours-corrector-keep", ours_variant(**CORRECTOR | THRIFT | PERSIST | KEEP),
                 "beyond the paper: ours-corrector-snap whose found path, where an edge of it never succeeded, takes "
                 "the split of that edge the search declined with the most legs alive before its first dead one, so "
                 "that the correction repairs that split's dead legs instead of asking for the whole edge again",
                 colour="#4527a0")
-register_method("ours-corrector-fallback", ours_variant(**CORRECTOR | THRIFT | PERSIST | dict(
-                    snap_waypoints=True, keep_declined=True, keep_fallback=True)),
+register_method("ours-corrector-fallback",
+                ours_variant(**CORRECTOR | THRIFT | PERSIST | KEEP | dict(keep_fallback=True)),
                 "beyond the paper: ours-corrector-keep whose path, where the kept split is still dead after half the "
                 "budget left, goes back to the edge it replaced and is corrected as snap corrects it with the rest",
                 colour="#283593")
