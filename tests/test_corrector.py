@@ -14,7 +14,7 @@ from test_refine_search import _Arrive, _chain_graph, _Query
 from specrefine.core.graph import check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
-from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP
+from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, weakest_untried
 from specrefine.refine.search import live_start
 
 
@@ -535,6 +535,54 @@ def test_without_the_fallback_the_kept_split_is_corrected_to_the_end():
 
 def test_live_start_counts_the_legs_before_the_first_dead_one():
     assert [live_start(p) for p in ([1.0, 0.5, 0.0, 1.0], [0.0], [0.9, 0.9], [])] == [2, 0, 2, 0]
+
+
+# --- ground kept where the path is dead (SearchConfig.correct_advance): method ours-corrector-advance --------------
+FAR_DEAD = {(0.0, 10.0): 0.0, (6.0, 9.0): 0.0, (6.0, 10.0): 0.0}  # the reply 3, 6, 9 dies after 6; so does 6 -> G
+ONWARD = {(0.0, 10.0): [[3, 6, 9]], (6.0, 10.0): [[8]]}
+
+
+def test_a_dead_path_keeps_the_live_legs_of_a_reply_and_asks_only_about_the_rest():
+    book = EdgeQueue(ONWARD)
+    g, result = run(LegTable(FAR_DEAD), book, correct_rollouts=4, correct_while_dead=True, correct_advance=True)
+    assert xs(result) == [0.0, 3.0, 6.0, 8.0, 10.0] and check_refines(result.graph, g) == []
+    assert result.predicted_success == pytest.approx(1.0) and book.queries.count((6.0, 10.0)) == 1
+    legs = [s for s in result.steps if s["event"] == "correct-leg"]
+    advanced = [s for s in legs if s["accepted"] == "advance"]
+    assert len(advanced) == 1 and advanced[0]["edge"] == ["S", "G"]
+    assert [t.get("nearer") for t in advanced[0]["tried"]] == [None, pytest.approx(6.0)]
+
+
+def test_without_it_the_same_replies_leave_the_path_dead():
+    book = EdgeQueue(ONWARD)
+    _, result = run(LegTable(FAR_DEAD), book, correct_rollouts=4, correct_while_dead=True, max_edge_splits=8)
+    assert xs(result) == [0.0, 10.0] and set(book.queries) == {(0.0, 10.0)}
+
+
+def test_ground_that_is_not_nearer_the_legs_end_is_not_kept():
+    book = EdgeQueue({(0.0, 10.0): [[-3, 5]]})  # 0 -> -3 lives, -3 -> 5 does not: -3 is farther from G than S
+    _, result = run(LegTable({(0.0, 10.0): 0.0, (-3.0, 5.0): 0.0, (-3.0, 10.0): 0.0}), book, correct_rollouts=4,
+                    correct_while_dead=True, correct_advance=True, max_edge_splits=6)
+    assert xs(result) == [0.0, 10.0] and set(book.queries) == {(0.0, 10.0)}
+    tried = [t for s in result.steps if s["event"] == "correct-leg" for t in s["tried"] if t["kind"] == "advance"]
+    assert tried and all(t["nearer"] < 0 for t in tried)
+
+
+def test_a_live_path_is_corrected_as_without_it():
+    fresh = {(3.0, 6.0): 0.75}
+    calls = []
+    for setting in (False, True):
+        book = AnswerBook({(0.0, 10.0): [3, 6]})
+        _, result = run(LegTable(LUCKY, fresh), book, correct_rollouts=4, correct_while_dead=True,
+                        correct_advance=setting)
+        calls.append((len(book.queries), xs(result), [s["event"] for s in result.steps]))
+    assert calls[0] == calls[1]
+
+
+def test_while_the_path_is_dead_only_its_dead_legs_are_tried():
+    check = Check(results=[_Arrive(0.5), _Arrive(0.0)], path=["S", "x0", "G"])
+    assert weakest_untried(check, {("x0", "G")}, dead_only=True) is None
+    assert weakest_untried(check, {("x0", "G")}) == 0 and weakest_untried(check, set(), dead_only=True) == 1
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

@@ -30,6 +30,11 @@ def weight(p: float, n: int) -> float:
     return -math.log(max(p, 0.5 / max(n, 1)))
 
 
+def live_start(probabilities) -> int:
+    """How many legs succeed at all before the first that never does."""
+    return next((i for i, p in enumerate(probabilities) if p <= 0.0), len(probabilities))
+
+
 def start_of(result):
     """Start distribution for the next subtask: the end states of this one's successful rollouts."""
     return result.end_states if result is not None and result.successes > 0 else None

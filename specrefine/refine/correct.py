@@ -33,6 +33,17 @@ its fresh rollouts failed: a leg losing a fraction of a per cent shows one failu
 one, and splitting it spends proposer calls on noise (docs/corrector.md, 'Where the corrector still loses'). Such a
 leg is still offered the bypass, which asks nothing.
 
+``advance`` (method ``ours-corrector-advance``): a dead path keeps the ground a reply won. Where the window's legs
+never all succeed, no alternative can gain a rollout's worth there, so a reply whose first legs succeed and whose later
+ones do not is thrown away, and the next query spans the whole dead leg again (with an erring proposer, the errors
+grow with the turns a query spans). With ``advance`` the split of a dead leg a -> b is also offered cut after its live
+legs: a -> x_1 -> ... -> x_k -> b, where x_1 .. x_k are the waypoints before its first never-succeeding leg. It
+replaces the path when no alternative wins, the path's fresh check reaches x_k, and x_k lies nearer b than a does (the
+straight distance between region centres: waypoints and rollouts only, no planner). The next query is then about
+x_k -> b, a shorter span; ground won is never given back while the path is dead, and a path that succeeds at all is
+judged as before. While the path is dead only its dead legs are tried: an alternative to a live leg is judged over a
+window that holds the dead one, where nothing can win.
+
 Every alternative is a refinement of the same input edge (a longer or shorter chain of waypoints), so the refined
 graph still implies the input graph (Theorem 4.1, checked like every refinement). What the correction sees is what
 a real proposer's reply gives: waypoints, pictures and rollouts.
@@ -44,8 +55,10 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..core.graph import TaskGraph
-from .common import Leg, LegEstimates, SubtaskEvaluator, estimate_legs, start_of
+from .common import Leg, LegEstimates, SubtaskEvaluator, estimate_legs, live_start, start_of
 from .shortcut import Shortcut, add_shortcuts, shortcuts
 
 CHECK_SEED_OFFSET = 104_729  # the correction's fresh rollouts: apart from the search's, polish's and the measurement's
@@ -81,9 +94,11 @@ def lean_score(check: Check) -> float:
     return math.prod(posterior_mean(r) for r in check.results) if check.results else 0.0
 
 
-def weakest_untried(check: Check, tried: set) -> int | None:
-    """The leg with the lowest fresh estimate below 1 that has not been tried (the first of ties)."""
-    legs = [i for i, p in enumerate(check.probabilities) if p < 1.0 and _leg_key(check, i) not in tried]
+def weakest_untried(check: Check, tried: set, dead_only: bool = False) -> int | None:
+    """The leg with the lowest fresh estimate below 1 that has not been tried (the first of ties); ``dead_only``: only
+    a leg that never succeeded."""
+    legs = [i for i, p in enumerate(check.probabilities) if (p <= 0.0 if dead_only else p < 1.0)
+            and _leg_key(check, i) not in tried]
     return min(legs, key=lambda i: (check.probabilities[i], i)) if legs else None
 
 
@@ -129,7 +144,7 @@ def spliced(graph: TaskGraph, path: list[str], i: int, j: int, waypoints) -> tup
 def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
-            first_win: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            first_win: bool = False, advance: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -137,12 +152,14 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     states as the current path's legs there; it replaces the path when it gains at least one rollout's worth
     (1 / rollouts) over the window (``lean``: when its posterior score there is higher), and the path's legs from
     the window on are then checked again. ``lean`` then offers every inner waypoint its bypass (module doc).
-    ``first_win``: the alternatives are asked for and judged cheapest first (module doc)."""
+    ``first_win``: the alternatives are asked for and judged cheapest first; ``advance``: a dead leg's split cut
+    after its live legs replaces the path where it gets nearer the leg's end, and while the path is dead only its dead
+    legs are tried (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
-                                           start=graph.region(path[0])), evaluator, rollouts, seed, lean)
+                                           start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
     log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
     tried: set = set()
-    while (leg := weakest_untried(state.check, tried)) is not None:
+    while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures)
         if not first_win:
@@ -185,7 +202,11 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
                                         seed=state.seed, n=state.rollouts)
         fix = split_leg(*_with_edge(graph, path, i, j), path[i], path[j], result, leg_start)
         if fix is not None and fix.waypoints:
-            yield [("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints))]
+            options = [("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints))]
+            live = min(live_start(fix.probabilities), len(fix.waypoints))
+            if state.advance and check.results[leg].p <= 0.0 and 0 < live < len(fix.results):
+                options.append(("advance", *spliced(graph, path, i, j, fix.waypoints[:live])))
+            yield options
 
 
 @dataclass
@@ -205,6 +226,7 @@ class _State:
     rollouts: int
     seed: int
     lean: bool
+    advance: bool = False
 
     def score(self, check: Check) -> float:
         return lean_score(check) if self.lean else check.p
@@ -224,13 +246,42 @@ class _State:
             wins = best is not None and self.score(best[3]) > current
         else:
             wins = best is not None and best[3].p >= current + 1.0 / self.rollouts
+        tried = [{"kind": kind, "p_window": self.score(c), "legs": len(p) - 1} for kind, _, p, c in judged]
+        if not wins and self.advance and current <= 0.0:
+            best, gains = _furthest(graph, path, leg, s, judged)
+            wins = best is not None
+            for entry, gain in zip(tried, gains):
+                if gain is not None:
+                    entry["nearer"] = gain
         if wins:
             self.graph, self.path = best[1], best[2]
             rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=self.seed,
                               start=start)
             self.check = Check(results=check.results[:s] + rest.results, path=list(self.path))
-        tried = [{"kind": kind, "p_window": self.score(c), "legs": len(p) - 1} for kind, _, p, c in judged]
         return Judged(current, tried), best[0] if wins else None
+
+
+def _furthest(graph: TaskGraph, path: list[str], leg: int, s: int, judged: list) -> tuple[tuple | None, list]:
+    """Of the ``advance`` options judged on a dead window (``judged``: kind, graph, path, check from path[s]), the one
+    whose fresh check reaches its last waypoint and which gets nearest the end of the span it replaces, if nearer than
+    path[leg] is -> (that option or None, per option how much nearer it gets, None where it does not count)."""
+    best, gains = None, []
+    for option in judged:
+        kind, alt, alt_path, alt_check = option
+        gain = None
+        if kind == "advance":
+            end = next(k for k in range(leg + 1, len(alt_path)) if alt_path[k] in path)
+            if live_start(alt_check.probabilities) >= end - 1 - s:  # every leg up to its last waypoint succeeds
+                gain = _distance(graph, path[leg], alt_path[end]) - _distance(alt, alt_path[end - 1], alt_path[end])
+        gains.append(gain)
+        if gain is not None and gain > 0.0 and (best is None or gain > best[1]):
+            best = (option, gain)
+    return (best[0] if best else None), gains
+
+
+def _distance(graph: TaskGraph, a: str, b: str) -> float:
+    """The straight distance between the centres of two vertices' regions."""
+    return float(np.linalg.norm(np.asarray(graph.region(a).centre()) - np.asarray(graph.region(b).centre())))
 
 
 def _prune(state: _State, reach: float, clearance: float, log: Callable[..., None]) -> None:

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core.graph import TaskGraph, assert_refines
 from ..core.paper import PAPER
-from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, start_of, weight
+from .common import UNREACHED, Leg, SubtaskEvaluator, estimate_legs, live_start, start_of, weight
 from .correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, correct, path_legs
 from .edge_split import SplitCandidate, edge_split
 from .polish import polish
@@ -91,6 +91,8 @@ class SearchConfig:
     #                              repairs that split's dead legs instead of asking for the whole edge again
     keep_fallback: bool = False  # with keep_declined: where the kept split's correction leaves the path dead at half
     #                              the budget left, the path goes back to the edge it replaced, corrected as before
+    correct_advance: bool = False  # beyond the paper: a dead leg's split cut after its live legs replaces the path
+    #                                where it gets nearer the leg's end (correct.py; method ours-corrector-advance)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -518,6 +520,8 @@ class RefinementSearch:
                 best = repair(cheapest(outcome.candidates, n), graph, a, b, start=start, evaluator=self.evaluator,
                               split_leg=split_once, may_split=lambda: self.splits_generated < budget,
                               depth=self.cfg.repair_depth) or best
+            if best is not None and best.p == 0.0 and self.cfg.correct_advance:  # the reply that got furthest alive
+                best = max([best, *outcome.candidates], key=lambda c: live_start(c.probabilities))
             return best
 
         reach = self.cfg.correct_reach or 0.0
@@ -528,7 +532,7 @@ class RefinementSearch:
                                       split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
                                       min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
-                                      first_win=self.cfg.correct_first_win)
+                                      first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance)
         return path, check
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
@@ -588,8 +592,3 @@ def shortest_path(graph: TaskGraph, evaluator: SubtaskEvaluator, seed: int = 0) 
     """DiRL: no refinement, just the lazy shortest-path search over the input graph."""
     cfg = SearchConfig(edge_refinement=False, vertex_refinement=False, seed=seed)
     return RefinementSearch(graph, evaluator, config=cfg).run()
-
-
-def live_start(probabilities) -> int:
-    """How many legs succeed at all before the first that never does."""
-    return next((i for i, p in enumerate(probabilities) if p <= 0.0), len(probabilities))

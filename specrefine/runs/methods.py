@@ -279,6 +279,17 @@ register_method("ours-corrector-fallback",
                 "beyond the paper: ours-corrector-keep whose path, where the kept split is still dead after half the "
                 "budget left, goes back to the edge it replaced and is corrected as snap corrects it with the rest",
                 colour="#283593")
+#: ours-corrector-advance: snap, a dead path keeping the ground a reply won (docs/corrector.md, "Ground kept where the
+#: path is dead")
+ADVANCE = SNAP | dict(correct_advance=True)
+register_method("ours-corrector-advance", ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE),
+                "beyond the paper: ours-corrector-snap whose correction of a dead leg keeps the legs a reply got "
+                "alive: the reply's split cut after its live legs replaces the leg where it gets nearer the leg's "
+                "end, and the next query spans only the rest", colour="#00695c")
+register_method("ours-corrector-advance-extend", ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND),
+                "beyond the paper: ours-corrector-advance whose correction of a path with a dead leg may go on past "
+                "the search's budget of 30 edge splits, up to 90 in all (ours-corrector-extend's budget)",
+                colour="#004d40")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
