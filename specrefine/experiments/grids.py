@@ -275,6 +275,16 @@ FALLBACK_MIXES = ("imperfect:position_sigma=0.3,coord_grid=0.5,radius=0.3,radius
                   "alpha=0.3,rho=0.5",
                   "imperfect:position_sigma=0.4,radius=0.35,radius_log_sigma=0.4,corner_pull=0.35,p_wrong_branch=0.3,"
                   "p_mirror_y=0.2,p_drop_turn=0.3,p_uncapped=0.4,alpha=0.25,rho=0.6")
+#: layouts and error mixes no run had used before grid corrector-advance-new (docs/corrector.md, "Ground kept where
+#: the path is dead"): four more generated mazes, and two mixes: Q (offsets rounded to half cells, false openings,
+#: wrong branches, mirrored replies, dropped turns, errors growing with the turns a query spans) and R (small regions
+#: pulled to corners, wrong branches, uncapped legs, dropped turns, unparseable replies, errors growing fast)
+ADVANCE_MAZES = ("random:7x7:58", "random:6x8:15", "random:8x6:62", "random:7x6:91")
+ADVANCE_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.35,radius_log_sigma=0.4,corner_pull=0.25,"
+                 "p_drop_turn=0.3,p_false_opening=0.2,p_wrong_branch=0.25,p_mirror_y=0.1,p_uncapped=0.5,"
+                 "p_unparseable=0.05,alpha=0.25,rho=0.5",
+                 "imperfect:position_sigma=0.3,radius=0.3,radius_log_sigma=0.5,corner_pull=0.4,p_wrong_branch=0.4,"
+                 "p_drop_turn=0.35,p_false_opening=0.1,p_uncapped=0.6,p_unparseable=0.1,alpha=0.3,rho=0.4")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -635,6 +645,16 @@ GRIDS = {g.name: g for g in (
                           code="c6a590c",
                           informed=Part(("ours-corrector-fallback",), KEEP_MIXES, seeds=(0, 1), mazes=KEEP_MAZES,
                                         table="data/results/corrector/fallback_keep_new.csv", out="keep_new")),
+    # docs/corrector.md, "Ground kept where the path is dead" (fixed 2026-11-28 09:23 UTC, before it ran)
+    new_layouts_grid("corrector-advance-new", "docs/corrector.md, 'Ground kept where the path is dead' (issue 39; "
+                     "fixed 2026-11-28 before it ran)", ("ours-corrector-advance-extend", "ours-corrector-advance",
+                                                         "ours-corrector-snap", "ours"), ADVANCE_MAZES, ADVANCE_MIXES,
+                     "advance_new", code="66e5948"),
+    *centre_variant_grids("corrector-advance", "Ground kept where the path is dead", "ours-corrector-advance-extend",
+                          "advance", code="66e5948",
+                          informed=Part(("ours-corrector-advance-extend",), FALLBACK_MIXES, seeds=(0, 1),
+                                        mazes=FALLBACK_MAZES, table="data/results/corrector/advance_fallback_new.csv",
+                                        out="fallback_new")),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
