@@ -578,6 +578,38 @@ def test_keep_is_judged_against_snap_on_its_new_layouts_and_extends_cells_that_i
     assert "runs at 0: ours-corrector-keep 0, ours-corrector-snap 4" in cc._new_text(informed)
 
 
+def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_that_informed_it(tmp_path):
+    """corrector-advance: advance-extend against snap (through snap and persist the centre grids' oracle and ours);
+    its new layouts (Q, R) put advance-extend, advance, snap and ours side by side; fallback's new cells (O, P) are its
+    informed part; adopted only where snap is."""
+    alone = "ours-corrector-advance"
+
+    def rate(maze, method, proposer):
+        if method == cc.ADVANCE:
+            return 0.99
+        dead = cc.table_name(maze) in ("random:6x6:77", "random:8x6:62")
+        if method in (cc.SNAP, cc.KEEP, cc.FALLBACK, alone) and dead and \
+                proposer in cc.FALLBACK_MIXES + cc.ADVANCE_MIXES:
+            return 0.0
+        return 0.99 if method in (cc.SNAP, cc.KEEP, cc.FALLBACK, alone) else persist_rate(maze, method, proposer)
+
+    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
+                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-fallback-new",
+                 "corrector-advance", "corrector-advance-suite", "corrector-advance-new"):
+        lay_all_parts(tmp_path, name, rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["advance"]
+    assert vs["reference"] == cc.SNAP and vs["versus_corrector"]["n_cells"] == 72
+    informed, new = vs["informed"], vs["new"]
+    assert informed["names"] == ["O", "P"] and informed["grid"] == "corrector-fallback-new"
+    assert informed["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4, cc.KEEP: 4, cc.FALLBACK: 4, "ours": 0}
+    assert new["names"] == ["Q", "R"] and new["zero"] == {cc.ADVANCE: 0, alone: 4, cc.SNAP: 4, "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
+    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed",) and cc.ADOPTABLE[0] == "advance"
+
+
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
     assert cc._unseen_text(cc.unseen(tmp_path)) == "not run yet"
     lay_all_parts(tmp_path, "corrector-keep-new", lambda maze, m, p: 0.0 if m == cc.SNAP and

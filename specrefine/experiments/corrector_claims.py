@@ -30,6 +30,8 @@ from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import (
+    ADVANCE_MAZES,
+    ADVANCE_MIXES,
     CHECK_MAZES,
     CHECK_MIXES,
     EXTEND_MAZES,
@@ -70,6 +72,8 @@ SNAP = "ours-corrector-snap"  # persist, a reply's waypoint centred in a wall mo
 EXTEND = "ours-corrector-extend"  # snap, a dead path corrected past the search's budget, up to 3x (its grids' rows)
 KEEP = "ours-corrector-keep"  # snap, a dead path's edge replaced by its declined split with the longest live start
 FALLBACK = "ours-corrector-fallback"  # keep, the kept split given up for the edge it replaced at half the budget
+ADVANCE = "ours-corrector-advance-extend"  # snap, a dead path keeping the live legs of a reply, with extend's budget
+SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
@@ -77,28 +81,29 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
                  SNAP: "corrector-snap", EXTEND: "corrector-extend",
-                 KEEP: "corrector-keep", FALLBACK: "corrector-fallback"}
+                 KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
-                     SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP}
+                     SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
                  CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
                  SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite",
-                 KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite"}
+                 KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite",
+                 ADVANCE: "corrector-advance-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
-            "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK}
+            "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
-ADOPTABLE = ("fallback", "keep", "extend", "snap", "persist")  # ... or a later one adopted by its rule (reported())
+ADOPTABLE = ("advance", "fallback", "keep", "extend", "snap", "persist")  # ... or a later one adopted (reported())
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -373,12 +378,13 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                "check": ("corrector-snap-check", CHECK_MAZES, CHECK_MIXES, ("I", "J")),  # a last check, described
                EXTEND: ("corrector-extend-new", EXTEND_MAZES, EXTEND_MIXES, ("K", "L")),
                KEEP: ("corrector-keep-new", KEEP_MAZES, KEEP_MIXES, ("M", "N")),
-               FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P"))}  # in the order made
+               FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P")),
+               ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
+INFORMED_PARTS = {SNAP: ("informed", "check"), **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK, ADVANCE)}}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
-INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP}
+INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -401,7 +407,7 @@ def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: 
                      for key, m in others}
             entries.append(e | {"mix": name} | {k: c[0] / c[1] if c[1] else math.nan for k, c in extra.items()})
     cells, failed = cmp.table_cells(rows, "point")
-    beside = tuple(sorted({r["method"] for r in rows} & set(VARIANTS.values()) - {method, ref, CENTRE}))
+    beside = tuple(sorted({r["method"] for r in rows} & ({*VARIANTS.values(), *SHOWN_BESIDE}) - {method, ref, CENTRE}))
     shown = tuple(dict.fromkeys((method, ref) + ((CENTRE,) if polish else ()) + beside + ("ours",)))
     study = {"grid": grid, "method": method, "reference": ref, "names": list(names), "per_maze": entries,
              "zero": {m: sum(zero_runs(rows, m, mix, mazes)[0] for mix in mixes) for m in shown},
@@ -565,7 +571,7 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
     if snap:  # snap is adopted only where persist is, or would be but for its second part ("Snapped out of the wall")
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
-    for later in (studies.get(name) for name in ("extend", "keep", "fallback")):  # adopted only where snap is
+    for later in (studies.get(name) for name in ("extend", "keep", "fallback", "advance")):  # only where snap is
         if later:
             held = bool(snap) and snap["adoption"]["adopted"]
             later["adoption"] |= {"reference_adopted": held, "adopted": later["adoption"]["adopted"] and held}
