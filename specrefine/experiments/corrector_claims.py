@@ -30,6 +30,8 @@ from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
 from . import comparison as cmp
 from .grids import (
+    ADVANCE_CHECK_MAZES,
+    ADVANCE_CHECK_MIXES,
     ADVANCE_MAZES,
     ADVANCE_MIXES,
     CHECK_MAZES,
@@ -366,6 +368,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["check"] = new_study(SNAP, root, on="check", reference="ours")
     if method in INFORMED_ON:  # on the cells that informed it
         study["informed"] = new_study(method, root, on=INFORMED_ON[method])
+    if method == ADVANCE:  # a last check after its adoption (described)
+        study["check"] = new_study(ADVANCE, root, on="advance-check")
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -379,10 +383,13 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                EXTEND: ("corrector-extend-new", EXTEND_MAZES, EXTEND_MIXES, ("K", "L")),
                KEEP: ("corrector-keep-new", KEEP_MAZES, KEEP_MIXES, ("M", "N")),
                FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P")),
-               ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R"))}  # in the order made
+               ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R")),
+               "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T"))
+               }  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK, ADVANCE)}}
+INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
+                  **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK}
 

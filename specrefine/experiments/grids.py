@@ -285,6 +285,17 @@ ADVANCE_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.35,radiu
                  "p_unparseable=0.05,alpha=0.25,rho=0.5",
                  "imperfect:position_sigma=0.3,radius=0.3,radius_log_sigma=0.5,corner_pull=0.4,p_wrong_branch=0.4,"
                  "p_drop_turn=0.35,p_false_opening=0.1,p_uncapped=0.6,p_unparseable=0.1,alpha=0.3,rho=0.4")
+#: layouts and error mixes no run had used before grid corrector-advance-check (docs/corrector.md, "A last check
+#: after advance-extend's adoption"), made after Q/R had been looked at: four larger generated mazes, and two mixes: S
+#: (large offsets rounded to half cells, false openings, wrong branches, mirrored replies, dropped turns, uncapped
+#: legs, errors growing with the turns a query spans) and T (coordinates rounded to whole cells, small regions pulled
+#: hard to corners, wrong branches, many dropped turns, errors growing fast)
+ADVANCE_CHECK_MAZES = ("random:8x8:5", "random:9x6:33", "random:6x9:70", "random:7x8:12")
+ADVANCE_CHECK_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.3,radius_log_sigma=0.5,corner_pull=0.3,"
+                       "p_drop_turn=0.35,p_false_opening=0.25,p_wrong_branch=0.3,p_mirror_y=0.15,p_uncapped=0.6,"
+                       "p_unparseable=0.1,alpha=0.3,rho=0.4",
+                       "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.6,corner_pull=0.5,"
+                       "p_wrong_branch=0.45,p_drop_turn=0.4,p_uncapped=0.7,p_unparseable=0.05,alpha=0.35,rho=0.5")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -655,6 +666,11 @@ GRIDS = {g.name: g for g in (
                           informed=Part(("ours-corrector-advance-extend",), FALLBACK_MIXES, seeds=(0, 1),
                                         mazes=FALLBACK_MAZES, table="data/results/corrector/advance_fallback_new.csv",
                                         out="fallback_new")),
+    # docs/corrector.md, "A last check after advance-extend's adoption" (fixed 2026-11-28 10:07 UTC, before it ran)
+    new_layouts_grid("corrector-advance-check", "docs/corrector.md, 'A last check after advance-extend's adoption' "
+                     "(issue 39; fixed 2026-11-28 before it ran)", ("ours-corrector-advance-extend",
+                                                                    "ours-corrector-snap", "ours"),
+                     ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, "advance_check", code="66e5948"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
