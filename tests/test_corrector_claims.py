@@ -607,7 +607,13 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     a = vs["adoption"]
     assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed",) and cc.ADOPTABLE[0] == "advance"
+    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[0] == "advance"
+    assert vs["check"] is None  # its last check not laid yet
+    lay_all_parts(tmp_path, "corrector-advance-check", lambda maze, m, p: 0.0 if m == cc.SNAP and
+                  cc.table_name(maze) == "random:9x6:33" else 1.0)
+    check = cc.variant_studies(tmp_path)["advance"]["check"]
+    assert check["names"] == ["S", "T"] and check["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4, "ours": 0}
+    assert [e["mixes"] for e in cc.unseen(tmp_path)][-3:] == ["O/P", "Q/R", "S/T"]  # in the order made
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
