@@ -13,6 +13,9 @@ def test_the_correction_steps_read_as_sentences():
            "tried": [{"kind": "bypass", "p_window": 0.5}, {"kind": "split", "p_window": 0.95}], "accepted": "split"}
     assert describe(leg) == ("step 5: correct leg 1 (a -> G, fresh p 0.800, window 0.800): tried bypass 0.500, "
                              "split 0.950; accepted split")
+    advanced = dict(leg, p_leg=0.0, p_window=0.0, accepted="advance",
+                    tried=[{"kind": "split", "p_window": 0.0}, {"kind": "advance", "p_window": 0.0, "nearer": 6.13}])
+    assert describe(advanced).endswith("tried split 0.000, advance 0.000 (+6.13 m nearer); accepted advance")
     nothing = dict(leg, tried=[], accepted=None)
     assert describe(nothing).endswith("tried nothing; accepted none")
     done = {"step": 6, "event": "correct-done", "p": 0.95, "probabilities": [1.0, 0.95]}

@@ -48,7 +48,8 @@ def describe(step: dict) -> str:
         detail["n_legs"] = len(detail["probabilities"])
     detail["pass_text"] = f" (pass {detail['correct_pass']})" if "correct_pass" in detail else ""
     if "tried" in detail:
-        detail["tried_text"] = ", ".join(f"{t['kind']} {t['p_window']:.3f}" for t in detail["tried"]) or "nothing"
+        detail["tried_text"] = ", ".join(f"{t['kind']} {t['p_window']:.3f}" + _nearer(t) for t in detail["tried"]) \
+            or "nothing"
         detail["accepted_text"] = detail.get("accepted") or "none"
     try:
         return f"step {step['step']}: " + EVENT_TEXT[step["event"]].format(**detail)
@@ -88,3 +89,8 @@ def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int 
     slider.observe(show, names="value")
     show()
     return widgets.VBox([slider, out])
+
+
+def _nearer(tried: dict) -> str:
+    """How much nearer the dead leg's end an ``advance`` gets (ours-corrector-advance), where it was measured."""
+    return f" ({tried['nearer']:+.2f} m nearer)" if tried.get("nearer") is not None else ""
