@@ -203,7 +203,7 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
         fix = split_leg(*_with_edge(graph, path, i, j), path[i], path[j], result, leg_start)
         if fix is not None and fix.waypoints:
             options = [("split" if j == i + 1 else "resplit", *spliced(graph, path, i, j, fix.waypoints))]
-            live = min(live_start(fix.probabilities), len(fix.waypoints))
+            live = live_start(fix.probabilities)  # the legs alive before its first dead one
             if state.advance and check.results[leg].p <= 0.0 and 0 < live < len(fix.results):
                 options.append(("advance", *spliced(graph, path, i, j, fix.waypoints[:live])))
             yield options
