@@ -433,6 +433,23 @@ def persist_rate(maze, method, proposer):
     return centre_rate(maze, method, proposer)
 
 
+#: the grids a variant judged against snap is laid with (through snap and persist, the centre grids' references)
+THROUGH_SNAP = ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
+                "corrector-snap", "corrector-snap-suite", "corrector-snap-new")
+
+
+def later_rate(variant: str, beside: tuple, mixes: tuple, dead: tuple):
+    """A rate for a variant judged against snap: the variant 0.99; the methods ``beside`` it 0 on the ``dead`` mazes
+    under ``mixes`` and 0.99 elsewhere; every other method as persist's grids give it."""
+    def rate(maze, method, proposer):
+        if method == variant:
+            return 0.99
+        if method in beside:
+            return 0.0 if proposer in mixes and cc.table_name(maze) in dead else 0.99
+        return persist_rate(maze, method, proposer)
+    return rate
+
+
 def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids_references(tmp_path):
     """corrector-persist runs persist only: its oracle, ours (U-chains and suite), ours-repair and the one-shot are
     corrector-centre's and corrector-centre-suite's rows, polish at centre points its reference; the adoption rule
@@ -511,17 +528,8 @@ def test_extend_is_judged_against_snap_on_its_new_layouts_and_the_check_cells_th
     """corrector-extend's references: snap (its rows), and through snap and persist the centre grids' oracle, ours and
     ours-repair; its new layouts put extend, snap and ours side by side (no polish: its grid runs none); the last
     check's cells are its informed part; it is adopted only where snap is."""
-    def rate(maze, method, proposer):
-        if method == cc.EXTEND:
-            return 0.99
-        if method == cc.SNAP and proposer in cc.EXTEND_MIXES + cc.CHECK_MIXES and \
-                cc.table_name(maze) in ("random:7x7:11", "random:7x6:40"):
-            return 0.0
-        return 0.99 if method == cc.SNAP else persist_rate(maze, method, proposer)
-
-    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
-                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-extend",
-                 "corrector-extend-suite"):
+    rate = later_rate(cc.EXTEND, (cc.SNAP,), cc.EXTEND_MIXES + cc.CHECK_MIXES, ("random:7x7:11", "random:7x6:40"))
+    for name in (*THROUGH_SNAP, "corrector-extend", "corrector-extend-suite"):
         lay_all_parts(tmp_path, name, rate)
     vs = cc.variant_studies(tmp_path)["extend"]
     assert vs["reference"] == cc.SNAP and vs["versus_corrector"]["n_cells"] == 72
@@ -553,17 +561,8 @@ def test_keep_is_judged_against_snap_on_its_new_layouts_and_extends_cells_that_i
     """corrector-keep: snap its reference (through snap and persist the centre grids' oracle and ours); its new
     layouts (M, N) put keep, snap and ours side by side; extend's new cells are its informed part; adopted only where
     snap is."""
-    def rate(maze, method, proposer):
-        if method == cc.KEEP:
-            return 0.99
-        dead = cc.table_name(maze) in ("random:7x7:11", "random:8x6:3")
-        if method in (cc.SNAP, cc.EXTEND) and proposer in cc.EXTEND_MIXES + cc.KEEP_MIXES and dead:
-            return 0.0
-        return 0.99 if method in (cc.SNAP, cc.EXTEND) else persist_rate(maze, method, proposer)
-
-    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
-                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-extend-new",
-                 "corrector-keep", "corrector-keep-suite", "corrector-keep-new"):
+    rate = later_rate(cc.KEEP, (cc.SNAP, cc.EXTEND), cc.EXTEND_MIXES + cc.KEEP_MIXES, ("random:7x7:11", "random:8x6:3"))
+    for name in (*THROUGH_SNAP, "corrector-extend-new", "corrector-keep", "corrector-keep-suite", "corrector-keep-new"):
         lay_all_parts(tmp_path, name, rate)
     studies = cc.variant_studies(tmp_path)
     vs = studies["keep"]
@@ -583,19 +582,10 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     its new layouts (Q, R) put advance-extend, advance, snap and ours side by side; fallback's new cells (O, P) are its
     informed part; adopted only where snap is."""
     alone = "ours-corrector-advance"
-
-    def rate(maze, method, proposer):
-        if method == cc.ADVANCE:
-            return 0.99
-        dead = cc.table_name(maze) in ("random:6x6:77", "random:8x6:62")
-        if method in (cc.SNAP, cc.KEEP, cc.FALLBACK, alone) and dead and \
-                proposer in cc.FALLBACK_MIXES + cc.ADVANCE_MIXES:
-            return 0.0
-        return 0.99 if method in (cc.SNAP, cc.KEEP, cc.FALLBACK, alone) else persist_rate(maze, method, proposer)
-
-    for name in ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
-                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new", "corrector-fallback-new",
-                 "corrector-advance", "corrector-advance-suite", "corrector-advance-new"):
+    rate = later_rate(cc.ADVANCE, (cc.SNAP, cc.KEEP, cc.FALLBACK, alone), cc.FALLBACK_MIXES + cc.ADVANCE_MIXES,
+                      ("random:6x6:77", "random:8x6:62"))
+    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
+                 "corrector-advance-new"):
         lay_all_parts(tmp_path, name, rate)
     studies = cc.variant_studies(tmp_path)
     vs = studies["advance"]
