@@ -9,12 +9,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import pytest
-from test_refine_search import _Arrive, _chain_graph, _Query
+from test_refine_search import WALLS, _Arrive, _chain_graph, _Query, box_at
 
 from specrefine.core.graph import check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
 from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, weakest_untried
+from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 
 
@@ -583,6 +584,58 @@ def test_while_the_path_is_dead_only_its_dead_legs_are_tried():
     check = Check(results=[_Arrive(0.5), _Arrive(0.0)], path=["S", "x0", "G"])
     assert weakest_untried(check, {("x0", "G")}, dead_only=True) is None
     assert weakest_untried(check, {("x0", "G")}) == 0 and weakest_untried(check, set(), dead_only=True) == 1
+
+
+# --- replies pooled into a roadmap (SearchConfig.correct_roadmap): method ours-corrector-roadmap -------------------
+#: no reply is right: S -> G is answered 3, 9 (3 -> 9 dead); 3 -> G is answered 6, 12 (6 -> 12 dead); 6 -> G is
+#: answered 12 (dead). Pooled, 3, 6 and 9 are legs within reach 3.5 of each other, and 9 -> G lives.
+NO_REPLY_RIGHT = {(0.0, 10.0): 0.0, (3.0, 9.0): 0.0, (3.0, 10.0): 0.0, (6.0, 12.0): 0.0, (6.0, 10.0): 0.0}
+WRONG_REPLIES = {(0.0, 10.0): [[3, 9]], (3.0, 10.0): [[6, 12]], (6.0, 10.0): [[12]]}
+POOLED = dict(correct_rollouts=4, correct_while_dead=True, correct_advance=True, correct_reach=3.5, max_edge_splits=8)
+
+
+def test_a_dead_leg_is_finished_over_the_waypoints_of_replies_that_were_each_wrong():
+    g, result = run(LegTable(NO_REPLY_RIGHT), EdgeQueue(WRONG_REPLIES), correct_roadmap=True, **POOLED)
+    assert xs(result) == [0.0, 3.0, 6.0, 9.0, 10.0] and check_refines(result.graph, g) == []
+    assert result.predicted_success == pytest.approx(1.0)
+    accepted = [s["accepted"] for s in result.steps if s["event"] == "correct-leg" and s["accepted"]]
+    assert accepted[-1] == "roadmap"
+    found = [s for s in result.steps if s["event"] == "roadmap" and s["reaches_end"]]
+    assert found and found[-1]["edge"][1] == "G" and found[-1]["waypoints"] == 1
+
+
+def test_without_the_roadmap_the_same_replies_leave_the_path_dead():
+    _, result = run(LegTable(NO_REPLY_RIGHT), EdgeQueue(WRONG_REPLIES), **POOLED)
+    assert result.predicted_success == 0.0 and not any(s["event"] == "roadmap" for s in result.steps)
+
+
+def test_a_live_path_never_consults_the_roadmap():
+    runs = []
+    for setting in (False, True):
+        book = AnswerBook({(0.0, 10.0): [3, 6]})
+        _, result = run(LegTable(LUCKY, {(3.0, 6.0): 0.75}), book, correct_rollouts=4, correct_while_dead=True,
+                        correct_advance=True, correct_reach=3.5, correct_roadmap=setting)
+        runs.append((book.queries, xs(result), [s["event"] for s in result.steps]))
+    assert runs[0] == runs[1] and "roadmap" not in runs[1][2]
+
+
+def test_the_roadmap_pools_one_waypoint_per_place_and_tries_a_dead_leg_once():
+    roadmap = Roadmap(reach=3.5)
+    roadmap.add([Disc(3, 0, 0.5), Disc(3.1, 0, 0.4)])
+    roadmap.add([Disc(6, 0, 0.5)])
+    assert [float(p.centre()[0]) for p in roadmap.points] == [3.0, 6.0]
+    ev, s, g = LegTable({(3.0, 6.0): 0.0}), box_at(0, 0), box_at(10, 0)
+    first, again = (roadmap.chain(ev, s, s, g, WALLS) for _ in range(2))
+    assert [float(r.centre()[0]) for r in first.waypoints] == [3.0] and not first.reaches_goal
+    assert (first.evaluations, again.evaluations) == (2, 1) and again.waypoints == first.waypoints
+
+
+def test_the_roadmap_stops_at_its_evaluations():
+    roadmap = Roadmap(reach=3.5, evaluations=1)
+    roadmap.add([Disc(3, 0, 0.5), Disc(6, 0, 0.5), Disc(9, 0, 0.5)])
+    ev, s = LegTable({}), box_at(0, 0)
+    found = roadmap.chain(ev, s, s, box_at(10, 0), WALLS)
+    assert found.evaluations == 1 and len(ev.calls) == 1 and not found.reaches_goal
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

@@ -144,7 +144,8 @@ def spliced(graph: TaskGraph, path: list[str], i: int, j: int, waypoints) -> tup
 def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, rollouts: int, seed: int,
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
-            first_win: bool = False, advance: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            first_win: bool = False, advance: bool = False,
+            roadmap: Callable | None = None) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -154,14 +155,15 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     the window on are then checked again. ``lean`` then offers every inner waypoint its bypass (module doc).
     ``first_win``: the alternatives are asked for and judged cheapest first; ``advance``: a dead leg's split cut
     after its live legs replaces the path where it gets nearer the leg's end, and while the path is dead only its dead
-    legs are tried (module doc)."""
+    legs are tried (module doc); ``roadmap(a, b, start)`` -> a ``roadmap.Chain`` over the run's pooled waypoints,
+    offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
     log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
     tried: set = set()
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
-        groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures)
+        groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -179,12 +181,16 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 
 
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
-                  may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int):
+                  may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
+                  roadmap: Callable | None = None):
     """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses (no
+    proposer call), then, for a dead leg of a dead path given ``roadmap``, the chain over the pooled waypoints (no
     proposer call), then its split, then its split over the next waypoint (one Algorithm 1 each). Lazy: a split is
     asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
+    if roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0:
+        yield _roadmap_options(state, leg, roadmap)
     if failures(check.results[leg]) < min_failures:
         return
     spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
@@ -207,6 +213,19 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
             if state.advance and check.results[leg].p <= 0.0 and 0 < live < len(fix.results):
                 options.append(("advance", *spliced(graph, path, i, j, fix.waypoints[:live])))
             yield options
+
+
+def _roadmap_options(state: _State, leg: int, roadmap: Callable) -> list:
+    """The pooled waypoints' chain for the dead ``leg``: the whole leg ("roadmap") where it reaches the leg's end,
+    else its live part ("advance"); none where it reaches no waypoint."""
+    graph, path, check = state.graph, state.path, state.check
+    start = graph.region(path[0]) if leg == 0 else start_of(check.results[leg - 1])
+    if start is None:
+        return []
+    found = roadmap(graph, path[leg], path[leg + 1], start)
+    if not found.waypoints:
+        return []
+    return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, leg, leg + 1, found.waypoints))]
 
 
 @dataclass
@@ -262,14 +281,15 @@ class _State:
 
 
 def _furthest(graph: TaskGraph, path: list[str], leg: int, s: int, judged: list) -> tuple[tuple | None, list]:
-    """Of the ``advance`` options judged on a dead window (``judged``: kind, graph, path, check from path[s]), the one
-    whose fresh check reaches its last waypoint and which gets nearest the end of the span it replaces, if nearer than
-    path[leg] is -> (that option or None, per option how much nearer it gets, None where it does not count)."""
+    """Of the ``advance`` and ``roadmap`` options judged on a dead window (``judged``: kind, graph, path, check from
+    path[s]), the one whose fresh check reaches its last waypoint and which gets nearest the end of the span it
+    replaces, if nearer than path[leg] is -> (that option or None, per option how much nearer it gets, None where it
+    does not count)."""
     best, gains = None, []
     for option in judged:
         kind, alt, alt_path, alt_check = option
         gain = None
-        if kind == "advance":
+        if kind in ("advance", "roadmap"):
             end = next(k for k in range(leg + 1, len(alt_path)) if alt_path[k] in path)
             if live_start(alt_check.probabilities) >= end - 1 - s:  # every leg up to its last waypoint succeeds
                 gain = _distance(graph, path[leg], alt_path[end]) - _distance(alt, alt_path[end - 1], alt_path[end])

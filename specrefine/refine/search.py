@@ -37,6 +37,7 @@ from .edge_split import SplitCandidate, edge_split
 from .polish import polish
 from .racing import Racing
 from .repair import cheapest, repair
+from .roadmap import Roadmap
 from .shortcut import add_shortcuts, shortcuts
 from .vertex import refine_chain
 
@@ -93,6 +94,8 @@ class SearchConfig:
     #                              the budget left, the path goes back to the edge it replaced, corrected as before
     correct_advance: bool = False  # beyond the paper: a dead leg's split cut after its live legs replaces the path
     #                                where it gets nearer the leg's end (correct.py; method ours-corrector-advance)
+    correct_roadmap: bool = False  # beyond the paper: a dead leg of a dead path is first offered a chain over every
+    #                                reply's waypoints pooled (roadmap.py; method ours-corrector-roadmap)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -197,6 +200,7 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
+        self.roadmap = Roadmap(reach=self.cfg.correct_reach or 0.0) if self.cfg.correct_roadmap else None
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -352,12 +356,16 @@ class RefinementSearch:
         query = self.query_for(chain_graph, a, b, result)
         if self.cfg.snap_waypoints:
             query = replace(query, snap=float(getattr(self.evaluator, "clearance", 0.0)))
-        return edge_split(self.evaluator, self.proposer, query, start=start,
-                          goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
-                          rng=self.rng, picture=self.picture, racing=self.racing,
-                          feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning,
-                          tune_check_seed=self.cfg.seed + TUNE_CHECK_SEED_OFFSET if self.cfg.tuning_check else None,
-                          confirm_seed=self.cfg.seed + CONFIRM_SEED_OFFSET if self.cfg.confirm_pick else None)
+        outcome = edge_split(self.evaluator, self.proposer, query, start=start,
+                             goal_point=chain_graph.goal_point(b), w=self.cfg.w, d=d or self.cfg.d, k=self.cfg.k,
+                             rng=self.rng, picture=self.picture, racing=self.racing,
+                             feedback=self.cfg.split_feedback, tune=self.cfg.split_tuning,
+                             tune_check_seed=self.cfg.seed + TUNE_CHECK_SEED_OFFSET if self.cfg.tuning_check else None,
+                             confirm_seed=self.cfg.seed + CONFIRM_SEED_OFFSET if self.cfg.confirm_pick else None)
+        if self.roadmap is not None:
+            for candidate in outcome.candidates:
+                self.roadmap.add(candidate.waypoints)
+        return outcome
 
     def _repair(self, u, v, candidate):
         repaired = repair(candidate, self.graph, u, v, start=self.f.arrivals[u], evaluator=self.evaluator,
@@ -532,8 +540,17 @@ class RefinementSearch:
                                       split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
                                       min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
-                                      first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance)
+                                      first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
+                                      roadmap=self._roadmap_chain if self.roadmap is not None else None)
         return path, check
+
+    def _roadmap_chain(self, graph, a, b, start):
+        """The pooled waypoints' chain for the dead leg a -> b (roadmap.py), logged."""
+        found = self.roadmap.chain(self.evaluator, start, graph.region(a), graph.region(b), graph.avoid(a, b),
+                                   graph.goal_point(b))
+        self._log("roadmap", edge=[a, b], pooled=len(self.roadmap.points), waypoints=len(found.waypoints),
+                  reaches_end=found.reaches_goal, evaluations=found.evaluations)
+        return found
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------
     def _shortcut(self, path: list[str]) -> list[str]:

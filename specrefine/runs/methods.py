@@ -290,6 +290,14 @@ register_method("ours-corrector-advance-extend", ours_variant(**CORRECTOR | THRI
                 "beyond the paper: ours-corrector-advance whose correction of a path with a dead leg may go on past "
                 "the search's budget of 30 edge splits, up to 90 in all (ours-corrector-extend's budget)",
                 colour="#004d40")
+#: ours-corrector-roadmap: advance-extend, a dead leg first offered a chain over every reply's waypoints pooled
+#: (docs/corrector.md, "Replies pooled into a roadmap")
+ROADMAP = dict(correct_roadmap=True)
+register_method("ours-corrector-roadmap", ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP),
+                "beyond the paper: ours-corrector-advance-extend whose correction of a dead leg, while the path is "
+                "dead, first tries a chain over the waypoints of every reply of the run pooled (best first toward the "
+                "leg's end, legs within the policy's reach, no proposer call), then asks the proposer as before",
+                colour="#1a237e")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "

@@ -1,0 +1,99 @@
+"""Every reply's waypoints pooled into a roadmap (beyond the paper: method ``ours-corrector-roadmap``).
+
+With a proposer that errs on long spans (dropped turns, wrong branches, errors that grow with the turns a query
+spans), no one reply to a dead leg may be right, while its waypoints, taken together, lie along the way: a reply
+that skips a turn still names regions in the corridors before and after it. The correction of a dead path
+otherwise judges each reply alone and throws the rest away (docs/corrector.md, "Replies pooled into a roadmap").
+
+The roadmap keeps every waypoint any reply of the run proposed (one per place: a waypoint within ``merge`` of one
+kept already adds nothing). For a dead leg a -> b it searches a chain a -> x_1 -> ... -> x_k -> b over those
+waypoints, best first by straight distance to b: the rollouts that reached a node start its legs, a leg is tried
+only between nodes at most ``reach`` apart (the policy's goal range), a leg that never succeeded is remembered and
+not tried again, and the search stops at b or after ``evaluations`` subtask evaluations. What it uses is what a
+real reply gives: the waypoints and rollouts, no planner and no map. The chain is a refinement of a -> b like any
+split (Theorem 4.1 holds), and the correction judges it on its fresh rollouts like any other alternative; where it
+does not reach b, its live part is offered as ``advance`` offers a reply's live legs.
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.regions import Region
+from .common import SubtaskEvaluator, evaluate_all, start_of
+
+
+@dataclass
+class Chain:
+    """A chain of pooled waypoints from a leg's start: its regions, whether it ends in the leg's goal, and its
+    evaluations."""
+
+    waypoints: list[Region]
+    reaches_goal: bool
+    evaluations: int
+
+
+@dataclass
+class Roadmap:
+    reach: float  # the longest leg tried (straight distance between region centres)
+    merge: float = 0.25  # a waypoint this near one kept already adds nothing
+    evaluations: int = 120  # subtask evaluations per search at most
+    points: list[Region] = field(default_factory=list)
+    dead: set = field(default_factory=set)  # (from, to) centres of legs that never succeeded
+
+    def add(self, regions) -> None:
+        """Pool ``regions`` (a reply's waypoints)."""
+        for region in regions:
+            centre = np.asarray(region.centre(), dtype=float)
+            if all(np.linalg.norm(centre - np.asarray(p.centre())) > self.merge for p in self.points):
+                self.points.append(region)
+
+    def chain(self, evaluator: SubtaskEvaluator, start, origin: Region, goal: Region, avoid: Region,
+              goal_point=None) -> Chain:
+        """The best-first chain from ``start`` (the start states of the leg from ``origin``) toward ``goal`` over
+        the pooled waypoints: to ``goal`` if found, else to the node reached nearest ``goal`` (none: no waypoints)."""
+        nodes = [*self.points, goal]
+        centres = np.asarray([r.centre() for r in nodes], dtype=float)
+        to_goal = np.linalg.norm(centres - centres[-1], axis=1)
+        first = np.asarray(origin.centre(), dtype=float)
+        reached: dict[int, tuple] = {-1: (start, None)}  # node -> (its start states, the node before it)
+        queue, used, best = [(float(np.linalg.norm(first - centres[-1])), -1)], 0, -1
+        while queue and used < self.evaluations:
+            _, u = heapq.heappop(queue)
+            here = first if u < 0 else centres[u]
+            near = self._untried(here, centres, to_goal, exclude={u, *reached})[:self.evaluations - used]
+            if not near:
+                continue
+            results = evaluate_all(evaluator, [(reached[u][0], nodes[v], avoid, goal_point if v == len(nodes) - 1
+                                                else None) for v in near])
+            used += len(near)
+            for v, result in zip(near, results):
+                if result.successes == 0:
+                    self.dead.add(self._key(here, centres[v]))
+                    continue
+                reached[v] = (start_of(result), u)
+                heapq.heappush(queue, (float(to_goal[v]), v))
+                if to_goal[v] < (to_goal[best] if best >= 0 else np.inf):
+                    best = v
+            if len(nodes) - 1 in reached:
+                best = len(nodes) - 1
+                break
+        order = []
+        while best >= 0:
+            order.append(best)
+            best = reached[best][1]
+        regions = [nodes[v] for v in reversed(order)]
+        reaches = bool(regions) and order[0] == len(nodes) - 1
+        return Chain(regions[:-1] if reaches else regions, reaches, used)
+
+    def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:
+        """The nodes within reach of ``here``, nearest the goal first, but those in ``exclude`` and the dead legs."""
+        return [v for v in np.argsort(to_goal) if v not in exclude and np.linalg.norm(centres[v] - here) <= self.reach
+                and self._key(here, centres[v]) not in self.dead]
+
+    @staticmethod
+    def _key(a, b) -> tuple:
+        return tuple(np.round(np.concatenate([a, b]), 3))
