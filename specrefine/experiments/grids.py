@@ -296,7 +296,22 @@ ADVANCE_CHECK_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.3,
                        "p_unparseable=0.1,alpha=0.3,rho=0.4",
                        "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.6,corner_pull=0.5,"
                        "p_wrong_branch=0.45,p_drop_turn=0.4,p_uncapped=0.7,p_unparseable=0.05,alpha=0.35,rho=0.5")
+#: layouts and error mixes no run had used before grid corrector-roadmap-new (docs/corrector.md, "Replies pooled into a
+#: roadmap"), made after S/T had been looked at: four larger generated mazes, and two mixes: U (large offsets rounded
+#: to quarter cells, false openings, wrong branches, mirrored replies, dropped turns, uncapped legs, unparseable
+#: replies, errors growing with the turns a query spans) and V (coordinates rounded to whole cells, regions pulled to
+#: corners, wrong branches, many dropped turns, false openings, uncapped legs, errors growing fast)
+ROADMAP_MAZES = ("random:8x7:44", "random:7x9:21", "random:9x7:60", "random:8x9:3")
+ROADMAP_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.25,radius=0.3,radius_log_sigma=0.5,corner_pull=0.35,"
+                 "p_drop_turn=0.35,p_false_opening=0.3,p_wrong_branch=0.35,p_mirror_y=0.1,p_uncapped=0.6,"
+                 "p_unparseable=0.1,alpha=0.3,rho=0.4",
+                 "imperfect:position_sigma=0.35,coord_grid=1.0,radius=0.35,radius_log_sigma=0.5,corner_pull=0.45,"
+                 "p_wrong_branch=0.4,p_drop_turn=0.45,p_false_opening=0.15,p_mirror_y=0.1,p_uncapped=0.7,"
+                 "p_unparseable=0.05,alpha=0.4,rho=0.5")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
+
+ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
+
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
     """A lever's six cells (docs/ant_experiments.md section 5): ``method`` x the oracle, stage 5, adaptive,
@@ -346,14 +361,14 @@ def fresh_grid(name: str, goal_points: str, methods: tuple) -> ExperimentGrid:
         out=f"runs/{name.replace('-', '_')}")
 
 
-def centre_variant_grids(name: str, section: str, method: str, stem: str, code: str, informed: Part | None = None
-                         ) -> tuple[ExperimentGrid, ExperimentGrid]:
+def centre_variant_grids(name: str, section: str, method: str, stem: str, code: str, informed: Part | None = None,
+                         fixed: str = "2026-11-28") -> tuple[ExperimentGrid, ExperimentGrid]:
     """A variant of the corrector at centre goal points (issue 39, docs/corrector.md SECTION): grid NAME, ``informed``
     (the cells that informed it, if any) then severe on the U-chains (STEM_severe.csv) then mild and moderate seed by
     seed (STEM.csv); grid NAME-suite, the other 8 suite mazes at mild and moderate (STEM_suite.csv), then the held-out
     cells (STEM_held_out.csv)."""
     table = f"data/results/corrector/{stem}"
-    doc = f"docs/corrector.md, '{section}' (issue 39; fixed 2026-11-28 before it"
+    doc = f"docs/corrector.md, '{section}' (issue 39; fixed {fixed} before it"
     u_chains = (Part((method,), ("imperfect:severe",), mazes=SCALING_MAZES, table=f"{table}_severe.csv", out="severe"),
                 Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=SCALING_MAZES, split="seeds"))
     suite = (Part((method,), ("imperfect:mild", "imperfect:moderate"), mazes=OTHER_POINT_MAZES),
@@ -671,6 +686,17 @@ GRIDS = {g.name: g for g in (
                      "(issue 39; fixed 2026-11-28 before it ran)", ("ours-corrector-advance-extend",
                                                                     "ours-corrector-snap", "ours"),
                      ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, "advance_check", code="66e5948"),
+    # docs/corrector.md, "Replies pooled into a roadmap" (fixed 2026-11-29 05:40 UTC, before its grids ran)
+    new_layouts_grid("corrector-roadmap-new", "docs/corrector.md, 'Replies pooled into a roadmap' (issue 39; fixed "
+                     "2026-11-29 before it ran)", ("ours-corrector-roadmap", "ours-corrector-advance-extend",
+                                                   "ours-corrector-snap", "ours"), ROADMAP_MAZES, ROADMAP_MIXES,
+                     "roadmap_new", code=ROADMAP_CODE),
+    *centre_variant_grids("corrector-roadmap", "Replies pooled into a roadmap", "ours-corrector-roadmap", "roadmap",
+                          code=ROADMAP_CODE,
+                          informed=Part(("ours-corrector-roadmap",), ADVANCE_CHECK_MIXES, seeds=(0, 1),
+                                        mazes=ADVANCE_CHECK_MAZES,
+                                        table="data/results/corrector/roadmap_advance_check.csv",
+                                        out="advance_check"), fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
