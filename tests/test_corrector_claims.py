@@ -597,13 +597,42 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     a = vs["adoption"]
     assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[0] == "advance"
+    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[:2] == ("roadmap", "advance")
     assert vs["check"] is None  # its last check not laid yet
     lay_all_parts(tmp_path, "corrector-advance-check", lambda maze, m, p: 0.0 if m == cc.SNAP and
                   cc.table_name(maze) == "random:9x6:33" else 1.0)
     check = cc.variant_studies(tmp_path)["advance"]["check"]
     assert check["names"] == ["S", "T"] and check["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4, "ours": 0}
     assert [e["mixes"] for e in cc.unseen(tmp_path)][-3:] == ["O/P", "Q/R", "S/T"]  # in the order made
+
+
+def test_roadmap_is_judged_against_advance_extend_on_its_new_layouts_and_the_st_cells_that_informed_it(tmp_path):
+    """corrector-roadmap: advance-extend its reference (through advance and snap the centre grids' oracle and ours);
+    its new layouts (U, V) put roadmap, advance-extend, snap and ours side by side; advance-extend's last check (S, T)
+    is its informed part; adopted only where advance-extend is."""
+    rate = later_rate(cc.ROADMAP, (cc.ADVANCE, cc.SNAP), cc.ADVANCE_CHECK_MIXES + cc.ROADMAP_MIXES,
+                      ("random:8x8:5", "random:7x9:21"))
+    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
+                 "corrector-advance-new", "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["roadmap"]
+    assert vs["reference"] == cc.ADVANCE and vs["versus_corrector"]["n_cells"] == 72
+    assert vs["new"] is None and not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
+    informed = vs["informed"]
+    assert informed["names"] == ["S", "T"] and informed["grid"] == "corrector-advance-check"
+    assert informed["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4, cc.SNAP: 4, "ours": 0}
+    lay_all_parts(tmp_path, "corrector-roadmap-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["roadmap"]
+    assert vs["new"]["names"] == ["U", "V"] and vs["new"]["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4, cc.SNAP: 4,
+                                                                      "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["reference_adopted"] == studies["advance"]["adoption"]["adopted"]
+    assert a["adopted"] == a["reference_adopted"]
+    assert cc.reported(studies) == ("roadmap" if a["adopted"] else cc.reported({**studies, "roadmap": None}))
+    assert [e["mixes"] for e in cc.unseen(tmp_path)][-2:] == ["S/T", "U/V"]  # in the order made
+    assert cc.INFORMED_PARTS[cc.ROADMAP] == ("informed",)  # README's marker roadmap-informed
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

@@ -50,6 +50,8 @@ from .grids import (
     NEW_MAZES,
     NEW_MIXES,
     OTHER_POINT_MAZES,
+    ROADMAP_MAZES,
+    ROADMAP_MIXES,
     ROOT,
     SCALING_MAZES,
     SNAP_MAZES,
@@ -75,6 +77,7 @@ EXTEND = "ours-corrector-extend"  # snap, a dead path corrected past the search'
 KEEP = "ours-corrector-keep"  # snap, a dead path's edge replaced by its declined split with the longest live start
 FALLBACK = "ours-corrector-fallback"  # keep, the kept split given up for the edge it replaced at half the budget
 ADVANCE = "ours-corrector-advance-extend"  # snap, a dead path keeping the live legs of a reply, with extend's budget
+ROADMAP = "ours-corrector-roadmap"  # advance-extend, a dead leg first offered a chain over every reply's waypoints
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
@@ -83,29 +86,33 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  FRUGAL: "corrector-frugal", RETRY: "corrector-retry", THRIFT: "corrector-thrift",
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
                  SNAP: "corrector-snap", EXTEND: "corrector-extend",
-                 KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance"}
+                 KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance",
+                 ROADMAP: "corrector-roadmap"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
-                     SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP}
+                     SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP,
+                     ROADMAP: ADVANCE}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
                  CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
                  SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite",
                  KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite",
-                 ADVANCE: "corrector-advance-suite"}
+                 ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
-            "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE}
+            "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE,
+            "roadmap": ROADMAP}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
-ADOPTABLE = ("advance", "fallback", "keep", "extend", "snap", "persist")  # ... or a later one adopted (reported())
+#: ... or the latest of these adopted (reported())
+ADOPTABLE = ("roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -384,14 +391,14 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                KEEP: ("corrector-keep-new", KEEP_MAZES, KEEP_MIXES, ("M", "N")),
                FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P")),
                ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R")),
-               "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T"))
-               }  # in the order made
+               "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T")),
+               ROADMAP: ("corrector-roadmap-new", ROADMAP_MAZES, ROADMAP_MIXES, ("U", "V"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
+INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"), ROADMAP: ("informed",),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
-INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK}
+INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check"}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -582,6 +589,10 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
         if later:
             held = bool(snap) and snap["adoption"]["adopted"]
             later["adoption"] |= {"reference_adopted": held, "adopted": later["adoption"]["adopted"] and held}
+    roadmap, advance = studies.get("roadmap"), studies.get("advance")
+    if roadmap:  # only where advance-extend, its reference, is adopted ("Replies pooled into a roadmap")
+        held = bool(advance) and advance["adoption"]["adopted"]
+        roadmap["adoption"] |= {"reference_adopted": held, "adopted": roadmap["adoption"]["adopted"] and held}
     return studies
 
 
