@@ -308,6 +308,18 @@ ROADMAP_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.25,radius=0.3,radius
                  "imperfect:position_sigma=0.35,coord_grid=1.0,radius=0.35,radius_log_sigma=0.5,corner_pull=0.45,"
                  "p_wrong_branch=0.4,p_drop_turn=0.45,p_false_opening=0.15,p_mirror_y=0.1,p_uncapped=0.7,"
                  "p_unparseable=0.05,alpha=0.4,rho=0.5")
+#: layouts and error mixes no run had used before grid corrector-roadmap-check (docs/corrector.md, "A last check after
+#: roadmap's adoption"), made after U/V had been looked at: four larger generated mazes, and two mixes: W (offsets
+#: rounded to half cells, mirrored replies often, wrong branches, dropped turns, uncapped legs, unparseable replies,
+#: errors growing with the turns a query spans) and X (small regions, false openings often, coordinates rounded to
+#: whole cells, dropped turns, wrong branches, errors growing fast)
+ROADMAP_CHECK_MAZES = ("random:9x9:14", "random:10x7:5", "random:7x10:31", "random:9x8:77")
+ROADMAP_CHECK_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.35,radius_log_sigma=0.4,corner_pull=0.3,"
+                       "p_drop_turn=0.3,p_wrong_branch=0.35,p_mirror_y=0.3,p_uncapped=0.6,p_unparseable=0.15,"
+                       "alpha=0.3,rho=0.5",
+                       "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.2,radius_log_sigma=0.5,corner_pull=0.4,"
+                       "p_drop_turn=0.35,p_false_opening=0.4,p_wrong_branch=0.3,p_uncapped=0.6,p_unparseable=0.05,"
+                       "alpha=0.4,rho=0.4")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
@@ -697,6 +709,11 @@ GRIDS = {g.name: g for g in (
                                         mazes=ADVANCE_CHECK_MAZES,
                                         table="data/results/corrector/roadmap_advance_check.csv",
                                         out="advance_check"), fixed="2026-11-29"),
+    # docs/corrector.md, "A last check after roadmap's adoption" (fixed 2026-11-29 06:40 UTC, before it ran)
+    new_layouts_grid("corrector-roadmap-check", "docs/corrector.md, 'A last check after roadmap's adoption' (issue 39; "
+                     "fixed 2026-11-29 before it ran)", ("ours-corrector-roadmap", "ours-corrector-advance-extend",
+                                                         "ours"), ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES,
+                     "roadmap_check", code=ROADMAP_CODE),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
