@@ -632,7 +632,12 @@ def test_roadmap_is_judged_against_advance_extend_on_its_new_layouts_and_the_st_
     assert a["adopted"] == a["reference_adopted"]
     assert cc.reported(studies) == ("roadmap" if a["adopted"] else cc.reported({**studies, "roadmap": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path)][-2:] == ["S/T", "U/V"]  # in the order made
-    assert cc.INFORMED_PARTS[cc.ROADMAP] == ("informed",)  # README's marker roadmap-informed
+    assert cc.INFORMED_PARTS[cc.ROADMAP] == ("informed", "check")  # README's markers roadmap-informed, -check
+    assert vs["check"] is None  # its last check not laid yet
+    lay_all_parts(tmp_path, "corrector-roadmap-check", lambda maze, m, p: 0.0 if m == cc.ADVANCE and
+                  cc.table_name(maze) == "random:9x9:14" else 1.0)
+    check = cc.variant_studies(tmp_path)["roadmap"]["check"]
+    assert check["names"] == ["W", "X"] and check["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4, "ours": 0}
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

@@ -50,6 +50,8 @@ from .grids import (
     NEW_MAZES,
     NEW_MIXES,
     OTHER_POINT_MAZES,
+    ROADMAP_CHECK_MAZES,
+    ROADMAP_CHECK_MIXES,
     ROADMAP_MAZES,
     ROADMAP_MIXES,
     ROOT,
@@ -375,8 +377,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["check"] = new_study(SNAP, root, on="check", reference="ours")
     if method in INFORMED_ON:  # on the cells that informed it
         study["informed"] = new_study(method, root, on=INFORMED_ON[method])
-    if method == ADVANCE:  # a last check after its adoption (described)
-        study["check"] = new_study(ADVANCE, root, on="advance-check")
+    if method in LAST_CHECK:  # a last check after its adoption (described)
+        study["check"] = new_study(method, root, on=LAST_CHECK[method])
     if method in NEW_STUDIES:
         study["new"] = new_study(method, root)
         study["adoption"] = adoption(study, cells, failed, root)
@@ -392,11 +394,16 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                FALLBACK: ("corrector-fallback-new", FALLBACK_MAZES, FALLBACK_MIXES, ("O", "P")),
                ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R")),
                "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T")),
-               ROADMAP: ("corrector-roadmap-new", ROADMAP_MAZES, ROADMAP_MIXES, ("U", "V"))}  # in the order made
+               ROADMAP: ("corrector-roadmap-new", ROADMAP_MAZES, ROADMAP_MIXES, ("U", "V")),
+               "roadmap-check": ("corrector-roadmap-check", ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, ("W", "X"))
+               }  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"), ROADMAP: ("informed",),
+INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
+                  ROADMAP: ("informed", "check"),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
+#: the new-layout study of a last check after a variant's adoption
+LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check"}
 
