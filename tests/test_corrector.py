@@ -17,6 +17,7 @@ from specrefine.refine import RefinementSearch, SearchConfig
 from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, weakest_untried
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
+from specrefine.runs.explore import describe
 
 
 class LegTable:
@@ -602,6 +603,7 @@ def test_a_dead_leg_is_finished_over_the_waypoints_of_replies_that_were_each_wro
     assert accepted[-1] == "roadmap"
     found = [s for s in result.steps if s["event"] == "roadmap" and s["reaches_end"]]
     assert found and found[-1]["edge"][1] == "G" and found[-1]["waypoints"] == 1
+    assert "a chain of 1, to the leg's end" in describe(found[-1])
 
 
 def test_without_the_roadmap_the_same_replies_leave_the_path_dead():
