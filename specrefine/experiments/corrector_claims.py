@@ -592,14 +592,12 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
     if snap:  # snap is adopted only where persist is, or would be but for its second part ("Snapped out of the wall")
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
-    for later in (studies.get(name) for name in ("extend", "keep", "fallback", "advance")):  # only where snap is
+    short = {method: name for name, method in VARIANTS.items()}
+    for name in ("extend", "keep", "fallback", "advance", "roadmap"):  # only where its reference is (snap, advance)
+        later, reference = studies.get(name), studies.get(short[reference_of(VARIANTS[name])])
         if later:
-            held = bool(snap) and snap["adoption"]["adopted"]
+            held = bool(reference) and reference["adoption"]["adopted"]
             later["adoption"] |= {"reference_adopted": held, "adopted": later["adoption"]["adopted"] and held}
-    roadmap, advance = studies.get("roadmap"), studies.get("advance")
-    if roadmap:  # only where advance-extend, its reference, is adopted ("Replies pooled into a roadmap")
-        held = bool(advance) and advance["adoption"]["adopted"]
-        roadmap["adoption"] |= {"reference_adopted": held, "adopted": roadmap["adoption"]["adopted"] and held}
     return studies
 
 

@@ -197,7 +197,7 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
     for i, j in spans:
         if not may_split():
             return
-        leg_start = graph.region(path[0]) if i == 0 else start_of(check.results[i - 1])
+        leg_start = state.start_of_leg(i)
         if leg_start is None:  # no fresh rollout reaches the leg: nothing to start its split from
             return
         if j == i + 1:
@@ -218,8 +218,8 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
 def _roadmap_options(state: _State, leg: int, roadmap: Callable) -> list:
     """The pooled waypoints' chain for the dead ``leg``: the whole leg ("roadmap") where it reaches the leg's end,
     else its live part ("advance"); none where it reaches no waypoint."""
-    graph, path, check = state.graph, state.path, state.check
-    start = graph.region(path[0]) if leg == 0 else start_of(check.results[leg - 1])
+    graph, path = state.graph, state.path
+    start = state.start_of_leg(leg)
     if start is None:
         return []
     found = roadmap(graph, path[leg], path[leg + 1], start)
@@ -250,13 +250,18 @@ class _State:
     def score(self, check: Check) -> float:
         return lean_score(check) if self.lean else check.p
 
+    def start_of_leg(self, i: int):
+        """Where leg ``i`` of the path starts on the fresh check: the first region, else the end states of the
+        previous leg's successes (None where none succeeded)."""
+        return self.graph.region(self.path[0]) if i == 0 else start_of(self.check.results[i - 1])
+
     def judge(self, leg: int, options: list) -> tuple[Judged, str | None]:
         """Judge ``options`` (kind, graph, path) against the path over the window around ``leg``; the best replaces
         the path (and the path is checked again from the window on) when it wins. -> (what was judged, the kind
         accepted or None)."""
         graph, path, check = self.graph, self.path, self.check
         s, e = max(leg - 1, 0), min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e]
-        start = graph.region(path[0]) if s == 0 else start_of(check.results[s - 1])
+        start = self.start_of_leg(s)
         current = self.score(Check(results=check.results[s:e]))
         judged = [(kind, g, p, check_path(g, p[s:p.index(path[e]) + 1], self.evaluator, rollouts=self.rollouts,
                                           seed=self.seed, start=start)) for kind, g, p in options]
