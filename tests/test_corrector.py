@@ -621,6 +621,11 @@ def test_a_live_path_never_consults_the_roadmap():
     assert runs[0] == runs[1] and "roadmap" not in runs[1][2]
 
 
+def test_the_roadmap_needs_a_reach():
+    with pytest.raises(ValueError, match="correct_roadmap needs correct_reach"):
+        SearchConfig(correct_roadmap=True)
+
+
 def test_the_roadmap_pools_one_waypoint_per_place_and_tries_a_dead_leg_once():
     roadmap = Roadmap(reach=3.5)
     roadmap.add([Disc(3, 0, 0.5), Disc(3.1, 0, 0.4)])

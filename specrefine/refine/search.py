@@ -108,6 +108,9 @@ class SearchConfig:
             raise ValueError(f"empty_retries must be at least 0, got {self.empty_retries!r}")
         if self.dead_budget is not None and self.dead_budget < 1:
             raise ValueError(f"dead_budget must be at least 1 (or None: max_edge_splits), got {self.dead_budget!r}")
+        if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
+            raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
+                             "give 'policy', the agent's goal range)")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
@@ -200,7 +203,7 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
-        self.roadmap = Roadmap(reach=self.cfg.correct_reach or 0.0) if self.cfg.correct_roadmap else None
+        self.roadmap = Roadmap(reach=self.cfg.correct_reach) if self.cfg.correct_roadmap else None
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
