@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import pytest
 from test_refine_search import WALLS, _Arrive, _chain_graph, _Query, box_at
 
@@ -643,6 +644,21 @@ def test_the_roadmap_stops_at_its_evaluations():
     ev, s = LegTable({}), box_at(0, 0)
     found = roadmap.chain(ev, s, s, box_at(10, 0), WALLS)
     assert found.evaluations == 1 and len(ev.calls) == 1 and not found.reaches_goal
+
+
+@pytest.mark.parametrize("sound,first", [(0.0, 3.0), (0.5, 2.0)])
+def test_a_sound_roadmap_builds_on_no_leg_that_mostly_fails(sound, first):
+    roadmap = Roadmap(reach=3.5, sound=sound)
+    roadmap.add([Disc(x, 0, 0.4) for x in (2, 3, 5, 6, 8)])
+    ev, s = LegTable({(0.0, 3.0): 0.05}), box_at(0, 0)  # the leg nearest the goal succeeds on 5 % of its rollouts
+    found = roadmap.chain(ev, s, s, box_at(10, 0), WALLS)
+    assert found.reaches_goal and float(found.waypoints[0].centre()[0]) == first
+    assert (Roadmap._key(np.zeros(2), np.array([3.0, 0.0])) in roadmap.dead) == (sound > 0)
+
+
+def test_a_sound_roadmap_needs_a_fraction():
+    with pytest.raises(ValueError, match="roadmap_sound must lie in"):
+        SearchConfig(roadmap_sound=1.5)
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

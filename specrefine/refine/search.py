@@ -96,6 +96,8 @@ class SearchConfig:
     #                                where it gets nearer the leg's end (correct.py; method ours-corrector-advance)
     correct_roadmap: bool = False  # beyond the paper: a dead leg of a dead path is first offered a chain over every
     #                                reply's waypoints pooled (roadmap.py; method ours-corrector-roadmap)
+    roadmap_sound: float = 0.0  # beyond the paper: the roadmap's chain builds only on legs at least this fraction of
+    #                             whose rollouts succeed (0: any success; roadmap.py; method ours-corrector-sound)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -111,6 +113,8 @@ class SearchConfig:
         if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
             raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
                              "give 'policy', the agent's goal range)")
+        if not 0.0 <= self.roadmap_sound <= 1.0:
+            raise ValueError(f"roadmap_sound must lie in [0, 1], got {self.roadmap_sound!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
@@ -203,7 +207,8 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
-        self.roadmap = Roadmap(reach=self.cfg.correct_reach) if self.cfg.correct_roadmap else None
+        self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound)
+                        if self.cfg.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 

@@ -298,6 +298,14 @@ register_method("ours-corrector-roadmap", ours_variant(**CORRECTOR | THRIFT | PE
                 "dead, first tries a chain over the waypoints of every reply of the run pooled (best first toward the "
                 "leg's end, legs within the policy's reach, no proposer call), then asks the proposer as before",
                 colour="#1a237e")
+#: ours-corrector-sound: roadmap, its chain built only on legs that succeed on at least half their rollouts
+#: (docs/corrector.md, "Sound legs for the roadmap")
+SOUND = dict(roadmap_sound=0.5)
+register_method("ours-corrector-sound",
+                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | SOUND),
+                "beyond the paper: ours-corrector-roadmap whose chain over the pooled waypoints builds only on legs "
+                "that succeed on at least half their rollouts (a weaker leg is remembered as a dead one is), so "
+                "that no chain starts the rest of the path from a few lucky states", colour="#311b92")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
