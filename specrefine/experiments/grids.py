@@ -320,9 +320,23 @@ ROADMAP_CHECK_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.35
                        "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.2,radius_log_sigma=0.5,corner_pull=0.4,"
                        "p_drop_turn=0.35,p_false_opening=0.4,p_wrong_branch=0.3,p_uncapped=0.6,p_unparseable=0.05,"
                        "alpha=0.4,rho=0.4")
+#: layouts and error mixes no run had used before grid corrector-sound-new (docs/corrector.md, "Sound legs for the
+#: roadmap"), made after W/X had been looked at: four larger generated mazes, and two mixes: Y (offsets rounded to half
+#: cells, small regions of spread sizes, many dropped turns, mirrored replies, false openings, wrong branches, uncapped
+#: legs, unparseable replies, few follow-ups that repair, errors growing with the turns a query spans) and Z
+#: (coordinates rounded to whole cells, regions pulled hard to corners, wrong branches, false openings often, uncapped
+#: legs, errors growing fast)
+SOUND_MAZES = ("random:10x8:23", "random:8x10:49", "random:9x9:88", "random:10x7:41")
+SOUND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.25,radius_log_sigma=0.6,corner_pull=0.35,"
+               "p_drop_turn=0.4,p_false_opening=0.2,p_wrong_branch=0.3,p_mirror_y=0.2,p_uncapped=0.5,"
+               "p_unparseable=0.1,alpha=0.35,rho=0.3",
+               "imperfect:position_sigma=0.25,coord_grid=1.0,radius=0.3,radius_log_sigma=0.4,corner_pull=0.5,"
+               "p_drop_turn=0.3,p_false_opening=0.35,p_wrong_branch=0.4,p_uncapped=0.7,p_unparseable=0.1,"
+               "alpha=0.45,rho=0.5")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
+SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -714,6 +728,16 @@ GRIDS = {g.name: g for g in (
                      "fixed 2026-11-29 before it ran)", ("ours-corrector-roadmap", "ours-corrector-advance-extend",
                                                          "ours"), ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES,
                      "roadmap_check", code=ROADMAP_CODE),
+    # docs/corrector.md, "Sound legs for the roadmap" (fixed 2026-11-29 08:28 UTC, before its grids ran)
+    new_layouts_grid("corrector-sound-new", "docs/corrector.md, 'Sound legs for the roadmap' (issue 39; fixed "
+                     "2026-11-29 before it ran)", ("ours-corrector-sound", "ours-corrector-roadmap", "ours"),
+                     SOUND_MAZES, SOUND_MIXES, "sound_new", code=SOUND_CODE),
+    *centre_variant_grids("corrector-sound", "Sound legs for the roadmap", "ours-corrector-sound", "sound",
+                          code=SOUND_CODE,
+                          informed=Part(("ours-corrector-sound",), ROADMAP_CHECK_MIXES, seeds=(0, 1),
+                                        mazes=ROADMAP_CHECK_MAZES,
+                                        table="data/results/corrector/sound_roadmap_check.csv",
+                                        out="roadmap_check"), fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
