@@ -597,7 +597,7 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     a = vs["adoption"]
     assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[:2] == ("roadmap", "advance")
+    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[1:3] == ("roadmap", "advance")
     assert vs["check"] is None  # its last check not laid yet
     lay_all_parts(tmp_path, "corrector-advance-check", lambda maze, m, p: 0.0 if m == cc.SNAP and
                   cc.table_name(maze) == "random:9x6:33" else 1.0)
@@ -638,6 +638,44 @@ def test_roadmap_is_judged_against_advance_extend_on_its_new_layouts_and_the_st_
                   cc.table_name(maze) == "random:9x9:14" else 1.0)
     check = cc.variant_studies(tmp_path)["roadmap"]["check"]
     assert check["names"] == ["W", "X"] and check["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4, "ours": 0}
+
+
+def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layouts(tmp_path):
+    """corrector-sound: roadmap its reference; its adoption counts runs below 0.5 (a run alive but weak is one) over
+    severe and its new layouts (Y, Z); roadmap's last check (W, X) is its informed part; adopted only where roadmap
+    is."""
+    roadmap_rate = later_rate(cc.ROADMAP, (cc.ADVANCE, cc.SNAP), cc.ADVANCE_CHECK_MIXES + cc.ROADMAP_MIXES,
+                              ("random:8x8:5", "random:7x9:21"))
+
+    def rate(maze, method, proposer):
+        if method == cc.SOUND:
+            return 0.99
+        if method == cc.ROADMAP and proposer in cc.ROADMAP_CHECK_MIXES + cc.SOUND_MIXES and \
+                cc.table_name(maze) in ("random:9x9:14", "random:10x8:23"):
+            return 0.3  # alive but weak: no run at 0
+        return roadmap_rate(maze, method, proposer)
+
+    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
+                 "corrector-advance-new", "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite",
+                 "corrector-roadmap-new", "corrector-roadmap-check", "corrector-sound", "corrector-sound-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["sound"]
+    assert vs["reference"] == cc.ROADMAP and vs["versus_corrector"]["n_cells"] == 72
+    assert vs["new"] is None and not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
+    informed = vs["informed"]
+    assert informed["names"] == ["W", "X"] and informed["grid"] == "corrector-roadmap-check"
+    assert informed["zero"][cc.SOUND] == informed["zero"][cc.ROADMAP] == 0
+    lay_all_parts(tmp_path, "corrector-sound-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["sound"]
+    assert vs["new"]["names"] == ["Y", "Z"] and vs["new"]["zero"][cc.ROADMAP] == 0
+    a = vs["adoption"]
+    assert a["floor"] == 0.5 and a["zero"] == {cc.SOUND: 0, cc.ROADMAP: 4}
+    assert a["fewer_zero"] and a["no_worse"] and a["complete"] and a["paired"]["estimate"] > 0
+    assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
+    assert "runs below 0.5: 0 against 4" in cc._adoption_text(vs)
+    assert cc.reported(studies) == ("sound" if a["adopted"] else cc.reported({**studies, "sound": None}))
+    assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["W/X", "Y/Z"]  # in the order made
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

@@ -58,6 +58,8 @@ from .grids import (
     SCALING_MAZES,
     SNAP_MAZES,
     SNAP_MIXES,
+    SOUND_MAZES,
+    SOUND_MIXES,
 )
 
 METHOD = "ours-corrector"
@@ -80,7 +82,10 @@ KEEP = "ours-corrector-keep"  # snap, a dead path's edge replaced by its decline
 FALLBACK = "ours-corrector-fallback"  # keep, the kept split given up for the edge it replaced at half the budget
 ADVANCE = "ours-corrector-advance-extend"  # snap, a dead path keeping the live legs of a reply, with extend's budget
 ROADMAP = "ours-corrector-roadmap"  # advance-extend, a dead leg first offered a chain over every reply's waypoints
+SOUND = "ours-corrector-sound"  # roadmap, its chain built only on legs that succeed on at least half their rollouts
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
+#: a variant whose adoption counts runs below this success instead of runs at 0 (its docs/corrector.md section)
+ADOPTION_FLOOR = {SOUND: 0.5}
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
@@ -89,32 +94,33 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
                  SNAP: "corrector-snap", EXTEND: "corrector-extend",
                  KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance",
-                 ROADMAP: "corrector-roadmap"}
+                 ROADMAP: "corrector-roadmap", SOUND: "corrector-sound"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
                      SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP,
-                     ROADMAP: ADVANCE}
+                     ROADMAP: ADVANCE, SOUND: ROADMAP}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
                  CENTRE: "corrector-centre-suite", PERSIST: "corrector-persist-suite",
                  SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite",
                  KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite",
-                 ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite"}
+                 ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite",
+                 SOUND: "corrector-sound-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
             "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE,
-            "roadmap": ROADMAP}
+            "roadmap": ROADMAP, "sound": SOUND}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
 #: ... or the latest of these adopted (reported())
-ADOPTABLE = ("roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
+ADOPTABLE = ("sound", "roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -395,17 +401,18 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                ADVANCE: ("corrector-advance-new", ADVANCE_MAZES, ADVANCE_MIXES, ("Q", "R")),
                "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T")),
                ROADMAP: ("corrector-roadmap-new", ROADMAP_MAZES, ROADMAP_MIXES, ("U", "V")),
-               "roadmap-check": ("corrector-roadmap-check", ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, ("W", "X"))
-               }  # in the order made
+               "roadmap-check": ("corrector-roadmap-check", ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, ("W", "X")),
+               SOUND: ("corrector-sound-new", SOUND_MAZES, SOUND_MIXES, ("Y", "Z"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
-                  ROADMAP: ("informed", "check"),
+                  ROADMAP: ("informed", "check"), SOUND: ("informed",),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
-INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check"}
+INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
+               SOUND: "roadmap-check"}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -460,17 +467,21 @@ def adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
                    for (maze, m, q, seed) in f if q == p}
     labels = [f"{maze} {p} s{seed}" for _, _, p, names, seeds in groups for maze in names for seed in seeds]
     paired = cmp.paired_difference(both, both_failed, "all", method, ref, (0,), labels)
-    severe = study.get("severe_zero", {})
-    new_zero = (study.get("new") or {}).get("zero", {})
-    zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (method, ref)}
+    floor = ADOPTION_FLOOR.get(method, 0.0)
+    if floor:  # runs below the floor over the same cells (a dead run is one)
+        zero = {m: sum(1 for (_, who, _, _), v in both.items() if who == m and v < floor) for m in (method, ref)}
+    else:
+        severe = study.get("severe_zero", {})
+        new_zero = (study.get("new") or {}).get("zero", {})
+        zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (method, ref)}
     versus, suite = study["versus_corrector"], study.get("versus_ours", [])
     below = [e for p in ("imperfect:mild", "imperfect:moderate") for e in _below_ours(suite, p)]
     first = (not math.isnan(versus["estimate"]) and versus["ci_low"] >= -NON_INFERIORITY and not below)
     second = zero[method] < zero[ref] and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
     suite_done = bool(suite) and all(e["runs"] == len(POINT_SEEDS) for e in suite)
     complete = versus["complete"] and paired["complete"] and suite_done
-    return {"no_worse": first, "fewer_zero": second, "zero": zero, "paired": paired, "below_ours": below,
-            "complete": complete, "adopted": first and second and complete}
+    return {"no_worse": first, "fewer_zero": second, "zero": zero, "floor": floor, "paired": paired,
+            "below_ours": below, "complete": complete, "adopted": first and second and complete}
 
 
 FRESH_GRIDS = ("corrector-centre-fresh", "corrector-sampled-fresh")  # docs/corrector.md, "Fresh layouts ..."
@@ -593,7 +604,7 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
     short = {method: name for name, method in VARIANTS.items()}
-    for name in ("extend", "keep", "fallback", "advance", "roadmap"):  # only where its reference is (snap, advance)
+    for name in ("extend", "keep", "fallback", "advance", "roadmap", "sound"):  # only where its reference is
         later, reference = studies.get(name), studies.get(short[reference_of(VARIANTS[name])])
         if later:
             held = bool(reference) and reference["adoption"]["adopted"]
@@ -913,12 +924,13 @@ def _adoption_rows(vs: dict) -> list[dict]:
     """The two parts of persist's adoption rule (docs/corrector.md, "Corrected until alive") and its outcome."""
     a, method, ref = vs["adoption"], vs["method"], vs["reference"]
     pending = "" if a["complete"] else " (partial)"
+    runs = f"runs below {a['floor']:g}" if a.get("floor") else "runs at 0"
     below = f"; below ours on {', '.join(a['below_ours'])}" if a["below_ours"] else "; below ours on no suite maze"
     return [{"rule": f"{method}, adoption 1: no worse than {ref} (U-chains, mild and moderate) and below ours on no "
                      "suite maze", "value": _paired_text(vs["versus_corrector"]) + below,
              "verdict": ("holds" if a["no_worse"] else "does not hold") + pending},
-            {"rule": f"{method}, adoption 2: fewer runs at 0 than {ref} over the severe and new cells, paired "
-                     "difference >= 0", "value": f"runs at 0: {a['zero'][method]} against {a['zero'][ref]}; "
+            {"rule": f"{method}, adoption 2: fewer {runs} than {ref} over the severe and new cells, paired "
+                     "difference >= 0", "value": f"{runs}: {a['zero'][method]} against {a['zero'][ref]}; "
                                                  f"{_paired_text(a['paired'])}",
              "verdict": ("holds" if a["fewer_zero"] else "does not hold") + pending},
             {"rule": f"{method}: adopted (README's rules table reads it)", "value": "both parts hold"
