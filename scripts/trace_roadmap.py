@@ -38,12 +38,17 @@ def chain(self, evaluator, start, origin, goal, avoid, goal_point=None):
 
 
 if __name__ == "__main__":
+    if len(sys.argv) < 3 or not os.path.isdir(os.path.dirname(os.path.abspath(sys.argv[1]))) \
+            or os.path.isdir(sys.argv[1]):
+        print("usage: trace_roadmap.py OUT.json refine MAZE ... (OUT.json a file in an existing folder)",
+              file=sys.stderr)
+        sys.exit(2)
     roadmap.evaluate_all, roadmap.Roadmap.chain = evaluate_all, chain
     out = sys.argv[1]
     try:
         main(sys.argv[2:])
     finally:  # written whole (temp + rename), also when the run fails midway
-        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(out)) or ".", suffix=".tmp")
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(out)), suffix=".tmp")
         with os.fdopen(fd, "w") as f:
             json.dump(SEARCHES, f)
         os.replace(tmp, out)

@@ -436,6 +436,10 @@ def persist_rate(maze, method, proposer):
 #: the grids a variant judged against snap is laid with (through snap and persist, the centre grids' references)
 THROUGH_SNAP = ("corrector-centre", "corrector-centre-suite", "corrector-persist", "corrector-persist-suite",
                 "corrector-snap", "corrector-snap-suite", "corrector-snap-new")
+#: the grids through advance-extend's, and through roadmap's (each variant's reference chain, laid in order)
+THROUGH_ADVANCE = (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
+                   "corrector-advance-new")
+THROUGH_ROADMAP = (*THROUGH_ADVANCE, "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite")
 
 
 def later_rate(variant: str, beside: tuple, mixes: tuple, dead: tuple):
@@ -448,6 +452,12 @@ def later_rate(variant: str, beside: tuple, mixes: tuple, dead: tuple):
             return 0.0 if proposer in mixes and cc.table_name(maze) in dead else 0.99
         return persist_rate(maze, method, proposer)
     return rate
+
+
+def roadmap_rate():
+    """Roadmap 0.99; advance-extend and snap 0 on one S/T and one U/V layout under those mixes (roadmap's grids)."""
+    return later_rate(cc.ROADMAP, (cc.ADVANCE, cc.SNAP), cc.ADVANCE_CHECK_MIXES + cc.ROADMAP_MIXES,
+                      ("random:8x8:5", "random:7x9:21"))
 
 
 def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids_references(tmp_path):
@@ -584,8 +594,7 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     alone = "ours-corrector-advance"
     rate = later_rate(cc.ADVANCE, (cc.SNAP, cc.KEEP, cc.FALLBACK, alone), cc.FALLBACK_MIXES + cc.ADVANCE_MIXES,
                       ("random:6x6:77", "random:8x6:62"))
-    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
-                 "corrector-advance-new"):
+    for name in THROUGH_ADVANCE:
         lay_all_parts(tmp_path, name, rate)
     studies = cc.variant_studies(tmp_path)
     vs = studies["advance"]
@@ -610,10 +619,8 @@ def test_roadmap_is_judged_against_advance_extend_on_its_new_layouts_and_the_st_
     """corrector-roadmap: advance-extend its reference (through advance and snap the centre grids' oracle and ours);
     its new layouts (U, V) put roadmap, advance-extend, snap and ours side by side; advance-extend's last check (S, T)
     is its informed part; adopted only where advance-extend is."""
-    rate = later_rate(cc.ROADMAP, (cc.ADVANCE, cc.SNAP), cc.ADVANCE_CHECK_MIXES + cc.ROADMAP_MIXES,
-                      ("random:8x8:5", "random:7x9:21"))
-    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
-                 "corrector-advance-new", "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite"):
+    rate = roadmap_rate()
+    for name in THROUGH_ROADMAP:
         lay_all_parts(tmp_path, name, rate)
     vs = cc.variant_studies(tmp_path)["roadmap"]
     assert vs["reference"] == cc.ADVANCE and vs["versus_corrector"]["n_cells"] == 72
@@ -644,8 +651,7 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
     """corrector-sound: roadmap its reference; its adoption counts runs below 0.5 (a run alive but weak is one) over
     severe and its new layouts (Y, Z); roadmap's last check (W, X) is its informed part; adopted only where roadmap
     is."""
-    roadmap_rate = later_rate(cc.ROADMAP, (cc.ADVANCE, cc.SNAP), cc.ADVANCE_CHECK_MIXES + cc.ROADMAP_MIXES,
-                              ("random:8x8:5", "random:7x9:21"))
+    roadmap = roadmap_rate()
 
     def rate(maze, method, proposer):
         if method == cc.SOUND:
@@ -653,11 +659,10 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
         if method == cc.ROADMAP and proposer in cc.ROADMAP_CHECK_MIXES + cc.SOUND_MIXES and \
                 cc.table_name(maze) in ("random:9x9:14", "random:10x8:23"):
             return 0.3  # alive but weak: no run at 0
-        return roadmap_rate(maze, method, proposer)
+        return roadmap(maze, method, proposer)
 
-    for name in (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance", "corrector-advance-suite",
-                 "corrector-advance-new", "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite",
-                 "corrector-roadmap-new", "corrector-roadmap-check", "corrector-sound", "corrector-sound-suite"):
+    for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-roadmap-check", "corrector-sound",
+                 "corrector-sound-suite"):
         lay_all_parts(tmp_path, name, rate)
     vs = cc.variant_studies(tmp_path)["sound"]
     assert vs["reference"] == cc.ROADMAP and vs["versus_corrector"]["n_cells"] == 72

@@ -467,13 +467,9 @@ def adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
                    for (maze, m, q, seed) in f if q == p}
     labels = [f"{maze} {p} s{seed}" for _, _, p, names, seeds in groups for maze in names for seed in seeds]
     paired = cmp.paired_difference(both, both_failed, "all", method, ref, (0,), labels)
-    floor = ADOPTION_FLOOR.get(method, 0.0)
-    if floor:  # runs below the floor over the same cells (a dead run is one)
-        zero = {m: sum(1 for (_, who, _, _), v in both.items() if who == m and v < floor) for m in (method, ref)}
-    else:
-        severe = study.get("severe_zero", {})
-        new_zero = (study.get("new") or {}).get("zero", {})
-        zero = {m: severe.get(m, (0, 0))[0] + new_zero.get(m, 0) for m in (method, ref)}
+    floor = ADOPTION_FLOOR.get(method, 0.0)  # runs at 0, or below the floor (a dead run is one), over the same cells
+    zero = {m: sum(1 for (_, who, _, _), v in both.items() if who == m and (v <= 0.0 or v < floor))
+            for m in (method, ref)}
     versus, suite = study["versus_corrector"], study.get("versus_ours", [])
     below = [e for p in ("imperfect:mild", "imperfect:moderate") for e in _below_ours(suite, p)]
     first = (not math.isnan(versus["estimate"]) and versus["ci_low"] >= -NON_INFERIORITY and not below)

@@ -9,16 +9,16 @@ The roadmap keeps every waypoint any reply of the run proposed (one per place: a
 kept already adds nothing). For a dead leg a -> b it searches a chain a -> x_1 -> ... -> x_k -> b over those
 waypoints, best first by straight distance to b: the rollouts that reached a node start its legs, a leg is tried
 only between nodes at most ``reach`` apart (the policy's goal range), a leg that never succeeded is remembered and
-not tried again, and the search stops at b or after ``evaluations`` subtask evaluations.
+not tried again, and the search stops at b or after ``evaluations`` subtask evaluations. What it uses is what a
+real reply gives: the waypoints and rollouts, no planner and no map. The chain is a refinement of a -> b like any
+split (Theorem 4.1 holds), and the correction judges it on its fresh rollouts like any other alternative; where it
+does not reach b, its live part is offered as ``advance`` offers a reply's live legs.
 
 ``sound`` (method ``ours-corrector-sound``): a leg is built on only where at least that fraction of its rollouts
 succeed; a weaker one is remembered as a dead one is. Without it one success in 128 makes a node reached, and a
 chain can start with a leg that succeeds on 2 % of its rollouts: every later leg then starts from those few states,
 the path is no longer dead, and the larger budget for a dead path stops with the path alive at a few per cent
-(docs/corrector.md, "Sound legs for the roadmap"). What it uses is what a
-real reply gives: the waypoints and rollouts, no planner and no map. The chain is a refinement of a -> b like any
-split (Theorem 4.1 holds), and the correction judges it on its fresh rollouts like any other alternative; where it
-does not reach b, its live part is offered as ``advance`` offers a reply's live legs.
+(docs/corrector.md, "Sound legs for the roadmap").
 """
 
 from __future__ import annotations
