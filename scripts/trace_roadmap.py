@@ -51,4 +51,5 @@ if __name__ == "__main__":
         fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(out)), suffix=".tmp")
         with os.fdopen(fd, "w") as f:
             json.dump(SEARCHES, f)
+        os.chmod(tmp, 0o644)  # mkstemp's 0600 would keep a shipped table from other readers
         os.replace(tmp, out)
