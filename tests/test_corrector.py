@@ -661,6 +661,35 @@ def test_a_sound_roadmap_needs_a_fraction():
         SearchConfig(roadmap_sound=1.5)
 
 
+@pytest.mark.parametrize("remember", [False, True])
+def test_a_remembering_roadmap_goes_on_where_the_search_before_stopped(remember):
+    roadmap = Roadmap(reach=3.5, evaluations=1, remember=remember)
+    roadmap.add([Disc(x, 0, 0.4) for x in (3, 6, 9)])
+    ev, s, g = LegTable({}), box_at(0, 0), box_at(10, 0)
+    found = [roadmap.chain(ev, s, s, g, WALLS) for _ in range(4)]
+    ends = [[float(r.centre()[0]) for r in f.waypoints] for f in found]
+    if remember:  # one evaluation each: every search adds one leg to what the one before reached
+        assert ends == [[3.0], [3.0, 6.0], [3.0, 6.0, 9.0], [3.0, 6.0, 9.0]] and found[-1].reaches_goal
+        assert [f.remembered for f in found] == [0, 1, 2, 3] and len(ev.calls) == 4
+    else:  # each search spends its one evaluation re-reaching the first waypoint
+        assert ends == [[3.0]] * 4 and not any(f.reaches_goal for f in found)
+        assert {f.remembered for f in found} == {0}
+
+
+def test_a_remembering_roadmap_keeps_a_tree_per_origin():
+    roadmap = Roadmap(reach=3.5, evaluations=1, remember=True)
+    roadmap.add([Disc(x, 0, 0.4) for x in (3, 6, 9)])
+    ev, g = LegTable({}), box_at(10, 0)
+    roadmap.chain(ev, box_at(0, 0), box_at(0, 0), g, WALLS)
+    other = roadmap.chain(ev, box_at(3, 0), box_at(3, 0), g, WALLS)  # another origin starts from nothing
+    assert other.remembered == 0 and len(roadmap.trees) == 2
+
+
+def test_remembering_needs_the_roadmap():
+    with pytest.raises(ValueError, match="roadmap_remember needs correct_roadmap"):
+        SearchConfig(roadmap_remember=True)
+
+
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------
 @dataclass
 class SnapQuery(_Query):

@@ -19,6 +19,12 @@ succeed; a weaker one is remembered as a dead one is. Without it one success in 
 chain can start with a leg that succeeds on 2 % of its rollouts: every later leg then starts from those few states,
 the path is no longer dead, and the larger budget for a dead path stops with the path alive at a few per cent
 (docs/corrector.md, "Sound legs for the roadmap").
+
+``remember`` (method ``ours-corrector-memory``): a search keeps the nodes it reached from its origin (their start
+states and the node before) for the next search from the same origin, which starts from them and spends its
+evaluations on legs not tried yet. Without it only dead legs are remembered, and where the way to the goal first leads
+away from it every search from that origin spends its evaluations re-reaching what the one before reached
+(docs/corrector.md, "A roadmap that remembers").
 """
 
 from __future__ import annotations
@@ -34,12 +40,13 @@ from .common import SubtaskEvaluator, evaluate_all, start_of
 
 @dataclass
 class Chain:
-    """A chain of pooled waypoints from a leg's start: its regions, whether it ends in the leg's goal, and its
-    evaluations."""
+    """A chain of pooled waypoints from a leg's start: its regions, whether it ends in the leg's goal, its
+    evaluations, and how many nodes its search started from that the searches before it had reached."""
 
     waypoints: list[Region]
     reaches_goal: bool
     evaluations: int
+    remembered: int = 0
 
 
 @dataclass
@@ -48,8 +55,10 @@ class Roadmap:
     merge: float = 0.25  # a waypoint this near one kept already adds nothing
     evaluations: int = 120  # subtask evaluations per search at most
     sound: float = 0.0  # a leg is built on only where at least this fraction of its rollouts succeed (0: any success)
+    remember: bool = False  # a search starts from the nodes the searches before it reached from the same origin
     points: list[Region] = field(default_factory=list)
     dead: set = field(default_factory=set)  # (from, to) centres of legs that never succeeded (or were not sound)
+    trees: dict = field(default_factory=dict)  # origin centre -> {pooled node: (start states, node before)}
 
     def add(self, regions) -> None:
         """Pool ``regions`` (a reply's waypoints)."""
@@ -67,7 +76,12 @@ class Roadmap:
         to_goal = np.linalg.norm(centres - centres[-1], axis=1)
         first = np.asarray(origin.centre(), dtype=float)
         reached: dict[int, tuple] = {-1: (start, None)}  # node -> (its start states, the node before it)
-        queue, used, best = [(float(np.linalg.norm(first - centres[-1])), -1)], 0, -1
+        if self.remember:
+            reached.update(self.trees.get(self._key(first, first), {}))
+        queue = [(float(np.linalg.norm(first - centres[-1])), -1), *((float(to_goal[v]), v) for v in reached if v >= 0)]
+        heapq.heapify(queue)
+        remembered = len(reached) - 1
+        used, best = 0, min((v for v in reached if v >= 0), key=lambda v: to_goal[v], default=-1)
         while queue and used < self.evaluations:
             _, u = heapq.heappop(queue)
             here = first if u < 0 else centres[u]
@@ -88,13 +102,15 @@ class Roadmap:
             if len(nodes) - 1 in reached:
                 best = len(nodes) - 1
                 break
+        if self.remember:
+            self.trees[self._key(first, first)] = {v: r for v, r in reached.items() if 0 <= v < len(self.points)}
         order = []
         while best >= 0:
             order.append(best)
             best = reached[best][1]
         regions = [nodes[v] for v in reversed(order)]
         reaches = bool(regions) and order[0] == len(nodes) - 1
-        return Chain(regions[:-1] if reaches else regions, reaches, used)
+        return Chain(regions[:-1] if reaches else regions, reaches, used, remembered)
 
     def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:
         """The nodes within reach of ``here``, nearest the goal first, but those in ``exclude`` and the dead legs."""

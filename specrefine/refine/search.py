@@ -98,6 +98,8 @@ class SearchConfig:
     #                                reply's waypoints pooled (roadmap.py; method ours-corrector-roadmap)
     roadmap_sound: float = 0.0  # beyond the paper: the roadmap's chain builds only on legs at least this fraction of
     #                             whose rollouts succeed (0: any success; roadmap.py; method ours-corrector-sound)
+    roadmap_remember: bool = False  # beyond the paper: a roadmap search starts from the nodes the searches before it
+    #                                 reached from the same origin (roadmap.py; method ours-corrector-memory)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -113,6 +115,8 @@ class SearchConfig:
         if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
             raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
                              "give 'policy', the agent's goal range)")
+        if self.roadmap_remember and not self.correct_roadmap:
+            raise ValueError("roadmap_remember needs correct_roadmap (it keeps what the roadmap's searches reached)")
         if not 0.0 <= self.roadmap_sound <= 1.0:
             raise ValueError(f"roadmap_sound must lie in [0, 1], got {self.roadmap_sound!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
@@ -207,8 +211,8 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
-        self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound)
-                        if self.cfg.correct_roadmap else None)
+        self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound,
+                                remember=self.cfg.roadmap_remember) if self.cfg.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -556,8 +560,9 @@ class RefinementSearch:
         """The pooled waypoints' chain for the dead leg a -> b (roadmap.py), logged."""
         found = self.roadmap.chain(self.evaluator, start, graph.region(a), graph.region(b), graph.avoid(a, b),
                                    graph.goal_point(b))
+        memory = dict(remembered=found.remembered) if self.roadmap.remember else {}
         self._log("roadmap", edge=[a, b], pooled=len(self.roadmap.points), waypoints=len(found.waypoints),
-                  reaches_end=found.reaches_goal, evaluations=found.evaluations)
+                  reaches_end=found.reaches_goal, evaluations=found.evaluations, **memory)
         return found
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------

@@ -306,6 +306,14 @@ register_method("ours-corrector-sound",
                 "beyond the paper: ours-corrector-roadmap whose chain over the pooled waypoints builds only on legs "
                 "that succeed on at least half their rollouts (a weaker leg is remembered as a dead one is), so "
                 "that no chain starts the rest of the path from a few lucky states", colour="#311b92")
+#: ours-corrector-memory: roadmap, each search starting from what the searches before it reached from the same origin
+#: (docs/corrector.md, "A roadmap that remembers")
+MEMORY = dict(roadmap_remember=True)
+register_method("ours-corrector-memory",
+                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY),
+                "beyond the paper: ours-corrector-roadmap whose chain search over the pooled waypoints starts from "
+                "the nodes the searches before it reached from the same origin, so that its evaluations go to legs "
+                "not tried yet instead of re-reaching them", colour="#4a148c")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
