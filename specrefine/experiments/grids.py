@@ -333,10 +333,24 @@ SOUND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.25,radius_l
                "imperfect:position_sigma=0.25,coord_grid=1.0,radius=0.3,radius_log_sigma=0.4,corner_pull=0.5,"
                "p_drop_turn=0.3,p_false_opening=0.35,p_wrong_branch=0.4,p_uncapped=0.7,p_unparseable=0.1,"
                "alpha=0.45,rho=0.5")
+#: layouts and error mixes no run had used before grid corrector-memory-new (docs/corrector.md, "A roadmap that
+#: remembers"), made after Y/Z had been looked at: four larger generated mazes, and two mixes: AA (large offsets
+#: rounded to quarter cells, regions pulled to corners, many dropped turns, false openings, wrong branches, mirrored
+#: replies, uncapped legs, unparseable replies, few follow-ups that repair, errors growing with the turns a query spans)
+#: and AB (coordinates rounded to whole cells, small regions, wrong branches often, false openings, dropped turns,
+#: uncapped legs, errors growing fast)
+MEMORY_MAZES = ("random:10x9:61", "random:9x10:17", "random:11x7:52", "random:8x11:36")
+MEMORY_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.3,radius_log_sigma=0.5,corner_pull=0.4,"
+                "p_drop_turn=0.45,p_false_opening=0.25,p_wrong_branch=0.35,p_mirror_y=0.15,p_uncapped=0.65,"
+                "p_unparseable=0.1,alpha=0.35,rho=0.35",
+                "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.5,corner_pull=0.45,"
+                "p_drop_turn=0.35,p_false_opening=0.3,p_wrong_branch=0.45,p_mirror_y=0.1,p_uncapped=0.7,"
+                "p_unparseable=0.05,alpha=0.45,rho=0.45")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
+MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -738,6 +752,15 @@ GRIDS = {g.name: g for g in (
                                         mazes=ROADMAP_CHECK_MAZES,
                                         table="data/results/corrector/sound_roadmap_check.csv",
                                         out="roadmap_check"), fixed="2026-11-29"),
+    # docs/corrector.md, "A roadmap that remembers" (fixed 2026-11-29 11:50 UTC, before its grids ran)
+    new_layouts_grid("corrector-memory-new", "docs/corrector.md, 'A roadmap that remembers' (issue 39; fixed "
+                     "2026-11-29 before it ran)", ("ours-corrector-memory", "ours-corrector-roadmap", "ours"),
+                     MEMORY_MAZES, MEMORY_MIXES, "memory_new", code=MEMORY_CODE),
+    *centre_variant_grids("corrector-memory", "A roadmap that remembers", "ours-corrector-memory", "memory",
+                          code=MEMORY_CODE,
+                          informed=Part(("ours-corrector-memory",), SOUND_MIXES, seeds=(0, 1), mazes=SOUND_MAZES,
+                                        table="data/results/corrector/memory_sound_new.csv", out="sound_new"),
+                          fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
