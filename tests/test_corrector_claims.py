@@ -606,7 +606,8 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     a = vs["adoption"]
     assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check") and cc.ADOPTABLE[1:3] == ("roadmap", "advance")
+    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check")
+    assert cc.ADOPTABLE[cc.ADOPTABLE.index("roadmap") + 1] == "advance"  # advance the next older than roadmap
     assert vs["check"] is None  # its last check not laid yet
     lay_all_parts(tmp_path, "corrector-advance-check", lambda maze, m, p: 0.0 if m == cc.SNAP and
                   cc.table_name(maze) == "random:9x6:33" else 1.0)
@@ -681,6 +682,40 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
     assert "runs below 0.5: 0 against 4" in cc._adoption_text(vs)
     assert cc.reported(studies) == ("sound" if a["adopted"] else cc.reported({**studies, "sound": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["W/X", "Y/Z"]  # in the order made
+
+
+def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_that_informed_it(tmp_path):
+    """corrector-memory: roadmap its reference; its new layouts (AA, AB) put memory, roadmap and ours side by side;
+    sound's new cells (Y, Z) are its informed part; its adoption counts runs at 0; adopted only where roadmap is."""
+    roadmap = roadmap_rate()
+
+    def rate(maze, method, proposer):
+        if method == cc.MEMORY:
+            return 0.99
+        if method in (cc.ROADMAP, cc.SOUND) and proposer in cc.SOUND_MIXES + cc.MEMORY_MIXES and \
+                cc.table_name(maze) in ("random:10x8:23", "random:9x10:17"):
+            return 0.0
+        return roadmap(maze, method, proposer)
+
+    for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-sound-new", "corrector-memory",
+                 "corrector-memory-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["memory"]
+    assert vs["reference"] == cc.ROADMAP and vs["versus_corrector"]["n_cells"] == 72
+    assert vs["new"] is None and not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
+    informed = vs["informed"]
+    assert informed["names"] == ["Y", "Z"] and informed["grid"] == "corrector-sound-new"
+    assert informed["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4, cc.SOUND: 4, "ours": 0}
+    lay_all_parts(tmp_path, "corrector-memory-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["memory"]
+    assert vs["new"]["names"] == ["AA", "AB"] and vs["new"]["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4, "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
+    assert "runs at 0: 0 against 4" in cc._adoption_text(vs)
+    assert cc.reported(studies) == ("memory" if a["adopted"] else cc.reported({**studies, "memory": None}))
+    assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["Y/Z", "AA/AB"]  # in the order made
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

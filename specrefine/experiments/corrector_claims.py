@@ -47,6 +47,8 @@ from .grids import (
     HELD_OUT_MIXES,
     KEEP_MAZES,
     KEEP_MIXES,
+    MEMORY_MAZES,
+    MEMORY_MIXES,
     NEW_MAZES,
     NEW_MIXES,
     OTHER_POINT_MAZES,
@@ -83,6 +85,7 @@ FALLBACK = "ours-corrector-fallback"  # keep, the kept split given up for the ed
 ADVANCE = "ours-corrector-advance-extend"  # snap, a dead path keeping the live legs of a reply, with extend's budget
 ROADMAP = "ours-corrector-roadmap"  # advance-extend, a dead leg first offered a chain over every reply's waypoints
 SOUND = "ours-corrector-sound"  # roadmap, its chain built only on legs that succeed on at least half their rollouts
+MEMORY = "ours-corrector-memory"  # roadmap, each chain search starting from what the ones before it reached
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 #: a variant whose adoption counts runs below this success instead of runs at 0 (its docs/corrector.md section)
 ADOPTION_FLOOR = {SOUND: 0.5}
@@ -94,12 +97,12 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  POLISH: "corrector-polish", CENTRE: "corrector-centre", PERSIST: "corrector-persist",
                  SNAP: "corrector-snap", EXTEND: "corrector-extend",
                  KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance",
-                 ROADMAP: "corrector-roadmap", SOUND: "corrector-sound"}
+                 ROADMAP: "corrector-roadmap", SOUND: "corrector-sound", MEMORY: "corrector-memory"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
                      SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP,
-                     ROADMAP: ADVANCE, SOUND: ROADMAP}
+                     ROADMAP: ADVANCE, SOUND: ROADMAP, MEMORY: ROADMAP}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
@@ -107,20 +110,20 @@ VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-
                  SNAP: "corrector-snap-suite", EXTEND: "corrector-extend-suite",
                  KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite",
                  ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite",
-                 SOUND: "corrector-sound-suite"}
+                 SOUND: "corrector-sound-suite", MEMORY: "corrector-memory-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND, MEMORY}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
             "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE,
-            "roadmap": ROADMAP, "sound": SOUND}
+            "roadmap": ROADMAP, "sound": SOUND, "memory": MEMORY}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
 #: ... or the latest of these adopted (reported())
-ADOPTABLE = ("sound", "roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
+ADOPTABLE = ("memory", "sound", "roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -402,17 +405,18 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                "advance-check": ("corrector-advance-check", ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, ("S", "T")),
                ROADMAP: ("corrector-roadmap-new", ROADMAP_MAZES, ROADMAP_MIXES, ("U", "V")),
                "roadmap-check": ("corrector-roadmap-check", ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, ("W", "X")),
-               SOUND: ("corrector-sound-new", SOUND_MAZES, SOUND_MIXES, ("Y", "Z"))}  # in the order made
+               SOUND: ("corrector-sound-new", SOUND_MAZES, SOUND_MIXES, ("Y", "Z")),
+               MEMORY: ("corrector-memory-new", MEMORY_MAZES, MEMORY_MIXES, ("AA", "AB"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
-                  ROADMAP: ("informed", "check"), SOUND: ("informed",),
+                  ROADMAP: ("informed", "check"), SOUND: ("informed",), MEMORY: ("informed",),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
-               SOUND: "roadmap-check"}
+               SOUND: "roadmap-check", MEMORY: SOUND}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -600,7 +604,7 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
     short = {method: name for name, method in VARIANTS.items()}
-    for name in ("extend", "keep", "fallback", "advance", "roadmap", "sound"):  # only where its reference is
+    for name in ("extend", "keep", "fallback", "advance", "roadmap", "sound", "memory"):  # only where its reference is
         later, reference = studies.get(name), studies.get(short[reference_of(VARIANTS[name])])
         if later:
             held = bool(reference) and reference["adoption"]["adopted"]
