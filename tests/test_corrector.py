@@ -685,6 +685,28 @@ def test_a_remembering_roadmap_keeps_a_tree_per_origin():
     assert other.remembered == 0 and len(roadmap.trees) == 2
 
 
+@pytest.mark.parametrize("explore", [0.0, 0.5])
+def test_an_exploring_roadmap_finds_a_way_no_reply_named(explore):
+    roadmap = Roadmap(reach=3.5, explore=explore)
+    roadmap.add([Disc(3, 0, 0.5)])  # the one waypoint any reply named; its leg to the goal never succeeds
+    ev, s, g = LegTable({(3.0, 6.0): 0.0}), box_at(0, 0), box_at(6, 0)
+    found = roadmap.chain(ev, s, s, g, WALLS)
+    assert found.reaches_goal == (explore > 0)
+    if explore:  # eight waypoints around each node reached (the origin and x = 3), 1.75 m out
+        assert found.explored == 16 and len(roadmap.points) == 17 and found.waypoints[0].centre()[0] == 3.0
+        again = roadmap.chain(ev, s, s, g, WALLS)
+        assert again.explored == 0 and again.reaches_goal  # a node is explored once; its waypoints stay pooled
+    else:
+        assert found.explored == 0 and [float(r.centre()[0]) for r in found.waypoints] == [3.0]
+
+
+def test_exploring_needs_the_roadmap_and_a_fraction():
+    with pytest.raises(ValueError, match="roadmap_explore needs correct_roadmap"):
+        SearchConfig(roadmap_explore=0.5)
+    with pytest.raises(ValueError, match="roadmap_explore must lie in"):
+        SearchConfig(roadmap_explore=1.5, correct_roadmap=True, correct_reach=3.0)
+
+
 def test_remembering_needs_the_roadmap():
     with pytest.raises(ValueError, match="roadmap_remember needs correct_roadmap"):
         SearchConfig(roadmap_remember=True)

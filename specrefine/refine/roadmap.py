@@ -25,6 +25,12 @@ states and the node before) for the next search from the same origin, which star
 evaluations on legs not tried yet. Without it only dead legs are remembered, and where the way to the goal first leads
 away from it every search from that origin spends its evaluations re-reaching what the one before reached
 (docs/corrector.md, "A roadmap that remembers").
+
+``explore`` (method ``ours-corrector-explore``): where a search has tried every leg within reach of what it reached
+and has evaluations left, it adds waypoints of its own, ``explore`` x ``reach`` from each node reached in eight
+directions, and goes on; the rollouts judge them as any other leg (one in a wall never succeeds and is remembered
+dead). Without it the roadmap holds only what the replies named, and where no reply names the way (a detour away
+from the goal that every reply skips), no search can find it (docs/corrector.md, "A roadmap that explores").
 """
 
 from __future__ import annotations
@@ -34,19 +40,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.regions import Region
+from ..core.regions import Disc, Region
 from .common import SubtaskEvaluator, evaluate_all, start_of
 
 
 @dataclass
 class Chain:
     """A chain of pooled waypoints from a leg's start: its regions, whether it ends in the leg's goal, its
-    evaluations, and how many nodes its search started from that the searches before it had reached."""
+    evaluations, how many nodes its search started from that the searches before it had reached, and how many waypoints
+    it added of its own (``explore``)."""
 
     waypoints: list[Region]
     reaches_goal: bool
     evaluations: int
     remembered: int = 0
+    explored: int = 0  # waypoints the search added of its own
 
 
 @dataclass
@@ -56,9 +64,12 @@ class Roadmap:
     evaluations: int = 120  # subtask evaluations per search at most
     sound: float = 0.0  # a leg is built on only where at least this fraction of its rollouts succeed (0: any success)
     remember: bool = False  # a search starts from the nodes the searches before it reached from the same origin
+    explore: float = 0.0  # where a search runs out of legs to try: waypoints this x reach from each node (0: none)
+    explore_radius: float = 0.3  # the radius of a waypoint the search adds
     points: list[Region] = field(default_factory=list)
     dead: set = field(default_factory=set)  # (from, to) centres of legs that never succeeded (or were not sound)
     trees: dict = field(default_factory=dict)  # origin centre -> {pooled node: (start states, node before)}
+    explored: set = field(default_factory=set)  # centres whose eight directions were added
 
     def add(self, regions) -> None:
         """Pool ``regions`` (a reply's waypoints)."""
@@ -71,18 +82,21 @@ class Roadmap:
               goal_point=None) -> Chain:
         """The best-first chain from ``start`` (the start states of the leg from ``origin``) toward ``goal`` over
         the pooled waypoints: to ``goal`` if found, else to the node reached nearest ``goal`` (none: no waypoints)."""
-        nodes = [*self.points, goal]
-        centres = np.asarray([r.centre() for r in nodes], dtype=float)
-        to_goal = np.linalg.norm(centres - centres[-1], axis=1)
         first = np.asarray(origin.centre(), dtype=float)
         reached: dict[int, tuple] = {-1: (start, None)}  # node -> (its start states, the node before it)
         if self.remember:
             reached.update(self.trees.get(self._key(first, first), {}))
-        queue = [(float(np.linalg.norm(first - centres[-1])), -1), *((float(to_goal[v]), v) for v in reached if v >= 0)]
-        heapq.heapify(queue)
-        remembered = len(reached) - 1
+        nodes, centres, to_goal = self._nodes(goal)
+        queue, remembered, added = self._queue(first, reached, centres, to_goal), len(reached) - 1, 0
         used, best = 0, min((v for v in reached if v >= 0), key=lambda v: to_goal[v], default=-1)
-        while queue and used < self.evaluations:
+        while used < self.evaluations:
+            if not queue:  # every leg within reach of what was reached is tried
+                more = self._explore(first, reached, centres) if self.explore > 0 else 0
+                if not more:
+                    break
+                added += more
+                nodes, centres, to_goal = self._nodes(goal)
+                queue = self._queue(first, reached, centres, to_goal)
             _, u = heapq.heappop(queue)
             here = first if u < 0 else centres[u]
             near = self._untried(here, centres, to_goal, exclude={u, *reached})[:self.evaluations - used]
@@ -110,7 +124,35 @@ class Roadmap:
             best = reached[best][1]
         regions = [nodes[v] for v in reversed(order)]
         reaches = bool(regions) and order[0] == len(nodes) - 1
-        return Chain(regions[:-1] if reaches else regions, reaches, used, remembered)
+        return Chain(regions[:-1] if reaches else regions, reaches, used, remembered, added)
+
+    def _nodes(self, goal: Region) -> tuple[list, np.ndarray, np.ndarray]:
+        """The search's nodes (the pooled waypoints, then ``goal``), their centres and straight distances to it."""
+        nodes = [*self.points, goal]
+        centres = np.asarray([r.centre() for r in nodes], dtype=float)
+        return nodes, centres, np.linalg.norm(centres - centres[-1], axis=1)
+
+    @staticmethod
+    def _queue(first, reached: dict, centres, to_goal) -> list:
+        """The search's frontier: the origin and every node reached, nearest the goal (``centres[-1]``) first."""
+        queue = [(float(np.linalg.norm(first - centres[-1])) if v < 0 else float(to_goal[v]), v) for v in reached]
+        heapq.heapify(queue)
+        return queue
+
+    def _explore(self, first, reached: dict, centres) -> int:
+        """Waypoints ``explore`` x ``reach`` from each node reached not explored yet, in eight directions, pooled;
+        how many were new."""
+        before, step = len(self.points), self.explore * self.reach
+        angles = np.arange(8) * np.pi / 4
+        for v in reached:
+            here = first if v < 0 else centres[v]
+            key = self._key(here, here)
+            if key in self.explored:
+                continue
+            self.explored.add(key)
+            self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
+                     for a in angles)
+        return len(self.points) - before
 
     def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:
         """The nodes within reach of ``here``, nearest the goal first, but those in ``exclude`` and the dead legs."""
