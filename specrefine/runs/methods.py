@@ -314,12 +314,12 @@ register_method("ours-corrector-memory",
                 "beyond the paper: ours-corrector-roadmap whose chain search over the pooled waypoints starts from "
                 "the nodes the searches before it reached from the same origin, so that its evaluations go to legs "
                 "not tried yet instead of re-reaching them", colour="#4a148c")
-#: ours-corrector-explore: roadmap, a chain search that runs out of legs adding waypoints of its own at half the
+#: ours-corrector-explore: memory, a chain search that runs out of legs adding waypoints of its own at half the
 #: policy's reach from what it reached (docs/corrector.md, "A roadmap that explores")
 EXPLORE = dict(roadmap_explore=0.5)
 register_method("ours-corrector-explore",
-                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | EXPLORE),
-                "beyond the paper: ours-corrector-roadmap whose chain search over the pooled waypoints, where it has "
+                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY | EXPLORE),
+                "beyond the paper: ours-corrector-memory whose chain search over the pooled waypoints, where it has "
                 "tried every leg within reach of what it reached, adds waypoints of its own at half the policy's "
                 "reach in eight directions from each node reached, judged by the rollouts as any other, so that a way "
                 "no reply names can be found", colour="#880e4f")
