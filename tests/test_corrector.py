@@ -700,11 +700,25 @@ def test_an_exploring_roadmap_finds_a_way_no_reply_named(explore):
         assert found.explored == 0 and [float(r.centre()[0]) for r in found.waypoints] == [3.0]
 
 
+def test_a_probing_roadmap_probes_the_node_nearest_the_goal_and_tries_its_probes_from_it_only():
+    roadmap = Roadmap(reach=3.5, probe=0.5)
+    roadmap.add([Disc(3, 0, 0.5)])  # the one waypoint any reply named; its leg to the goal never succeeds
+    ev, s, g = LegTable({(3.0, 6.0): 0.0}), box_at(0, 0), box_at(6, 0)
+    found = roadmap.chain(ev, s, s, g, WALLS)
+    assert found.reaches_goal and found.explored == 8 and len(roadmap.probes) == 8
+    assert [float(r.centre()[0]) for r in found.waypoints] == [3.0, 4.75]  # the probe 1.75 m east of x = 3
+    assert set(roadmap.probes.values()) == {Roadmap._key(np.array([3.0, 0.0]), np.array([3.0, 0.0]))}
+    from_origin = [c for c in ev.calls if c[0] == 0.0]
+    assert [c[1] for c in from_origin] == [3.0]  # no probe of x = 3 was tried from the origin
+
+
 def test_exploring_needs_the_roadmap_and_a_fraction():
     with pytest.raises(ValueError, match="roadmap_explore needs correct_roadmap"):
         SearchConfig(roadmap_explore=0.5)
     with pytest.raises(ValueError, match="roadmap_explore must lie in"):
         SearchConfig(roadmap_explore=1.5, correct_roadmap=True, correct_reach=3.0)
+    with pytest.raises(ValueError, match="roadmap_probe needs correct_roadmap"):
+        SearchConfig(roadmap_probe=0.5)
 
 
 def test_remembering_needs_the_roadmap():

@@ -31,6 +31,12 @@ and has evaluations left, it adds waypoints of its own, ``explore`` x ``reach`` 
 directions, and goes on; the rollouts judge them as any other leg (one in a wall never succeeds and is remembered
 dead). Without it the roadmap holds only what the replies named, and where no reply names the way (a detour away
 from the goal that every reply skips), no search can find it (docs/corrector.md, "A roadmap that explores").
+
+``probe`` (method ``ours-corrector-probe``): the same, one node at a time and kept to it: where a search runs out of
+legs, the node reached nearest the goal that has not been probed gets eight waypoints ``probe`` x ``reach`` out, tried
+from that node only, and the search goes on. Exploring every node at once adds legs from every node within reach of
+every new waypoint, and each search then spends its evaluations on dead ones (docs/corrector.md, "Probes from the
+nearest node").
 """
 
 from __future__ import annotations
@@ -65,11 +71,13 @@ class Roadmap:
     sound: float = 0.0  # a leg is built on only where at least this fraction of its rollouts succeed (0: any success)
     remember: bool = False  # a search starts from the nodes the searches before it reached from the same origin
     explore: float = 0.0  # where a search runs out of legs to try: waypoints this x reach from each node (0: none)
+    probe: float = 0.0  # where a search runs out of legs: eight waypoints this x reach from one node, its own (0: none)
     explore_radius: float = 0.3  # the radius of a waypoint the search adds
     points: list[Region] = field(default_factory=list)
     dead: set = field(default_factory=set)  # (from, to) centres of legs that never succeeded (or were not sound)
     trees: dict = field(default_factory=dict)  # origin centre -> {pooled node: (start states, node before)}
     explored: set = field(default_factory=set)  # centres whose eight directions were added
+    probes: dict = field(default_factory=dict)  # a probe's index in points -> the centre of the node it is tried from
 
     def add(self, regions) -> None:
         """Pool ``regions`` (a reply's waypoints)."""
@@ -91,7 +99,8 @@ class Roadmap:
         used, best = 0, min((v for v in reached if v >= 0), key=lambda v: to_goal[v], default=-1)
         while used < self.evaluations:
             if not queue:  # every leg within reach of what was reached is tried
-                more = self._explore(first, reached, centres) if self.explore > 0 else 0
+                more = (self._explore(first, reached, centres) if self.explore > 0 else
+                        self._probe(first, reached, centres, to_goal) if self.probe > 0 else 0)
                 if not more:
                     break
                 added += more
@@ -154,10 +163,31 @@ class Roadmap:
                      for a in angles)
         return len(self.points) - before
 
+    def _probe(self, first, reached: dict, centres, to_goal) -> int:
+        """Eight waypoints ``probe`` x ``reach`` out from the node reached nearest the goal not probed yet, pooled as
+        that node's own; how many were new (0: every node reached is probed)."""
+        step, angles = self.probe * self.reach, np.arange(8) * np.pi / 4
+        far = float(np.linalg.norm(first - centres[-1]))
+        for v in sorted(reached, key=lambda v: far if v < 0 else float(to_goal[v])):
+            here = first if v < 0 else centres[v]
+            key = self._key(here, here)
+            if key in self.explored:
+                continue
+            self.explored.add(key)
+            before = len(self.points)
+            self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
+                     for a in angles)
+            self.probes |= {i: key for i in range(before, len(self.points))}
+            if len(self.points) > before:
+                return len(self.points) - before
+        return 0
+
     def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:
-        """The nodes within reach of ``here``, nearest the goal first, but those in ``exclude`` and the dead legs."""
+        """The nodes within reach of ``here``, nearest the goal first, but those in ``exclude``, the dead legs and
+        the probes of other nodes."""
+        own = self._key(here, here)
         return [v for v in np.argsort(to_goal) if v not in exclude and np.linalg.norm(centres[v] - here) <= self.reach
-                and self._key(here, centres[v]) not in self.dead]
+                and self._key(here, centres[v]) not in self.dead and self.probes.get(v, own) == own]
 
     @staticmethod
     def _key(a, b) -> tuple:

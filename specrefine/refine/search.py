@@ -102,6 +102,8 @@ class SearchConfig:
     #                                 reached from the same origin (roadmap.py; method ours-corrector-memory)
     roadmap_explore: float = 0.0  # beyond the paper: a roadmap search that runs out of legs adds waypoints this
     #                               fraction of correct_reach from what it reached (roadmap.py; ours-corrector-explore)
+    roadmap_probe: float = 0.0  # beyond the paper: the same from one node at a time, nearest the goal first, its own
+    #                             waypoints tried from it only (roadmap.py; method ours-corrector-probe)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -121,6 +123,11 @@ class SearchConfig:
             raise ValueError("roadmap_remember needs correct_roadmap (it keeps what the roadmap's searches reached)")
         if self.roadmap_explore and not self.correct_roadmap:
             raise ValueError("roadmap_explore needs correct_roadmap (it adds waypoints to the roadmap's searches)")
+        if self.roadmap_probe and not self.correct_roadmap:
+            raise ValueError("roadmap_probe needs correct_roadmap (it adds waypoints to the roadmap's searches)")
+        if not 0.0 <= self.roadmap_probe <= 1.0:
+            raise ValueError(f"roadmap_probe must lie in [0, 1] (a fraction of correct_reach), got "
+                             f"{self.roadmap_probe!r}")
         if not 0.0 <= self.roadmap_explore <= 1.0:
             raise ValueError(f"roadmap_explore must lie in [0, 1] (a fraction of correct_reach), got "
                              f"{self.roadmap_explore!r}")
@@ -219,7 +226,8 @@ class RefinementSearch:
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
         self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound,
-                                remember=self.cfg.roadmap_remember, explore=self.cfg.roadmap_explore)
+                                remember=self.cfg.roadmap_remember, explore=self.cfg.roadmap_explore,
+                                probe=self.cfg.roadmap_probe)
                         if self.cfg.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
@@ -569,7 +577,7 @@ class RefinementSearch:
         found = self.roadmap.chain(self.evaluator, start, graph.region(a), graph.region(b), graph.avoid(a, b),
                                    graph.goal_point(b))
         memory = dict(remembered=found.remembered) if self.roadmap.remember else {}
-        memory |= dict(explored=found.explored) if self.roadmap.explore else {}
+        memory |= dict(explored=found.explored) if self.roadmap.explore or self.roadmap.probe else {}
         self._log("roadmap", edge=[a, b], pooled=len(self.roadmap.points), waypoints=len(found.waypoints),
                   reaches_end=found.reaches_goal, evaluations=found.evaluations, **memory)
         return found

@@ -323,6 +323,14 @@ register_method("ours-corrector-explore",
                 "tried every leg within reach of what it reached, adds waypoints of its own at half the policy's "
                 "reach in eight directions from each node reached, judged by the rollouts as any other, so that a way "
                 "no reply names can be found", colour="#880e4f")
+#: ours-corrector-probe: memory, a chain search that runs out of legs probing from the node reached nearest the goal
+#: (docs/corrector.md, "Probes from the nearest node")
+PROBE = dict(roadmap_probe=0.5)
+register_method("ours-corrector-probe",
+                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY | PROBE),
+                "beyond the paper: ours-corrector-memory whose chain search, where it has tried every leg within "
+                "reach of what it reached, adds eight waypoints at half the policy's reach around the node reached "
+                "nearest the leg's end not probed yet, tried from that node only, and goes on", colour="#ad1457")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
