@@ -346,11 +346,25 @@ MEMORY_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.3,radius
                 "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.5,corner_pull=0.45,"
                 "p_drop_turn=0.35,p_false_opening=0.3,p_wrong_branch=0.45,p_mirror_y=0.1,p_uncapped=0.7,"
                 "p_unparseable=0.05,alpha=0.45,rho=0.45")
+#: layouts and error mixes no run had used before grid corrector-probe-new (docs/corrector.md, "Probes from the nearest
+#: node"), made after AA/AB had been looked at: four larger generated mazes, and two mixes: AC (offsets rounded to half
+#: cells, regions pulled to corners, many dropped turns, wrong branches often, mirrored replies, false openings,
+#: uncapped legs, unparseable replies, few follow-ups that repair, errors growing with the turns a query spans) and AD
+#: (coordinates rounded to whole cells, small regions of spread sizes, wrong branches, false openings often, dropped
+#: turns, uncapped legs, errors growing fast)
+PROBE_MAZES = ("random:10x10:29", "random:9x11:8", "random:11x8:66", "random:8x10:90")
+PROBE_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.3,radius_log_sigma=0.5,corner_pull=0.4,"
+               "p_drop_turn=0.45,p_false_opening=0.2,p_wrong_branch=0.45,p_mirror_y=0.15,p_uncapped=0.6,"
+               "p_unparseable=0.1,alpha=0.35,rho=0.3",
+               "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.6,corner_pull=0.35,"
+               "p_drop_turn=0.35,p_false_opening=0.4,p_wrong_branch=0.35,p_uncapped=0.7,p_unparseable=0.05,"
+               "alpha=0.45,rho=0.4")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
+PROBE_CODE = "fef6e19"  # the commit of ours-corrector-probe's code (Roadmap.probe)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -760,6 +774,16 @@ GRIDS = {g.name: g for g in (
                           code=MEMORY_CODE,
                           informed=Part(("ours-corrector-memory",), SOUND_MIXES, seeds=(0, 1), mazes=SOUND_MAZES,
                                         table="data/results/corrector/memory_sound_new.csv", out="sound_new"),
+                          fixed="2026-11-29"),
+    # docs/corrector.md, "Probes from the nearest node" (fixed 2026-11-29 13:10 UTC, before its grids ran)
+    new_layouts_grid("corrector-probe-new", "docs/corrector.md, 'Probes from the nearest node' (issue 39; fixed "
+                     "2026-11-29 before it ran)", ("ours-corrector-probe", "ours-corrector-memory",
+                                                   "ours-corrector-roadmap", "ours"),
+                     PROBE_MAZES, PROBE_MIXES, "probe_new", code=PROBE_CODE),
+    *centre_variant_grids("corrector-probe", "Probes from the nearest node", "ours-corrector-probe", "probe",
+                          code=PROBE_CODE,
+                          informed=Part(("ours-corrector-probe",), MEMORY_MIXES, seeds=(0, 1), mazes=MEMORY_MAZES,
+                                        table="data/results/corrector/probe_memory_new.csv", out="memory_new"),
                           fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
