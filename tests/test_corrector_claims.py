@@ -718,6 +718,40 @@ def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_th
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["Y/Z", "AA/AB"]  # in the order made
 
 
+def test_probe_is_judged_against_roadmap_with_memory_beside_it_and_memorys_cells_that_informed_it(tmp_path):
+    """corrector-probe: roadmap its reference (the adopted method), memory run beside it on its new layouts (AC, AD)
+    as the control without the probes; memory's new cells (AA, AB) are its informed part; adopted only where roadmap
+    is."""
+    roadmap = roadmap_rate()
+
+    def rate(maze, method, proposer):
+        if method == cc.PROBE:
+            return 0.99
+        if method in (cc.ROADMAP, cc.MEMORY) and proposer in cc.MEMORY_MIXES + cc.PROBE_MIXES and \
+                cc.table_name(maze) in ("random:9x10:17", "random:9x11:8"):
+            return 0.0
+        return roadmap(maze, method, proposer)
+
+    for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-memory-new", "corrector-probe",
+                 "corrector-probe-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["probe"]
+    assert vs["reference"] == cc.ROADMAP and vs["new"] is None and not vs["adoption"]["adopted"]
+    informed = vs["informed"]
+    assert informed["names"] == ["AA", "AB"] and informed["grid"] == "corrector-memory-new"
+    assert informed["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
+    lay_all_parts(tmp_path, "corrector-probe-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["probe"]
+    assert vs["new"]["names"] == ["AC", "AD"]
+    assert vs["new"]["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
+    assert cc.reported(studies) == ("probe" if a["adopted"] else cc.reported({**studies, "probe": None}))
+    assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["AA/AB", "AC/AD"]  # in the order made
+
+
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
     assert cc._unseen_text(cc.unseen(tmp_path)) == "not run yet"
     lay_all_parts(tmp_path, "corrector-keep-new", lambda maze, m, p: 0.0 if m == cc.SNAP and
