@@ -442,15 +442,15 @@ THROUGH_ADVANCE = (*THROUGH_SNAP, "corrector-fallback-new", "corrector-advance",
 THROUGH_ROADMAP = (*THROUGH_ADVANCE, "corrector-advance-check", "corrector-roadmap", "corrector-roadmap-suite")
 
 
-def later_rate(variant: str, beside: tuple, mixes: tuple, dead: tuple):
-    """A rate for a variant judged against snap: the variant 0.99; the methods ``beside`` it 0 on the ``dead`` mazes
-    under ``mixes`` and 0.99 elsewhere; every other method as persist's grids give it."""
+def later_rate(variant: str, beside: tuple, mixes: tuple, dead: tuple, base=persist_rate):
+    """A rate for a later variant: the variant 0.99; the methods ``beside`` it 0 on the ``dead`` mazes under
+    ``mixes`` and 0.99 elsewhere; every other method as ``base`` gives it (persist's grids unless named)."""
     def rate(maze, method, proposer):
         if method == variant:
             return 0.99
         if method in beside:
             return 0.0 if proposer in mixes and cc.table_name(maze) in dead else 0.99
-        return persist_rate(maze, method, proposer)
+        return base(maze, method, proposer)
     return rate
 
 
@@ -687,16 +687,8 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
 def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_that_informed_it(tmp_path):
     """corrector-memory: roadmap its reference; its new layouts (AA, AB) put memory, roadmap and ours side by side;
     sound's new cells (Y, Z) are its informed part; its adoption counts runs at 0; adopted only where roadmap is."""
-    roadmap = roadmap_rate()
-
-    def rate(maze, method, proposer):
-        if method == cc.MEMORY:
-            return 0.99
-        if method in (cc.ROADMAP, cc.SOUND) and proposer in cc.SOUND_MIXES + cc.MEMORY_MIXES and \
-                cc.table_name(maze) in ("random:10x8:23", "random:9x10:17"):
-            return 0.0
-        return roadmap(maze, method, proposer)
-
+    rate = later_rate(cc.MEMORY, (cc.ROADMAP, cc.SOUND), cc.SOUND_MIXES + cc.MEMORY_MIXES,
+                      ("random:10x8:23", "random:9x10:17"), base=roadmap_rate())
     for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-sound-new", "corrector-memory",
                  "corrector-memory-suite"):
         lay_all_parts(tmp_path, name, rate)
@@ -722,16 +714,8 @@ def test_probe_is_judged_against_roadmap_with_memory_beside_it_and_memorys_cells
     """corrector-probe: roadmap its reference (the adopted method), memory run beside it on its new layouts (AC, AD)
     as the control without the probes; memory's new cells (AA, AB) are its informed part; adopted only where roadmap
     is."""
-    roadmap = roadmap_rate()
-
-    def rate(maze, method, proposer):
-        if method == cc.PROBE:
-            return 0.99
-        if method in (cc.ROADMAP, cc.MEMORY) and proposer in cc.MEMORY_MIXES + cc.PROBE_MIXES and \
-                cc.table_name(maze) in ("random:9x10:17", "random:9x11:8"):
-            return 0.0
-        return roadmap(maze, method, proposer)
-
+    rate = later_rate(cc.PROBE, (cc.ROADMAP, cc.MEMORY), cc.MEMORY_MIXES + cc.PROBE_MIXES,
+                      ("random:9x10:17", "random:9x11:8"), base=roadmap_rate())
     for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-memory-new", "corrector-probe",
                  "corrector-probe-suite"):
         lay_all_parts(tmp_path, name, rate)

@@ -142,44 +142,40 @@ class Roadmap:
         return nodes, centres, np.linalg.norm(centres - centres[-1], axis=1)
 
     @staticmethod
-    def _queue(first, reached: dict, centres, to_goal) -> list:
-        """The search's frontier: the origin and every node reached, nearest the goal (``centres[-1]``) first."""
-        queue = [(float(np.linalg.norm(first - centres[-1])) if v < 0 else float(to_goal[v]), v) for v in reached]
+    def _to_goal(first, centres, to_goal, v: int) -> float:
+        """Node ``v``'s straight distance to the goal (``centres[-1]``); the origin's (``first``) for v < 0."""
+        return float(np.linalg.norm(first - centres[-1])) if v < 0 else float(to_goal[v])
+
+    def _queue(self, first, reached: dict, centres, to_goal) -> list:
+        """The search's frontier: the origin and every node reached, nearest the goal first."""
+        queue = [(self._to_goal(first, centres, to_goal, v), v) for v in reached]
         heapq.heapify(queue)
         return queue
+
+    def _ring(self, here, step: float) -> range:
+        """Eight waypoints ``step`` from ``here``, pooled, unless ``here`` had its ring already; their indices in
+        points (those not merged into one kept already)."""
+        before, key = len(self.points), self._key(here, here)
+        if key not in self.explored:
+            self.explored.add(key)
+            self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
+                     for a in np.arange(8) * np.pi / 4)
+        return range(before, len(self.points))
 
     def _explore(self, first, reached: dict, centres) -> int:
         """Waypoints ``explore`` x ``reach`` from each node reached not explored yet, in eight directions, pooled;
         how many were new."""
-        before, step = len(self.points), self.explore * self.reach
-        angles = np.arange(8) * np.pi / 4
-        for v in reached:
-            here = first if v < 0 else centres[v]
-            key = self._key(here, here)
-            if key in self.explored:
-                continue
-            self.explored.add(key)
-            self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
-                     for a in angles)
-        return len(self.points) - before
+        return sum(len(self._ring(first if v < 0 else centres[v], self.explore * self.reach)) for v in reached)
 
     def _probe(self, first, reached: dict, centres, to_goal) -> int:
         """Eight waypoints ``probe`` x ``reach`` out from the node reached nearest the goal not probed yet, pooled as
         that node's own; how many were new (0: every node reached is probed)."""
-        step, angles = self.probe * self.reach, np.arange(8) * np.pi / 4
-        far = float(np.linalg.norm(first - centres[-1]))
-        for v in sorted(reached, key=lambda v: far if v < 0 else float(to_goal[v])):
+        for v in sorted(reached, key=lambda v: self._to_goal(first, centres, to_goal, v)):
             here = first if v < 0 else centres[v]
-            key = self._key(here, here)
-            if key in self.explored:
-                continue
-            self.explored.add(key)
-            before = len(self.points)
-            self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
-                     for a in angles)
-            self.probes |= {i: key for i in range(before, len(self.points))}
-            if len(self.points) > before:
-                return len(self.points) - before
+            new = self._ring(here, self.probe * self.reach)
+            self.probes |= dict.fromkeys(new, self._key(here, here))
+            if new:
+                return len(new)
         return 0
 
     def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:

@@ -119,18 +119,13 @@ class SearchConfig:
         if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
             raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
                              "give 'policy', the agent's goal range)")
-        if self.roadmap_remember and not self.correct_roadmap:
-            raise ValueError("roadmap_remember needs correct_roadmap (it keeps what the roadmap's searches reached)")
-        if self.roadmap_explore and not self.correct_roadmap:
-            raise ValueError("roadmap_explore needs correct_roadmap (it adds waypoints to the roadmap's searches)")
-        if self.roadmap_probe and not self.correct_roadmap:
-            raise ValueError("roadmap_probe needs correct_roadmap (it adds waypoints to the roadmap's searches)")
-        if not 0.0 <= self.roadmap_probe <= 1.0:
-            raise ValueError(f"roadmap_probe must lie in [0, 1] (a fraction of correct_reach), got "
-                             f"{self.roadmap_probe!r}")
-        if not 0.0 <= self.roadmap_explore <= 1.0:
-            raise ValueError(f"roadmap_explore must lie in [0, 1] (a fraction of correct_reach), got "
-                             f"{self.roadmap_explore!r}")
+        for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe"):
+            if getattr(self, name) and not self.correct_roadmap:
+                raise ValueError(f"{name} needs correct_roadmap (it changes the roadmap's searches)")
+        for name in ("roadmap_explore", "roadmap_probe"):
+            fraction = getattr(self, name)
+            if not 0.0 <= fraction <= 1.0:
+                raise ValueError(f"{name} must lie in [0, 1] (a fraction of correct_reach), got {fraction!r}")
         if not 0.0 <= self.roadmap_sound <= 1.0:
             raise ValueError(f"roadmap_sound must lie in [0, 1], got {self.roadmap_sound!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
@@ -576,10 +571,10 @@ class RefinementSearch:
         """The pooled waypoints' chain for the dead leg a -> b (roadmap.py), logged."""
         found = self.roadmap.chain(self.evaluator, start, graph.region(a), graph.region(b), graph.avoid(a, b),
                                    graph.goal_point(b))
-        memory = dict(remembered=found.remembered) if self.roadmap.remember else {}
-        memory |= dict(explored=found.explored) if self.roadmap.explore or self.roadmap.probe else {}
+        extra = dict(remembered=found.remembered) if self.roadmap.remember else {}
+        extra |= dict(explored=found.explored) if self.roadmap.explore or self.roadmap.probe else {}
         self._log("roadmap", edge=[a, b], pooled=len(self.roadmap.points), waypoints=len(found.waypoints),
-                  reaches_end=found.reaches_goal, evaluations=found.evaluations, **memory)
+                  reaches_end=found.reaches_goal, evaluations=found.evaluations, **extra)
         return found
 
     # --- beyond the paper: shortcut edges over the found path (shortcut.py) -------------

@@ -293,7 +293,8 @@ register_method("ours-corrector-advance-extend", ours_variant(**CORRECTOR | THRI
 #: ours-corrector-roadmap: advance-extend, a dead leg first offered a chain over every reply's waypoints pooled
 #: (docs/corrector.md, "Replies pooled into a roadmap")
 ROADMAP = dict(correct_roadmap=True)
-register_method("ours-corrector-roadmap", ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP),
+ROADMAPPED = CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP  # roadmap's settings, which its variants extend
+register_method("ours-corrector-roadmap", ours_variant(**ROADMAPPED),
                 "beyond the paper: ours-corrector-advance-extend whose correction of a dead leg, while the path is "
                 "dead, first tries a chain over the waypoints of every reply of the run pooled (best first toward the "
                 "leg's end, legs within the policy's reach, no proposer call), then asks the proposer as before",
@@ -302,7 +303,7 @@ register_method("ours-corrector-roadmap", ours_variant(**CORRECTOR | THRIFT | PE
 #: (docs/corrector.md, "Sound legs for the roadmap")
 SOUND = dict(roadmap_sound=0.5)
 register_method("ours-corrector-sound",
-                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | SOUND),
+                ours_variant(**ROADMAPPED | SOUND),
                 "beyond the paper: ours-corrector-roadmap whose chain over the pooled waypoints builds only on legs "
                 "that succeed on at least half their rollouts (a weaker leg is remembered as a dead one is), so "
                 "that no chain starts the rest of the path from a few lucky states", colour="#311b92")
@@ -310,7 +311,7 @@ register_method("ours-corrector-sound",
 #: (docs/corrector.md, "A roadmap that remembers")
 MEMORY = dict(roadmap_remember=True)
 register_method("ours-corrector-memory",
-                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY),
+                ours_variant(**ROADMAPPED | MEMORY),
                 "beyond the paper: ours-corrector-roadmap whose chain search over the pooled waypoints starts from "
                 "the nodes the searches before it reached from the same origin, so that its evaluations go to legs "
                 "not tried yet instead of re-reaching them", colour="#4a148c")
@@ -318,7 +319,7 @@ register_method("ours-corrector-memory",
 #: policy's reach from what it reached (docs/corrector.md, "A roadmap that explores")
 EXPLORE = dict(roadmap_explore=0.5)
 register_method("ours-corrector-explore",
-                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY | EXPLORE),
+                ours_variant(**ROADMAPPED | MEMORY | EXPLORE),
                 "beyond the paper: ours-corrector-memory whose chain search over the pooled waypoints, where it has "
                 "tried every leg within reach of what it reached, adds waypoints of its own at half the policy's "
                 "reach in eight directions from each node reached, judged by the rollouts as any other, so that a way "
@@ -327,7 +328,7 @@ register_method("ours-corrector-explore",
 #: (docs/corrector.md, "Probes from the nearest node")
 PROBE = dict(roadmap_probe=0.5)
 register_method("ours-corrector-probe",
-                ours_variant(**CORRECTOR | THRIFT | PERSIST | ADVANCE | EXTEND | ROADMAP | MEMORY | PROBE),
+                ours_variant(**ROADMAPPED | MEMORY | PROBE),
                 "beyond the paper: ours-corrector-memory whose chain search, where it has tried every leg within "
                 "reach of what it reached, adds eight waypoints at half the policy's reach around the node reached "
                 "nearest the leg's end not probed yet, tried from that node only, and goes on", colour="#ad1457")
