@@ -19,6 +19,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
+from specrefine.runs.methods import DEEP, get_method
 
 
 class LegTable:
@@ -719,6 +720,16 @@ def test_exploring_needs_the_roadmap_and_a_fraction():
         SearchConfig(roadmap_explore=1.5, correct_roadmap=True, correct_reach=3.0)
     with pytest.raises(ValueError, match="roadmap_probe needs correct_roadmap"):
         SearchConfig(roadmap_probe=0.5)
+
+
+def test_a_roadmap_search_spends_the_evaluations_its_config_gives_it():
+    assert SearchConfig().roadmap_evaluations == Roadmap(reach=1.0).evaluations == 120
+    with pytest.raises(ValueError, match="roadmap_evaluations must be at least 1"):
+        SearchConfig(roadmap_evaluations=0)
+    config = SearchConfig(correct_roadmap=True, correct_reach=3.0, roadmap_evaluations=360, edge_refinement=False)
+    assert RefinementSearch(_chain_graph(), LegTable({}), config=config).roadmap.evaluations == 360
+    assert DEEP == {"roadmap_evaluations": 360}  # the one thing ours-corrector-deep changes in probe
+    assert get_method("ours-corrector-deep").name == "ours-corrector-deep"
 
 
 def test_remembering_needs_the_roadmap():

@@ -104,6 +104,8 @@ class SearchConfig:
     #                               fraction of correct_reach from what it reached (roadmap.py; ours-corrector-explore)
     roadmap_probe: float = 0.0  # beyond the paper: the same from one node at a time, nearest the goal first, its own
     #                             waypoints tried from it only (roadmap.py; method ours-corrector-probe)
+    roadmap_evaluations: int = 120  # subtask evaluations one roadmap search may spend at most (roadmap.py; 360:
+    #                                 method ours-corrector-deep)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -126,6 +128,8 @@ class SearchConfig:
             fraction = getattr(self, name)
             if not 0.0 <= fraction <= 1.0:
                 raise ValueError(f"{name} must lie in [0, 1] (a fraction of correct_reach), got {fraction!r}")
+        if self.roadmap_evaluations < 1:
+            raise ValueError(f"roadmap_evaluations must be at least 1, got {self.roadmap_evaluations!r}")
         if not 0.0 <= self.roadmap_sound <= 1.0:
             raise ValueError(f"roadmap_sound must lie in [0, 1], got {self.roadmap_sound!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
@@ -222,7 +226,7 @@ class RefinementSearch:
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
         self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound,
                                 remember=self.cfg.roadmap_remember, explore=self.cfg.roadmap_explore,
-                                probe=self.cfg.roadmap_probe)
+                                probe=self.cfg.roadmap_probe, evaluations=self.cfg.roadmap_evaluations)
                         if self.cfg.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")

@@ -332,6 +332,14 @@ register_method("ours-corrector-probe",
                 "beyond the paper: ours-corrector-memory whose chain search, where it has tried every leg within "
                 "reach of what it reached, adds eight waypoints at half the policy's reach around the node reached "
                 "nearest the leg's end not probed yet, tried from that node only, and goes on", colour="#ad1457")
+#: ours-corrector-deep: probe, each roadmap search allowed 360 subtask evaluations instead of 120
+#: (docs/corrector.md, "Longer searches for the probes")
+DEEP = dict(roadmap_evaluations=360)
+register_method("ours-corrector-deep",
+                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP),
+                "beyond the paper: ours-corrector-probe whose roadmap searches may each spend 360 subtask "
+                "evaluations instead of 120, so that a search probing its way out of a pocket is not cut off and "
+                "started again after one more proposer call", colour="#6a1b9a")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
