@@ -359,12 +359,26 @@ PROBE_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.3,radius_lo
                "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.6,corner_pull=0.35,"
                "p_drop_turn=0.35,p_false_opening=0.4,p_wrong_branch=0.35,p_uncapped=0.7,p_unparseable=0.05,"
                "alpha=0.45,rho=0.4")
+#: layouts and error mixes no run had used before grid corrector-deep-new (docs/corrector.md, "Longer searches for the
+#: probes"), made after AC/AD had been looked at: four larger generated mazes, and two mixes: AE (offsets rounded to
+#: half cells, regions pulled to corners, dropped turns, false openings, wrong branches often, mirrored replies often,
+#: uncapped legs, unparseable replies, errors growing with the turns a query spans) and AF (coordinates rounded to
+#: whole cells, small regions of spread sizes, many dropped turns, false openings often, wrong branches, uncapped legs,
+#: errors growing fast)
+DEEP_MAZES = ("random:10x11:55", "random:11x10:19", "random:12x9:7", "random:9x12:63")
+DEEP_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.3,radius_log_sigma=0.5,corner_pull=0.45,"
+              "p_drop_turn=0.4,p_false_opening=0.3,p_wrong_branch=0.4,p_mirror_y=0.2,p_uncapped=0.65,"
+              "p_unparseable=0.1,alpha=0.4,rho=0.35",
+              "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.2,radius_log_sigma=0.6,corner_pull=0.4,"
+              "p_drop_turn=0.45,p_false_opening=0.35,p_wrong_branch=0.4,p_uncapped=0.7,p_unparseable=0.05,"
+              "alpha=0.45,rho=0.45")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
 PROBE_CODE = "fef6e19"  # the commit of ours-corrector-probe's code (Roadmap.probe)
+DEEP_CODE = "d788274"  # the commit of ours-corrector-deep's code (SearchConfig.roadmap_evaluations)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -784,6 +798,15 @@ GRIDS = {g.name: g for g in (
                           code=PROBE_CODE,
                           informed=Part(("ours-corrector-probe",), MEMORY_MIXES, seeds=(0, 1), mazes=MEMORY_MAZES,
                                         table="data/results/corrector/probe_memory_new.csv", out="memory_new"),
+                          fixed="2026-11-29"),
+    # docs/corrector.md, "Longer searches for the probes" (fixed 2026-11-29 16:30 UTC, before its grids ran)
+    new_layouts_grid("corrector-deep-new", "docs/corrector.md, 'Longer searches for the probes' (issue 39; fixed "
+                     "2026-11-29 before it ran)", ("ours-corrector-deep", "ours-corrector-probe", "ours"),
+                     DEEP_MAZES, DEEP_MIXES, "deep_new", code=DEEP_CODE),
+    *centre_variant_grids("corrector-deep", "Longer searches for the probes", "ours-corrector-deep", "deep",
+                          code=DEEP_CODE,
+                          informed=Part(("ours-corrector-deep",), PROBE_MIXES, seeds=(0, 1), mazes=PROBE_MAZES,
+                                        table="data/results/corrector/deep_probe_new.csv", out="probe_new"),
                           fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
