@@ -799,7 +799,7 @@ GRIDS = {g.name: g for g in (
                           informed=Part(("ours-corrector-probe",), MEMORY_MIXES, seeds=(0, 1), mazes=MEMORY_MAZES,
                                         table="data/results/corrector/probe_memory_new.csv", out="memory_new"),
                           fixed="2026-11-29"),
-    # docs/corrector.md, "Longer searches for the probes" (fixed 2026-11-29 16:30 UTC, before its grids ran)
+    # docs/corrector.md, "Longer searches for the probes" (fixed 2026-11-29 15:23 UTC, before its grids ran)
     new_layouts_grid("corrector-deep-new", "docs/corrector.md, 'Longer searches for the probes' (issue 39; fixed "
                      "2026-11-29 before it ran)", ("ours-corrector-deep", "ours-corrector-probe", "ours"),
                      DEEP_MAZES, DEEP_MIXES, "deep_new", code=DEEP_CODE),
