@@ -710,14 +710,22 @@ def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_th
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["Y/Z", "AA/AB"]  # in the order made
 
 
+def probe_rate():
+    """Probe 0.99; roadmap and memory 0 on one AA/AB and one AC/AD layout under those mixes (probe's grids)."""
+    return later_rate(cc.PROBE, (cc.ROADMAP, cc.MEMORY), cc.MEMORY_MIXES + cc.PROBE_MIXES,
+                      ("random:9x10:17", "random:9x11:8"), base=roadmap_rate())
+
+
+THROUGH_PROBE = (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-memory-new", "corrector-probe",
+                 "corrector-probe-suite")
+
+
 def test_probe_is_judged_against_roadmap_with_memory_beside_it_and_memorys_cells_that_informed_it(tmp_path):
     """corrector-probe: roadmap its reference (the adopted method), memory run beside it on its new layouts (AC, AD)
     as the control without the probes; memory's new cells (AA, AB) are its informed part; adopted only where roadmap
     is."""
-    rate = later_rate(cc.PROBE, (cc.ROADMAP, cc.MEMORY), cc.MEMORY_MIXES + cc.PROBE_MIXES,
-                      ("random:9x10:17", "random:9x11:8"), base=roadmap_rate())
-    for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-memory-new", "corrector-probe",
-                 "corrector-probe-suite"):
+    rate = probe_rate()
+    for name in THROUGH_PROBE:
         lay_all_parts(tmp_path, name, rate)
     vs = cc.variant_studies(tmp_path)["probe"]
     assert vs["reference"] == cc.ROADMAP and vs["new"] is None and not vs["adoption"]["adopted"]
@@ -734,6 +742,28 @@ def test_probe_is_judged_against_roadmap_with_memory_beside_it_and_memorys_cells
     assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
     assert cc.reported(studies) == ("probe" if a["adopted"] else cc.reported({**studies, "probe": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["AA/AB", "AC/AD"]  # in the order made
+
+
+def test_deep_is_judged_against_probe_its_control_and_probes_cells_that_informed_it(tmp_path):
+    """corrector-deep: probe its reference and control (the adopted method; deep changes only the search's budget),
+    run beside it on its new layouts (AE, AF); probe's new cells (AC, AD) are its informed part; adopted only where
+    probe is."""
+    rate = later_rate(cc.DEEP, (cc.PROBE,), cc.DEEP_MIXES, ("random:12x9:7",), base=probe_rate())
+    for name in (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite"):
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)["deep"]
+    assert vs["reference"] == cc.PROBE and vs["new"] is None and not vs["adoption"]["adopted"]
+    informed = vs["informed"]
+    assert informed["names"] == ["AC", "AD"] and informed["grid"] == "corrector-probe-new"
+    assert informed["zero"] == {cc.DEEP: 0, cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
+    lay_all_parts(tmp_path, "corrector-deep-new", rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies["deep"]
+    assert vs["new"]["names"] == ["AE", "AF"] and vs["new"]["zero"] == {cc.DEEP: 0, cc.PROBE: 4, "ours": 0}
+    a = vs["adoption"]
+    assert a["zero"] == {cc.DEEP: 0, cc.PROBE: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    assert a["adopted"] == a["reference_adopted"] == studies["probe"]["adoption"]["adopted"]
+    assert cc.reported(studies) == ("deep" if a["adopted"] else cc.reported({**studies, "deep": None}))
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

@@ -36,6 +36,8 @@ from .grids import (
     ADVANCE_MIXES,
     CHECK_MAZES,
     CHECK_MIXES,
+    DEEP_MAZES,
+    DEEP_MIXES,
     EXTEND_MAZES,
     EXTEND_MIXES,
     FALLBACK_MAZES,
@@ -89,6 +91,7 @@ ROADMAP = "ours-corrector-roadmap"  # advance-extend, a dead leg first offered a
 SOUND = "ours-corrector-sound"  # roadmap, its chain built only on legs that succeed on at least half their rollouts
 MEMORY = "ours-corrector-memory"  # roadmap, each chain search starting from what the ones before it reached
 PROBE = "ours-corrector-probe"  # memory, a search that runs out of legs probing from the node nearest the goal
+DEEP = "ours-corrector-deep"  # probe, each roadmap search allowed 360 evaluations instead of 120
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 #: a variant whose adoption counts runs below this success instead of runs at 0 (its docs/corrector.md section)
 ADOPTION_FLOOR = {SOUND: 0.5}
@@ -101,12 +104,13 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  SNAP: "corrector-snap", EXTEND: "corrector-extend",
                  KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance",
                  ROADMAP: "corrector-roadmap", SOUND: "corrector-sound", MEMORY: "corrector-memory",
-                 PROBE: "corrector-probe"}
+                 PROBE: "corrector-probe", DEEP: "corrector-deep"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
                      SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP,
-                     ROADMAP: ADVANCE, SOUND: ROADMAP, MEMORY: ROADMAP, PROBE: ROADMAP}
+                     ROADMAP: ADVANCE, SOUND: ROADMAP, MEMORY: ROADMAP, PROBE: ROADMAP,
+                     DEEP: PROBE}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
@@ -115,21 +119,21 @@ VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-
                  KEEP: "corrector-keep-suite", FALLBACK: "corrector-fallback-suite",
                  ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite",
                  SOUND: "corrector-sound-suite", MEMORY: "corrector-memory-suite",
-                 PROBE: "corrector-probe-suite"}
+                 PROBE: "corrector-probe-suite", DEEP: "corrector-deep-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
-SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND, MEMORY, PROBE}
+SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND, MEMORY, PROBE, DEEP}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
             "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE,
             "roadmap": ROADMAP, "sound": SOUND, "memory": MEMORY,
-            "probe": PROBE}
+            "probe": PROBE, "deep": DEEP}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
 #: ... or the latest of these adopted (reported())
-ADOPTABLE = ("probe", "memory", "sound", "roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
+ADOPTABLE = ("deep", "probe", "memory", "sound", "roadmap", "advance", "fallback", "keep", "extend", "snap", "persist")
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
@@ -413,18 +417,20 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                "roadmap-check": ("corrector-roadmap-check", ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, ("W", "X")),
                SOUND: ("corrector-sound-new", SOUND_MAZES, SOUND_MIXES, ("Y", "Z")),
                MEMORY: ("corrector-memory-new", MEMORY_MAZES, MEMORY_MIXES, ("AA", "AB")),
-               PROBE: ("corrector-probe-new", PROBE_MAZES, PROBE_MIXES, ("AC", "AD"))}  # in the order made
+               PROBE: ("corrector-probe-new", PROBE_MAZES, PROBE_MIXES, ("AC", "AD")),
+               DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF"))}  # in the order made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
                   ROADMAP: ("informed", "check"), SOUND: ("informed",), MEMORY: ("informed",),
-                  PROBE: ("informed",),
+                  PROBE: ("informed",), DEEP: ("informed",),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
-               SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY}
+               SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
+               DEEP: PROBE}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
@@ -612,7 +618,7 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
     short = {method: name for name, method in VARIANTS.items()}
-    later_variants = ("extend", "keep", "fallback", "advance", "roadmap", "sound", "memory", "probe")
+    later_variants = ("extend", "keep", "fallback", "advance", "roadmap", "sound", "memory", "probe", "deep")
     for name in later_variants:  # adopted only where its reference is
         later, reference = studies.get(name), studies.get(short[reference_of(VARIANTS[name])])
         if later:
