@@ -429,6 +429,12 @@ def fresh_grid(name: str, goal_points: str, methods: tuple) -> ExperimentGrid:
         out=f"runs/{name.replace('-', '_')}")
 
 
+def informed_on(method: str, stem: str, mazes: tuple, mixes: tuple, on: str) -> Part:
+    """``method`` on the cells of study ``on`` (seeds 0-1), those that informed it, into
+    data/results/corrector/STEM_ON.csv."""
+    return Part((method,), mixes, seeds=(0, 1), mazes=mazes, table=f"data/results/corrector/{stem}_{on}.csv", out=on)
+
+
 def centre_variant_grids(name: str, section: str, method: str, stem: str, code: str, informed: Part | None = None,
                          fixed: str = "2026-11-28") -> tuple[ExperimentGrid, ExperimentGrid]:
     """A variant of the corrector at centre goal points (issue 39, docs/corrector.md SECTION): grid NAME, ``informed``
@@ -703,8 +709,7 @@ GRIDS = {g.name: g for g in (
                      ("ours-corrector-snap", "ours-corrector-persist", "ours-corrector-polish", "ours"), SNAP_MAZES,
                      SNAP_MIXES, "snap_new", code="8d73398"),
     *centre_variant_grids("corrector-snap", "Snapped out of the wall", "ours-corrector-snap", "snap", code="8d73398",
-                          informed=Part(("ours-corrector-snap",), NEW_MIXES, seeds=(0, 1), mazes=NEW_MAZES,
-                                        table="data/results/corrector/snap_persist_new.csv", out="persist_new")),
+                          informed=informed_on("ours-corrector-snap", "snap", NEW_MAZES, NEW_MIXES, "persist_new")),
     # docs/corrector.md, "A last check on layouts and mixes no run had used" (fixed 2026-11-28 04:48 UTC, before it ran)
     ExperimentGrid(
         "corrector-snap-check", "docs/corrector.md, 'A last check on layouts and mixes no run had used' (issue 39; "
@@ -720,16 +725,15 @@ GRIDS = {g.name: g for g in (
                      code="1fa15b9"),
     *centre_variant_grids("corrector-extend", "A budget that grows where the run would end at 0",
                           "ours-corrector-extend", "extend", code="1fa15b9",
-                          informed=Part(("ours-corrector-extend",), CHECK_MIXES, seeds=(0, 1), mazes=CHECK_MAZES,
-                                        table="data/results/corrector/extend_check.csv", out="check")),
+                          informed=informed_on("ours-corrector-extend", "extend", CHECK_MAZES, CHECK_MIXES, "check")),
     # docs/corrector.md, "A declined split kept where the path is dead" (fixed 2026-11-28 07:15 UTC, before it ran)
     new_layouts_grid("corrector-keep-new", "docs/corrector.md, 'A declined split kept where the path is dead' (issue "
                      "39; fixed 2026-11-28 before it ran)", ("ours-corrector-keep", "ours-corrector-snap", "ours"),
                      KEEP_MAZES, KEEP_MIXES, "keep_new", code="fe494db"),
     *centre_variant_grids("corrector-keep", "A declined split kept where the path is dead", "ours-corrector-keep",
                           "keep", code="fe494db",
-                          informed=Part(("ours-corrector-keep",), EXTEND_MIXES, seeds=(0, 1), mazes=EXTEND_MAZES,
-                                        table="data/results/corrector/keep_extend_new.csv", out="extend_new")),
+                          informed=informed_on("ours-corrector-keep", "keep",
+                                               EXTEND_MAZES, EXTEND_MIXES, "extend_new")),
     # docs/corrector.md, "Given up at half the budget" (fixed 2026-11-28 07:20 UTC, before it ran)
     new_layouts_grid("corrector-fallback-new", "docs/corrector.md, 'Given up at half the budget' (issue 39; fixed "
                      "2026-11-28 before it ran)", ("ours-corrector-fallback", "ours-corrector-snap",
@@ -737,8 +741,8 @@ GRIDS = {g.name: g for g in (
                      "fallback_new", code="c6a590c"),
     *centre_variant_grids("corrector-fallback", "Given up at half the budget", "ours-corrector-fallback", "fallback",
                           code="c6a590c",
-                          informed=Part(("ours-corrector-fallback",), KEEP_MIXES, seeds=(0, 1), mazes=KEEP_MAZES,
-                                        table="data/results/corrector/fallback_keep_new.csv", out="keep_new")),
+                          informed=informed_on("ours-corrector-fallback", "fallback",
+                                               KEEP_MAZES, KEEP_MIXES, "keep_new")),
     # docs/corrector.md, "Ground kept where the path is dead" (fixed 2026-11-28 09:23 UTC, before it ran)
     new_layouts_grid("corrector-advance-new", "docs/corrector.md, 'Ground kept where the path is dead' (issue 39; "
                      "fixed 2026-11-28 before it ran)", ("ours-corrector-advance-extend", "ours-corrector-advance",
@@ -746,9 +750,8 @@ GRIDS = {g.name: g for g in (
                      "advance_new", code="66e5948"),
     *centre_variant_grids("corrector-advance", "Ground kept where the path is dead", "ours-corrector-advance-extend",
                           "advance", code="66e5948",
-                          informed=Part(("ours-corrector-advance-extend",), FALLBACK_MIXES, seeds=(0, 1),
-                                        mazes=FALLBACK_MAZES, table="data/results/corrector/advance_fallback_new.csv",
-                                        out="fallback_new")),
+                          informed=informed_on("ours-corrector-advance-extend", "advance",
+                                               FALLBACK_MAZES, FALLBACK_MIXES, "fallback_new")),
     # docs/corrector.md, "A last check after advance-extend's adoption" (fixed 2026-11-28 10:07 UTC, before it ran)
     new_layouts_grid("corrector-advance-check", "docs/corrector.md, 'A last check after advance-extend's adoption' "
                      "(issue 39; fixed 2026-11-28 before it ran)", ("ours-corrector-advance-extend",
@@ -761,10 +764,9 @@ GRIDS = {g.name: g for g in (
                      "roadmap_new", code=ROADMAP_CODE),
     *centre_variant_grids("corrector-roadmap", "Replies pooled into a roadmap", "ours-corrector-roadmap", "roadmap",
                           code=ROADMAP_CODE,
-                          informed=Part(("ours-corrector-roadmap",), ADVANCE_CHECK_MIXES, seeds=(0, 1),
-                                        mazes=ADVANCE_CHECK_MAZES,
-                                        table="data/results/corrector/roadmap_advance_check.csv",
-                                        out="advance_check"), fixed="2026-11-29"),
+                          informed=informed_on("ours-corrector-roadmap", "roadmap",
+                                               ADVANCE_CHECK_MAZES, ADVANCE_CHECK_MIXES, "advance_check"),
+                          fixed="2026-11-29"),
     # docs/corrector.md, "A last check after roadmap's adoption" (fixed 2026-11-29 06:40 UTC, before it ran)
     new_layouts_grid("corrector-roadmap-check", "docs/corrector.md, 'A last check after roadmap's adoption' (issue 39; "
                      "fixed 2026-11-29 before it ran)", ("ours-corrector-roadmap", "ours-corrector-advance-extend",
@@ -776,18 +778,17 @@ GRIDS = {g.name: g for g in (
                      SOUND_MAZES, SOUND_MIXES, "sound_new", code=SOUND_CODE),
     *centre_variant_grids("corrector-sound", "Sound legs for the roadmap", "ours-corrector-sound", "sound",
                           code=SOUND_CODE,
-                          informed=Part(("ours-corrector-sound",), ROADMAP_CHECK_MIXES, seeds=(0, 1),
-                                        mazes=ROADMAP_CHECK_MAZES,
-                                        table="data/results/corrector/sound_roadmap_check.csv",
-                                        out="roadmap_check"), fixed="2026-11-29"),
+                          informed=informed_on("ours-corrector-sound", "sound",
+                                               ROADMAP_CHECK_MAZES, ROADMAP_CHECK_MIXES, "roadmap_check"),
+                          fixed="2026-11-29"),
     # docs/corrector.md, "A roadmap that remembers" (fixed 2026-11-29 11:50 UTC, before its grids ran)
     new_layouts_grid("corrector-memory-new", "docs/corrector.md, 'A roadmap that remembers' (issue 39; fixed "
                      "2026-11-29 before it ran)", ("ours-corrector-memory", "ours-corrector-roadmap", "ours"),
                      MEMORY_MAZES, MEMORY_MIXES, "memory_new", code=MEMORY_CODE),
     *centre_variant_grids("corrector-memory", "A roadmap that remembers", "ours-corrector-memory", "memory",
                           code=MEMORY_CODE,
-                          informed=Part(("ours-corrector-memory",), SOUND_MIXES, seeds=(0, 1), mazes=SOUND_MAZES,
-                                        table="data/results/corrector/memory_sound_new.csv", out="sound_new"),
+                          informed=informed_on("ours-corrector-memory", "memory",
+                                               SOUND_MAZES, SOUND_MIXES, "sound_new"),
                           fixed="2026-11-29"),
     # docs/corrector.md, "Probes from the nearest node" (fixed 2026-11-29 13:10 UTC, before its grids ran)
     new_layouts_grid("corrector-probe-new", "docs/corrector.md, 'Probes from the nearest node' (issue 39; fixed "
@@ -796,8 +797,8 @@ GRIDS = {g.name: g for g in (
                      PROBE_MAZES, PROBE_MIXES, "probe_new", code=PROBE_CODE),
     *centre_variant_grids("corrector-probe", "Probes from the nearest node", "ours-corrector-probe", "probe",
                           code=PROBE_CODE,
-                          informed=Part(("ours-corrector-probe",), MEMORY_MIXES, seeds=(0, 1), mazes=MEMORY_MAZES,
-                                        table="data/results/corrector/probe_memory_new.csv", out="memory_new"),
+                          informed=informed_on("ours-corrector-probe", "probe",
+                                               MEMORY_MAZES, MEMORY_MIXES, "memory_new"),
                           fixed="2026-11-29"),
     # docs/corrector.md, "Longer searches for the probes" (fixed 2026-11-29 15:23 UTC, before its grids ran)
     new_layouts_grid("corrector-deep-new", "docs/corrector.md, 'Longer searches for the probes' (issue 39; fixed "
@@ -805,8 +806,7 @@ GRIDS = {g.name: g for g in (
                      DEEP_MAZES, DEEP_MIXES, "deep_new", code=DEEP_CODE),
     *centre_variant_grids("corrector-deep", "Longer searches for the probes", "ours-corrector-deep", "deep",
                           code=DEEP_CODE,
-                          informed=Part(("ours-corrector-deep",), PROBE_MIXES, seeds=(0, 1), mazes=PROBE_MAZES,
-                                        table="data/results/corrector/deep_probe_new.csv", out="probe_new"),
+                          informed=informed_on("ours-corrector-deep", "deep", PROBE_MAZES, PROBE_MIXES, "probe_new"),
                           fixed="2026-11-29"),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
