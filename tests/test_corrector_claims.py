@@ -684,29 +684,43 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["W/X", "Y/Z"]  # in the order made
 
 
+def judged_after_its_reference(tmp_path, short, rate, laid, informed, new_grid, new, adoption_zero):
+    """Lay ``laid`` and check variant ``short`` before its new layouts (its informed part: names, grid, runs at 0;
+    not complete, not adopted), then lay ``new_grid`` and check its new part (names, runs at 0) and its adoption
+    (``adoption_zero``, both parts hold, adopted only where its reference is); the studies and its own."""
+    variant = cc.VARIANTS[short]
+    reference = cc.reference_of(variant)
+    for name in laid:
+        lay_all_parts(tmp_path, name, rate)
+    vs = cc.variant_studies(tmp_path)[short]
+    assert vs["reference"] == reference and vs["versus_corrector"]["n_cells"] == 72
+    assert vs["new"] is None and not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
+    names, grid, zero = informed
+    assert vs["informed"]["names"] == names and vs["informed"]["grid"] == grid and vs["informed"]["zero"] == zero
+    lay_all_parts(tmp_path, new_grid, rate)
+    studies = cc.variant_studies(tmp_path)
+    vs = studies[short]
+    assert (vs["new"]["names"], vs["new"]["zero"]) == new
+    a = vs["adoption"]
+    assert a["zero"] == adoption_zero and a["fewer_zero"] and a["no_worse"] and a["complete"]
+    reference_short = next(n for n, m in cc.VARIANTS.items() if m == reference)
+    assert a["adopted"] == a["reference_adopted"] == studies[reference_short]["adoption"]["adopted"]
+    assert cc.reported(studies) == (short if a["adopted"] else cc.reported({**studies, short: None}))
+    return studies, vs
+
+
 def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_that_informed_it(tmp_path):
     """corrector-memory: roadmap its reference; its new layouts (AA, AB) put memory, roadmap and ours side by side;
     sound's new cells (Y, Z) are its informed part; its adoption counts runs at 0; adopted only where roadmap is."""
     rate = later_rate(cc.MEMORY, (cc.ROADMAP, cc.SOUND), cc.SOUND_MIXES + cc.MEMORY_MIXES,
                       ("random:10x8:23", "random:9x10:17"), base=roadmap_rate())
-    for name in (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-sound-new", "corrector-memory",
-                 "corrector-memory-suite"):
-        lay_all_parts(tmp_path, name, rate)
-    vs = cc.variant_studies(tmp_path)["memory"]
-    assert vs["reference"] == cc.ROADMAP and vs["versus_corrector"]["n_cells"] == 72
-    assert vs["new"] is None and not vs["adoption"]["complete"] and not vs["adoption"]["adopted"]
-    informed = vs["informed"]
-    assert informed["names"] == ["Y", "Z"] and informed["grid"] == "corrector-sound-new"
-    assert informed["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4, cc.SOUND: 4, "ours": 0}
-    lay_all_parts(tmp_path, "corrector-memory-new", rate)
-    studies = cc.variant_studies(tmp_path)
-    vs = studies["memory"]
-    assert vs["new"]["names"] == ["AA", "AB"] and vs["new"]["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4, "ours": 0}
-    a = vs["adoption"]
-    assert a["zero"] == {cc.MEMORY: 0, cc.ROADMAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
-    assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
+    laid = (*THROUGH_ROADMAP, "corrector-roadmap-new", "corrector-sound-new", "corrector-memory",
+            "corrector-memory-suite")
+    _, vs = judged_after_its_reference(
+        tmp_path, "memory", rate, laid,
+        (["Y", "Z"], "corrector-sound-new", {cc.MEMORY: 0, cc.ROADMAP: 4, cc.SOUND: 4, "ours": 0}),
+        "corrector-memory-new", (["AA", "AB"], {cc.MEMORY: 0, cc.ROADMAP: 4, "ours": 0}), {cc.MEMORY: 0, cc.ROADMAP: 4})
     assert "runs at 0: 0 against 4" in cc._adoption_text(vs)
-    assert cc.reported(studies) == ("memory" if a["adopted"] else cc.reported({**studies, "memory": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["Y/Z", "AA/AB"]  # in the order made
 
 
@@ -724,23 +738,11 @@ def test_probe_is_judged_against_roadmap_with_memory_beside_it_and_memorys_cells
     """corrector-probe: roadmap its reference (the adopted method), memory run beside it on its new layouts (AC, AD)
     as the control without the probes; memory's new cells (AA, AB) are its informed part; adopted only where roadmap
     is."""
-    rate = probe_rate()
-    for name in THROUGH_PROBE:
-        lay_all_parts(tmp_path, name, rate)
-    vs = cc.variant_studies(tmp_path)["probe"]
-    assert vs["reference"] == cc.ROADMAP and vs["new"] is None and not vs["adoption"]["adopted"]
-    informed = vs["informed"]
-    assert informed["names"] == ["AA", "AB"] and informed["grid"] == "corrector-memory-new"
-    assert informed["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
-    lay_all_parts(tmp_path, "corrector-probe-new", rate)
-    studies = cc.variant_studies(tmp_path)
-    vs = studies["probe"]
-    assert vs["new"]["names"] == ["AC", "AD"]
-    assert vs["new"]["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
-    a = vs["adoption"]
-    assert a["zero"] == {cc.PROBE: 0, cc.ROADMAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
-    assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
-    assert cc.reported(studies) == ("probe" if a["adopted"] else cc.reported({**studies, "probe": None}))
+    judged_after_its_reference(
+        tmp_path, "probe", probe_rate(), THROUGH_PROBE,
+        (["AA", "AB"], "corrector-memory-new", {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}),
+        "corrector-probe-new", (["AC", "AD"], {cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}),
+        {cc.PROBE: 0, cc.ROADMAP: 4})
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["AA/AB", "AC/AD"]  # in the order made
 
 
@@ -749,21 +751,10 @@ def test_deep_is_judged_against_probe_its_control_and_probes_cells_that_informed
     run beside it on its new layouts (AE, AF); probe's new cells (AC, AD) are its informed part; adopted only where
     probe is."""
     rate = later_rate(cc.DEEP, (cc.PROBE,), cc.DEEP_MIXES, ("random:12x9:7",), base=probe_rate())
-    for name in (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite"):
-        lay_all_parts(tmp_path, name, rate)
-    vs = cc.variant_studies(tmp_path)["deep"]
-    assert vs["reference"] == cc.PROBE and vs["new"] is None and not vs["adoption"]["adopted"]
-    informed = vs["informed"]
-    assert informed["names"] == ["AC", "AD"] and informed["grid"] == "corrector-probe-new"
-    assert informed["zero"] == {cc.DEEP: 0, cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}
-    lay_all_parts(tmp_path, "corrector-deep-new", rate)
-    studies = cc.variant_studies(tmp_path)
-    vs = studies["deep"]
-    assert vs["new"]["names"] == ["AE", "AF"] and vs["new"]["zero"] == {cc.DEEP: 0, cc.PROBE: 4, "ours": 0}
-    a = vs["adoption"]
-    assert a["zero"] == {cc.DEEP: 0, cc.PROBE: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
-    assert a["adopted"] == a["reference_adopted"] == studies["probe"]["adoption"]["adopted"]
-    assert cc.reported(studies) == ("deep" if a["adopted"] else cc.reported({**studies, "deep": None}))
+    judged_after_its_reference(
+        tmp_path, "deep", rate, (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite"),
+        (["AC", "AD"], "corrector-probe-new", {cc.DEEP: 0, cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}),
+        "corrector-deep-new", (["AE", "AF"], {cc.DEEP: 0, cc.PROBE: 4, "ours": 0}), {cc.DEEP: 0, cc.PROBE: 4})
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
