@@ -606,13 +606,8 @@ def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_t
     a = vs["adoption"]
     assert a["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert cc.INFORMED_PARTS[cc.ADVANCE] == ("informed", "check")
     assert cc.ADOPTABLE[cc.ADOPTABLE.index("roadmap") + 1] == "advance"  # advance the next older than roadmap
-    assert vs["check"] is None  # its last check not laid yet
-    lay_all_parts(tmp_path, "corrector-advance-check", lambda maze, m, p: 0.0 if m == cc.SNAP and
-                  cc.table_name(maze) == "random:9x6:33" else 1.0)
-    check = cc.variant_studies(tmp_path)["advance"]["check"]
-    assert check["names"] == ["S", "T"] and check["zero"] == {cc.ADVANCE: 0, cc.SNAP: 4, "ours": 0}
+    checked_last(tmp_path, "advance", "corrector-advance-check", "random:9x6:33", ["S", "T"])
     assert [e["mixes"] for e in cc.unseen(tmp_path)][-3:] == ["O/P", "Q/R", "S/T"]  # in the order made
 
 
@@ -640,12 +635,7 @@ def test_roadmap_is_judged_against_advance_extend_on_its_new_layouts_and_the_st_
     assert a["adopted"] == a["reference_adopted"]
     assert cc.reported(studies) == ("roadmap" if a["adopted"] else cc.reported({**studies, "roadmap": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path)][-2:] == ["S/T", "U/V"]  # in the order made
-    assert cc.INFORMED_PARTS[cc.ROADMAP] == ("informed", "check")  # README's markers roadmap-informed, -check
-    assert vs["check"] is None  # its last check not laid yet
-    lay_all_parts(tmp_path, "corrector-roadmap-check", lambda maze, m, p: 0.0 if m == cc.ADVANCE and
-                  cc.table_name(maze) == "random:9x9:14" else 1.0)
-    check = cc.variant_studies(tmp_path)["roadmap"]["check"]
-    assert check["names"] == ["W", "X"] and check["zero"] == {cc.ROADMAP: 0, cc.ADVANCE: 4, "ours": 0}
+    checked_last(tmp_path, "roadmap", "corrector-roadmap-check", "random:9x9:14", ["W", "X"])
 
 
 def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layouts(tmp_path):
@@ -682,6 +672,20 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
     assert "runs below 0.5: 0 against 4" in cc._adoption_text(vs)
     assert cc.reported(studies) == ("sound" if a["adopted"] else cc.reported({**studies, "sound": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["W/X", "Y/Z"]  # in the order made
+
+
+def checked_last(tmp_path, short, grid, dead_maze, names):
+    """Variant ``short``'s last check (described): none before ``grid`` is laid; then its mixes ``names`` and runs
+    at 0, where its reference dies on ``dead_maze`` only (4 runs: two mixes, two seeds) and the variant nowhere."""
+    variant = cc.VARIANTS[short]
+    reference = cc.reference_of(variant)
+    assert cc.INFORMED_PARTS[variant] == ("informed", "check")  # README's markers NAME-informed, NAME-check
+    assert cc.variant_studies(tmp_path)[short]["check"] is None  # its last check not laid yet
+    lay_all_parts(tmp_path, grid, lambda maze, m, p: 0.0 if m == reference and cc.table_name(maze) == dead_maze
+                  else 1.0)
+    check = cc.variant_studies(tmp_path)[short]["check"]
+    assert check["names"] == names and check["zero"] == {variant: 0, reference: 4, "ours": 0}
+    assert check["grid"] == grid and check["runs"] == 16
 
 
 def judged_after_its_reference(tmp_path, short, rate, laid, informed, new_grid, new, adoption_zero):
@@ -755,6 +759,7 @@ def test_deep_is_judged_against_probe_its_control_and_probes_cells_that_informed
         tmp_path, "deep", rate, (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite"),
         (["AC", "AD"], "corrector-probe-new", {cc.DEEP: 0, cc.PROBE: 0, cc.ROADMAP: 4, cc.MEMORY: 4, "ours": 0}),
         "corrector-deep-new", (["AE", "AF"], {cc.DEEP: 0, cc.PROBE: 4, "ours": 0}), {cc.DEEP: 0, cc.PROBE: 4})
+    checked_last(tmp_path, "deep", "corrector-deep-check", "random:13x9:30", ["AG", "AH"])
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):

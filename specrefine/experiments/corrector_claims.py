@@ -36,6 +36,8 @@ from .grids import (
     ADVANCE_MIXES,
     CHECK_MAZES,
     CHECK_MIXES,
+    DEEP_CHECK_MAZES,
+    DEEP_CHECK_MIXES,
     DEEP_MAZES,
     DEEP_MIXES,
     EXTEND_MAZES,
@@ -418,15 +420,16 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                SOUND: ("corrector-sound-new", SOUND_MAZES, SOUND_MIXES, ("Y", "Z")),
                MEMORY: ("corrector-memory-new", MEMORY_MAZES, MEMORY_MIXES, ("AA", "AB")),
                PROBE: ("corrector-probe-new", PROBE_MAZES, PROBE_MIXES, ("AC", "AD")),
-               DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF"))}  # in the order made
+               DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF")),
+               "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH"))}  # as made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
                   ROADMAP: ("informed", "check"), SOUND: ("informed",), MEMORY: ("informed",),
-                  PROBE: ("informed",), DEEP: ("informed",),
+                  PROBE: ("informed",), DEEP: ("informed", "check"),
                   **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study of a last check after a variant's adoption
-LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check"}
+LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,

@@ -372,6 +372,19 @@ DEEP_MIXES = ("imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.3,radius_lo
               "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.2,radius_log_sigma=0.6,corner_pull=0.4,"
               "p_drop_turn=0.45,p_false_opening=0.35,p_wrong_branch=0.4,p_uncapped=0.7,p_unparseable=0.05,"
               "alpha=0.45,rho=0.45")
+#: layouts and error mixes no run had used before grid corrector-deep-check (docs/corrector.md, "A last check of
+#: deep"), made after AE/AF had been looked at: four larger generated mazes (sizes chosen, seeds drawn by
+#: random.Random(20261201)), and two mixes: AG (large offsets rounded to quarter cells, small regions of spread sizes,
+#: regions pulled hard to corners, dropped turns, false openings, wrong branches often, mirrored replies, uncapped legs,
+#: unparseable replies, errors growing with the turns a query spans) and AH (coordinates rounded to whole cells, many
+#: dropped turns, false openings often, wrong branches, uncapped legs, errors growing fast)
+DEEP_CHECK_MAZES = ("random:12x10:19", "random:10x12:32", "random:11x11:20", "random:13x9:30")
+DEEP_CHECK_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.25,radius_log_sigma=0.6,corner_pull=0.5,"
+                    "p_drop_turn=0.4,p_false_opening=0.3,p_wrong_branch=0.45,p_mirror_y=0.2,p_uncapped=0.65,"
+                    "p_unparseable=0.1,alpha=0.4,rho=0.3",
+                    "imperfect:position_sigma=0.3,coord_grid=1.0,radius=0.25,radius_log_sigma=0.6,corner_pull=0.45,"
+                    "p_drop_turn=0.45,p_false_opening=0.4,p_wrong_branch=0.4,p_mirror_y=0.1,p_uncapped=0.7,"
+                    "p_unparseable=0.05,alpha=0.5,rho=0.45")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
@@ -808,6 +821,10 @@ GRIDS = {g.name: g for g in (
                           code=DEEP_CODE,
                           informed=informed_on("ours-corrector-deep", "deep", PROBE_MAZES, PROBE_MIXES, "probe_new"),
                           fixed="2026-11-29"),
+    # docs/corrector.md, "A last check of deep" (fixed 2026-12-01 23:40 UTC, before it ran)
+    new_layouts_grid("corrector-deep-check", "docs/corrector.md, 'A last check of deep' (issue 39; fixed 2026-12-01 "
+                     "before it ran)", ("ours-corrector-deep", "ours-corrector-probe", "ours"),
+                     DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, "deep_check", code=DEEP_CODE),
     corrector_variant_grid("corrector-trim", "The larger check and the lean rule together", "ours-corrector-trim",
                            "trim", code="57aa840"),
     ant_corrector_grid("ant-corrector", "docs/corrector.md, 'The Ant' (issue 39; fixed 2026-11-27 before its first "
