@@ -621,8 +621,7 @@ def variant_studies(root: Path = ROOT) -> dict[str, dict | None]:
         held = bool(persist) and persist["adoption"]["no_worse"]
         snap["adoption"] |= {"reference_no_worse": held, "adopted": snap["adoption"]["adopted"] and held}
     short = {method: name for name, method in VARIANTS.items()}
-    later_variants = ("extend", "keep", "fallback", "advance", "roadmap", "sound", "memory", "probe", "deep")
-    for name in later_variants:  # adopted only where its reference is
+    for name in ADOPTABLE[::-1][2:]:  # in the order made, after persist and snap: adopted only where its reference is
         later, reference = studies.get(name), studies.get(short[reference_of(VARIANTS[name])])
         if later:
             held = bool(reference) and reference["adoption"]["adopted"]
