@@ -423,17 +423,15 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF")),
                "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH"))}  # as made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
-#: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {SNAP: ("informed", "check"), ADVANCE: ("informed", "check"),
-                  ROADMAP: ("informed", "check"), SOUND: ("informed",), MEMORY: ("informed",),
-                  PROBE: ("informed",), DEEP: ("informed", "check"),
-                  **{m: ("informed",) for m in (EXTEND, KEEP, FALLBACK)}}
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
                DEEP: PROBE}
+#: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
+INFORMED_PARTS = {m: ("informed", "check") if m in LAST_CHECK or m == SNAP else ("informed",)
+                  for m in (SNAP, *INFORMED_ON)}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:

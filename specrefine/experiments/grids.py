@@ -821,7 +821,7 @@ GRIDS = {g.name: g for g in (
                           code=DEEP_CODE,
                           informed=informed_on("ours-corrector-deep", "deep", PROBE_MAZES, PROBE_MIXES, "probe_new"),
                           fixed="2026-11-29"),
-    # docs/corrector.md, "A last check of deep" (fixed 2026-12-01 23:40 UTC, before it ran)
+    # docs/corrector.md, "A last check of deep" (fixed 2026-12-01 23:20 UTC, committed 23:23, before it ran)
     new_layouts_grid("corrector-deep-check", "docs/corrector.md, 'A last check of deep' (issue 39; fixed 2026-12-01 "
                      "before it ran)", ("ours-corrector-deep", "ours-corrector-probe", "ours"),
                      DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, "deep_check", code=DEEP_CODE),
