@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -155,3 +156,12 @@ def test_an_out_file_in_a_missing_folder_is_refused_before_any_episode(point_run
     assert main(["official", str(point_run), "--out", str(tmp_path / "nowhere" / "x.json")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "does not exist" in err
+
+
+@pytest.mark.parametrize("agent", ["point", "ant"])
+def test_making_the_official_env_leaves_no_model_file_behind(agent):
+    env = make_env(load_maze("gr:U_MAZE").for_agent(agent), agent, 10)
+    model_file = Path(env.unwrapped.tmp_xml_file_path)
+    env.reset(seed=0)  # the environment still works without it
+    env.close()
+    assert model_file.name.endswith(".xml") and not model_file.exists()

@@ -87,8 +87,12 @@ def make_env(maze, agent: str, max_episode_steps: int):
     """The official environment on ``maze``'s walls (see the module docstring)."""
     gym = _gymnasium()
     family, version, extra = ENVIRONMENTS[agent]
-    return gym.make(f"{family}_UMaze-{version}", maze_map=to_gymnasium(maze), continuing_task=True,
-                    reset_target=False, max_episode_steps=max_episode_steps, **extra)
+    env = gym.make(f"{family}_UMaze-{version}", maze_map=to_gymnasium(maze), continuing_task=True,
+                   reset_target=False, max_episode_steps=max_episode_steps, **extra)
+    # Gymnasium-Robotics writes the maze's model to a file in the temp folder and never removes it (one per
+    # environment made); the model is loaded by now, so the file goes.
+    Path(env.unwrapped.tmp_xml_file_path).unlink(missing_ok=True)
+    return env
 
 
 def judged_env(run_dir, seed=None, *, start: str = "official", reset_noise: str = "official",
