@@ -250,6 +250,9 @@ def test_a_finished_run_of_the_users_own_maze_is_reopened_from_its_record(tmp_pa
     maze.unlink()  # the record alone must do
     capsys.readouterr()
     assert failures_main([str(tmp_path / "run" / "result.json"), "--episodes", "4"]) == 0, capsys.readouterr().err
+    by_file = capsys.readouterr().out
+    assert failures_main([str(tmp_path / "run"), "--episodes", "4"]) == 0, capsys.readouterr().err  # its folder
+    assert capsys.readouterr().out == by_file
     assert calibrate_main([str(tmp_path / "run"), "--table", str(tmp_path / "p.csv")]) == 0, capsys.readouterr().err
     assert sweep.read_table(tmp_path / "p.csv")[0]["cell"] == "run"
 

@@ -110,6 +110,12 @@ def positive_float(text: str) -> float:
     return value
 
 
+def result_file(text: str) -> Path:
+    """An argparse type for a finished run: its result.json, or its folder (then the result.json in it)."""
+    path = out_path(text)
+    return path / "result.json" if path.is_dir() else path
+
+
 def out_path(text: str) -> Path:
     """An argparse type for an output path: not empty (``--out ''`` would write into the current directory)."""
     if not text.strip():

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import sys
 
-from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
+from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe, result_file
 from ..core.errors import SpecrefineError
 from ..core.runfolder import output_file, read_result, write_atomic
 
@@ -38,7 +38,7 @@ def about_pair(text: str) -> tuple[str, str]:
 
 def main(argv=None) -> int:
     ap = OneLineParser(prog="python -m specrefine.experiments.cost", description=__doc__.splitlines()[0])
-    ap.add_argument("results", nargs="+", help="runs' result.json files")
+    ap.add_argument("results", nargs="+", type=result_file, help="runs' folders or their result.json files")
     ap.add_argument("--about", action="append", default=[], metavar="KEY=TEXT", help="written ahead of the runs")
     ap.add_argument("--out", required=True, help="the JSON file to write (whole, or not at all)")
     args = ap.parse_args(argv)

@@ -24,7 +24,6 @@ import sys
 from collections import Counter
 from contextlib import nullcontext
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -177,12 +176,13 @@ def summary(report: dict) -> str:
 
 
 def add_arguments(p) -> None:
-    from ..core.argtypes import bounded_int, out_path
+    from ..core.argtypes import bounded_int, out_path, result_file
     from ..evaluation.evaluator import GOAL_POINTS
     from ..sim.switching import SWITCHING
 
     p.description = __doc__.split("\n\n")[0]
-    p.add_argument("result", type=Path, help="a run's result.json (the maze is rebuilt from its folder's run.json)")
+    p.add_argument("result", type=result_file,
+                   help="a run's folder or its result.json (the maze is rebuilt from the folder's run.json)")
     p.add_argument("--episodes", type=bounded_int("episodes"), default=300)
     p.add_argument("--seed", type=bounded_int("seed"), default=77,
                    help="seed of the fresh episodes (not the run's own)")
