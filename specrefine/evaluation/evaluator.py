@@ -70,8 +70,28 @@ log = logging.getLogger(__name__)  # one line per record (no echoed source line,
 
 CACHE_VERSION = 2  # 2: start states from a preceding edge drawn by spread_draw (1: with replacement)
 #: where a leg's policy aims when its goal vertex has no fixed point: a point drawn in the goal region per rollout
-#: (the paper's rule) or the goal region's centre
-GOAL_POINTS = ("sampled", "centre")
+#: (the paper's rule), the goal region's centre, or its clearest point (:func:`clearest_point`; beyond the paper)
+GOAL_POINTS = ("sampled", "centre", "clear")
+CLEAR_GRID = 40  # grid points per cell side (or region side) ``clearest_point`` searches: 0.1 m for the Ant's cell
+
+
+def clearest_point(region: Region, obstacles: CompiledRegion, cell_size: float) -> np.ndarray:
+    """The point of ``region`` nearest its centre among those as far from ``obstacles`` (walls and hazards) as the
+    region allows, up to half a cell: in a corridor one cell wide, the centre moved across to the corridor's middle
+    line, and a centre already that clear stays.  Searched on a grid over the region's bounds, of 1/40 cell or 1/40
+    of the bounds' shorter side where that is finer (to within one grid step); the centre itself when no grid point
+    lies in the region."""
+    centre = np.asarray(region.centre(), dtype=float)
+    x0, y0, x1, y1 = region.bounds()
+    step = min(cell_size, x1 - x0, y1 - y0) / CLEAR_GRID
+    xs, ys = np.arange(x0, x1 + step / 2, step), np.arange(y0, y1 + step / 2, step)
+    grid = np.vstack([np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2), centre])
+    grid = grid[region.contains(grid)]
+    if not len(grid):
+        return centre
+    clearance = obstacles.signed_distance(grid)
+    clear = grid[clearance >= min(clearance.max(), cell_size / 2) - step]
+    return clear[np.argmin(np.sum((clear - centre) ** 2, axis=1))]
 
 
 @dataclass(frozen=True)
@@ -158,6 +178,7 @@ class Evaluator:
         self._sims: dict[int, object] = {}
         self._compiled: dict[Region, CompiledRegion] = {}
         self._walls = self.compiled(maze.obstacles)  # starts and goal points keep clear of walls and hazards
+        self._clearest: dict[Region, np.ndarray] = {}  # goal_points="clear": each region's point, found once
         grid = "\n".join(maze.grid) + f"|{maze.cell_size!r}"
         self._maze_digest = hashlib.sha256(grid.encode()).hexdigest()[:16]
 
@@ -227,10 +248,20 @@ class Evaluator:
 
     def aim(self, goal: Region, point=None):
         """The fixed point a leg to ``goal`` aims at: ``point`` if given, else the goal's centre when
-        ``goal_points`` is "centre"; None: a point is drawn per rollout (``sample_free``)."""
-        if point is not None or self.goal_points != "centre":
+        ``goal_points`` is "centre", its clearest point when "clear" (:func:`clearest_point`); None: a point is drawn
+        per rollout (``sample_free``)."""
+        if point is not None or self.goal_points == "sampled":
             return point
-        return np.asarray(goal.centre(), dtype=float)
+        if self.goal_points == "centre":
+            return np.asarray(goal.centre(), dtype=float)
+        return self.clearest(goal)
+
+    def clearest(self, region: Region) -> np.ndarray:
+        """``region``'s point nearest its centre among those as clear of walls and hazards as it allows, up to half a
+        cell (:func:`clearest_point`; found once per region)."""
+        if region not in self._clearest:
+            self._clearest[region] = clearest_point(region, self._walls, self.maze.cell_size)
+        return self._clearest[region]
 
     def sample_free(self, region: Region, k: int, rng: np.random.Generator, clearance: float | None = None
                     ) -> np.ndarray:

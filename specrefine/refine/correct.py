@@ -44,6 +44,12 @@ x_k -> b, a shorter span; ground won is never given back while the path is dead,
 judged as before. While the path is dead only its dead legs are tried: an alternative to a live leg is judged over a
 window that holds the dead one, where nothing can win.
 
+``reaim`` (method ``ours-corrector-reaim``): a weak leg is also offered, before any proposer call, the path with
+the waypoint at either end of it aimed at another point of the same region: ``reaim(region)``, the point nearest the
+region's centre among those as clear of walls as the region allows (``Evaluator.clearest``). A waypoint the proposer
+centred near a corridor's wall leaves its leg hugging that wall; aimed at the corridor's middle line the leg keeps
+clear of it, and the region, and so the task, stays the same. Judged like any alternative.
+
 Every alternative is a refinement of the same input edge (a longer or shorter chain of waypoints), so the refined
 graph still implies the input graph (Theorem 4.1, checked like every refinement). What the correction sees is what
 a real proposer's reply gives: waypoints, pictures and rollouts.
@@ -117,6 +123,30 @@ def bypasses(graph: TaskGraph, path: list[str], leg: int, reach: float, clearanc
     return [(i, i + 2) for i in (leg - 1, leg) if (i, i + 2) in allowed]
 
 
+def reaims(graph: TaskGraph, path: list[str], leg: int, reaim: Callable) -> list[tuple[int, np.ndarray]]:
+    """(k, point) for each inner waypoint path[k] at either end of ``leg`` whose ``reaim`` point is not where it
+    aims already (its own point, else its region's centre)."""
+    out = []
+    for k in (leg, leg + 1):
+        if 1 <= k <= len(path) - 2:
+            region, own = graph.region(path[k]), graph.goal_point(path[k])
+            point = np.asarray(reaim(region), dtype=float)
+            if not np.allclose(point, region.centre() if own is None else own):
+                out.append((k, point))
+    return out
+
+
+def reaimed(graph: TaskGraph, path: list[str], k: int, point) -> tuple[TaskGraph, list[str]]:
+    """A copy of ``graph`` where path[k] has a twin of the same region aimed at ``point`` (the same edges in and out
+    along the path), and the path through the twin."""
+    alt = graph.copy()
+    a, v, b = path[k - 1:k + 2]
+    twin = alt.add_vertex(None, graph.region(v), point=point, refines=graph.refines(v), label=graph.label(v))
+    alt.add_edge(a, twin, graph.avoid(a, v), parent=graph.parent(a, v))
+    alt.add_edge(twin, b, graph.avoid(v, b), parent=graph.parent(v, b))
+    return alt, path[:k] + [twin] + path[k + 1:]
+
+
 def one_split(graph: TaskGraph, path: list[str], i: int) -> bool:
     """Whether path[i] -> path[i+1] -> path[i+2] are legs of one split (path[i+1] a waypoint between them)."""
     a, b, c = path[i:i + 3]
@@ -145,7 +175,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
             first_win: bool = False, advance: bool = False,
-            roadmap: Callable | None = None) -> tuple[TaskGraph, list[str], Check]:
+            roadmap: Callable | None = None, reaim: Callable | None = None) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -156,14 +186,16 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     ``first_win``: the alternatives are asked for and judged cheapest first; ``advance``: a dead leg's split cut
     after its live legs replaces the path where it gets nearer the leg's end, and while the path is dead only its dead
     legs are tried (module doc); ``roadmap(a, b, start)`` -> a ``roadmap.Chain`` over the run's pooled waypoints,
-    offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's)."""
+    offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's); ``reaim(region)`` ->
+    the point a re-aimed waypoint of that region aims at (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
     log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
     tried: set = set()
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
-        groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap)
+        groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
+                               reaim)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -182,13 +214,15 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
                   may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
-                  roadmap: Callable | None = None):
-    """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses (no
-    proposer call), then, for a dead leg of a dead path given ``roadmap``, the chain over the pooled waypoints (no
-    proposer call), then its split, then its split over the next waypoint (one Algorithm 1 each). Lazy: a split is
-    asked for only when its group is reached."""
+                  roadmap: Callable | None = None, reaim: Callable | None = None):
+    """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses and,
+    given ``reaim``, its waypoints re-aimed (no proposer call), then, for a dead leg of a dead path given ``roadmap``,
+    the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
+    Algorithm 1 each). Lazy: a split is asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
+    if reaim is not None:
+        yield [("reaim", *reaimed(graph, path, k, point)) for k, point in reaims(graph, path, leg, reaim)]
     if roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0:
         yield _roadmap_options(state, leg, roadmap)
     if failures(check.results[leg]) < min_failures:

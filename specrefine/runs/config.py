@@ -130,8 +130,10 @@ class RunConfig:
     goal_points: str | None = option(None,
                                      "where a subtask's policy aims when its goal vertex has no fixed point, in the "
                                      "search, the measurement and the calibration alike: sampled (a point drawn in "
-                                     "the goal region per rollout, the paper's rule) or centre (the goal region's "
-                                     "centre in every rollout; beyond the paper)", choices=_goal_points,
+                                     "the goal region per rollout, the paper's rule), centre (the goal region's "
+                                     "centre in every rollout; beyond the paper) or clear (the region's point "
+                                     "farthest from walls, the nearest such to its centre; beyond the paper)",
+                                     choices=_goal_points,
                                      shown="the preset's: best: centre; paper: sampled")
     switching: str = option("at-region", "when a leg's policy is fed the next goal point, in the search, the "
                                          "measurement, the calibration and the saved policy alike: at-region (on "

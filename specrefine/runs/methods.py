@@ -344,6 +344,13 @@ register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confir
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
                 "check)", colour="#bf360c")
+#: ours-corrector-reaim: confirm, whose correction also offers a weak leg's end waypoints aimed clear of the walls
+#: (docs/corrector.md, "Aimed clear of the walls")
+register_method("ours-corrector-reaim", ours_variant(**CORRECTOR | dict(confirm_pick=True, correct_reaim=True)),
+                "beyond the paper: ours-corrector-confirm whose correction also offers a weak leg, before any "
+                "proposer call, the waypoint at either end of it aimed at the point of its region nearest the "
+                "centre among those as clear of walls as the region allows (the region, so the task, unchanged)",
+                colour="#e65100")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
