@@ -836,7 +836,7 @@ GRIDS = {g.name: g for g in (
                        "2026-11-27 19:55 UTC before its first cell ran)", "ant_confirm", code="c463c3e",
                        method="ours-corrector-confirm"),
     ant_corrector_grid("ant-corrector-reaim", "docs/corrector.md, 'Aimed clear of the walls: the Ant' (issue 39; "
-                       "fixed 2026-12-02 04:00 UTC before its first cell ran; one confirm cell's pilot informed it): "
+                       "fixed 2026-12-02 03:57 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with the re-aim", "ant_reaim", code="dee7bc8",
                        method="ours-corrector-reaim"),
     ant_oracle_grid("ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed "
