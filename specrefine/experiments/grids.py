@@ -480,14 +480,15 @@ def new_layouts_grid(name: str, source: str, methods: tuple, mazes: tuple, mixes
                           out=f"runs/{name.replace('-', '_')}")
 
 
-def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector"
-                       ) -> ExperimentGrid:
+def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector",
+                       split_pick: str | None = None) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
-    adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv."""
+    adaptive evaluation, centre goal points, into data/results/corrector/STEM.csv. ``split_pick``: what a code whose
+    preset decides it runs (its cell ids name it), None for a code before the option."""
     part = Part((method,), ("imperfect:moderate",), split="seeds")
     return ExperimentGrid(name, source, "ant", parts=(part,), seeds=(0, 1, 2), mazes=SCALING_MAZES,
                           policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
-                          workers=1, code=code,
+                          split_pick=split_pick, workers=1, code=code,
                           table=f"data/results/corrector/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
 
 
@@ -838,7 +839,7 @@ GRIDS = {g.name: g for g in (
     ant_corrector_grid("ant-corrector-reaim", "docs/corrector.md, 'Aimed clear of the walls: the Ant' (issue 39; "
                        "fixed 2026-12-02 03:57 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with the re-aim", "ant_reaim", code="dee7bc8",
-                       method="ours-corrector-reaim"),
+                       method="ours-corrector-reaim", split_pick="confirmed"),  # the Ant's default there
     ant_oracle_grid("ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed "
                     "2026-11-27 13:45 UTC before its first cell ran)", "ours", "oracle_spread", code="e08c8b9"),
     ant_oracle_grid("ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC "
