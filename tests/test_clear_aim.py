@@ -66,7 +66,8 @@ def test_the_evaluator_aims_at_it_keys_it_as_a_fixed_point_and_tells_the_propose
     assert clear.successes == fixed.successes and np.array_equal(clear.success, fixed.success)
     query = EdgeQuery(maze=maze, agent="point", start=start, goal=goal, avoid=avoid, success=0.25, n=8,
                       image_png=None, graph=graph, facts=ev["clear"].facts())
-    assert "farthest from walls" in messages_to_text(split_messages(query))
+    assert "nearest its centre among those as far from walls as the region allows" in messages_to_text(
+        split_messages(query))
 
 
 def test_a_clear_run_records_the_rule_and_its_policy_aims_where_the_search_did(tmp_path):

@@ -71,8 +71,8 @@ def path_failures(result: dict, episodes: int, seed: int, policy=None, goal_poin
     """Re-run ``result``'s selected path twice (as built, and with the inner walls removed): per-leg failures.
 
     ``goal_points``: "sampled" (the paper's rule: each episode aims at a point drawn from the goal vertex's set) or
-    "centre" (each leg aims at the centre of its goal vertex's set) or "clear" (at its point farthest from walls;
-    both beyond the paper); None: as the run measured
+    "centre" (each leg aims at the centre of its goal vertex's set) or "clear" (``Evaluator.clearest``; both beyond
+    the paper); None: as the run measured
     it (its configuration's ``goal_points``).  ``switching``: the switching rule (``sim.switching``); None: the
     run's own.  ``walls_only``: the run with the walls alone (no ``no_inner_walls`` entry)."""
     from ..evaluation.evaluator import Evaluator
@@ -191,7 +191,8 @@ def add_arguments(p) -> None:
                                                   "policy checkpoint (default: the run's own)")
     p.add_argument("--goal-points", choices=GOAL_POINTS, default=None,
                    help="sampled: each episode aims at a point drawn from the goal vertex's set (the paper's rule); "
-                        "centre: at the set's centre; clear: at its point farthest from walls (both beyond the paper) "
+                        "centre: at the set's centre; clear: at its point nearest the centre among those as clear of "
+                        "walls as it allows, up to half a cell (both beyond the paper) "
                         "(default: as the run measured it)")
     p.add_argument("--switching", choices=SWITCHING, default=None,
                    help="at-region: the next goal point as soon as a goal region is entered (the paper's rule); "

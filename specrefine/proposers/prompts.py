@@ -78,8 +78,8 @@ def _target_sentence(facts: EvaluationFacts, r: str) -> str:
     if facts.goal_points == "centre":
         aim = "the centre of the next region, in every rollout"
     elif facts.goal_points == "clear":
-        aim = ("the point of the next region farthest from walls (of those, the one nearest its centre), in every "
-               "rollout")
+        aim = ("the point of the next region nearest its centre among those as far from walls as the region allows "
+               "(a point half a cell from every wall is far enough), in every rollout")
     else:
         aim = (f"one target point, drawn uniformly at random inside the next region (at least {r} m from walls where "
                f"the region allows), a new draw per rollout")
