@@ -4,7 +4,8 @@
 
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
 and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
-alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corrector-spread`` beside it) with the
+alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corrector-spread`` and
+``ant-corrector-reaim`` beside it; reaim read instead once its adoption rule holds) with the
 Ant scaling grid's one-shot;
 writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
 rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
@@ -147,6 +148,9 @@ ANT_GRID, ANT_METHOD = "ant-corrector-confirm", "ours-corrector-confirm"
 #: the same cells with ours-corrector at the fixed code (stopped at 10 of 27): shown beside, cell for cell
 ANT_BEFORE = "ant-corrector-spread"
 ANT_FIRST = "ant-corrector"  # ours-corrector before spread start states (stopped at 10 of 27; ant.csv)
+#: the same cells with the re-aiming corrector (docs/corrector.md, "Aimed clear of the walls: the Ant"): the Ant's rules
+#: read it instead of ANT_GRID once REAIM - ANT_METHOD over every paired cell has a 95 % interval above 0
+ANT_REAIM, REAIM = "ant-corrector-reaim", "ours-corrector-reaim"
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
@@ -274,13 +278,19 @@ def table_name(maze: str) -> str:
 
 
 def ant_study(root: Path = ROOT) -> dict | None:
-    """The Ant's rules on ``ANT_GRID`` (``ANT_METHOD``), with ``ANT_BEFORE``'s cells (ours-corrector) beside and
-    their pooled difference on the cells both ran; None while neither has a cell."""
-    now, before = _ant_grid_study(ANT_GRID, ANT_METHOD, root), _ant_grid_study(ANT_BEFORE, METHOD, root)
-    if not any(e["runs"] for e in now["per_maze"] + before["per_maze"]):
+    """The Ant's rules on ``ANT_GRID`` (``ANT_METHOD``), or on ``ANT_REAIM`` once adopted, with ``ANT_BEFORE``'s cells
+    (ours-corrector) and ``ANT_REAIM``'s beside and their pooled differences from ANT_METHOD on the cells both ran;
+    None while no grid has a cell."""
+    confirm = _ant_grid_study(ANT_GRID, ANT_METHOD, root)
+    before, reaim = _ant_grid_study(ANT_BEFORE, METHOD, root), _ant_grid_study(ANT_REAIM, REAIM, root)
+    if not any(e["runs"] for e in confirm["per_maze"] + before["per_maze"] + reaim["per_maze"]):
         return None
-    return now | {"grid": ANT_GRID, "method": ANT_METHOD, "before": before["per_maze"],
-                  "paired": _ant_paired(root)}
+    reaim_paired = _ant_paired((ANT_REAIM, REAIM), (ANT_GRID, ANT_METHOD), root)
+    adopted = reaim_paired["complete"] and reaim_paired["ci"][0] > 0
+    now, grid, method = (reaim, ANT_REAIM, REAIM) if adopted else (confirm, ANT_GRID, ANT_METHOD)
+    return now | {"grid": grid, "method": method, "confirm": confirm["per_maze"], "before": before["per_maze"],
+                  "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root),
+                  "reaim": reaim["per_maze"], "reaim_paired": reaim_paired, "reaim_adopted": adopted}
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
@@ -302,13 +312,13 @@ def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
             "zero": zero_runs(rows, method, proposer, SCALING_MAZES)}
 
 
-def _ant_paired(root: Path) -> dict:
-    """ANT_METHOD - ours-corrector (ANT_BEFORE) pooled over the cells both grids ran (``levers.lever_check``)."""
+def _ant_paired(first: tuple[str, str], second: tuple[str, str], root: Path) -> dict:
+    """``first`` - ``second`` (each a grid and its method) pooled over the cells both ran (``levers.lever_check``)."""
     from .levers import lever_check
 
-    rows = [r for r in load(GRIDS[ANT_GRID].tables + GRIDS[ANT_BEFORE].tables, root) if cmp.is_done(r)]
-    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m} for m in (ANT_METHOD, METHOD)}
-    return lever_check(by[ANT_METHOD], by[METHOD], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
+    rows = [r for r in load(GRIDS[first[0]].tables + GRIDS[second[0]].tables, root) if cmp.is_done(r)]
+    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m} for m in (first[1], second[1])}
+    return lever_check(by[first[1]], by[second[1]], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
 
 
 def levers_study(root: Path = ROOT) -> dict | None:
@@ -724,20 +734,31 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
                     "value": f"{_num(c['evaluations_ratio'], '{:.2f}x')}, {_num(c['proposer_calls_ratio'], '{:.2f}x')}"
                              f" over {c['pairs']} pairs",
                     "verdict": _cost_verdict(c)})
-    if ant and not any(e["runs"] for e in ant["per_maze"]):
-        out.append({"rule": f"Ant ({ANT_METHOD}), imperfect:moderate: at least {ANT_FLOOR} on every maze",
-                    "value": f"{ANT_GRID}: no cell yet", "verdict": "not run yet"})
-    elif ant:
+    if ant:
+        out += _ant_verdicts(ant)
+    return out
+
+
+def _ant_verdicts(ant: dict) -> list[dict]:
+    """The Ant's floor and ratio rules on the adopted grid, and the re-aiming corrector's adoption rule."""
+    floor = f"Ant ({ant['method']}), imperfect:moderate: at least {ANT_FLOOR} on every maze"
+    if not any(e["runs"] for e in ant["per_maze"]):
+        out = [{"rule": floor, "value": f"{ant['grid']}: no cell yet", "verdict": "not run yet"}]
+    else:
         complete = all(e["runs"] == len(ANT_SEEDS) for e in ant["per_maze"])
         ran = [e for e in ant["per_maze"] if e["runs"]]
         low = [e["maze"] for e in ran if e["success"] < ANT_FLOOR]
-        out.append({"rule": f"Ant ({ANT_METHOD}), imperfect:moderate: at least {ANT_FLOOR} on every maze",
-                    "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of {len(ant['per_maze'])})"
-                    + (f": {', '.join(low)}" if low else ""), "verdict": _verdict(not low, complete)})
         ratio = ant["ratio"][0]
-        out.append({"rule": f"Ant: {ANT_METHOD} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
-                    "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
-    return out
+        out = [{"rule": floor, "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of "
+                f"{len(ant['per_maze'])})" + (f": {', '.join(low)}" if low else ""),
+                "verdict": _verdict(not low, complete)},
+               {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
+                "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
+    e = ant["reaim_paired"]
+    verdict = ("adopted" if ant["reaim_adopted"] else "not adopted") if e["complete"] else \
+        f"undecided ({e['cells']} of {e['expected']} cells)"
+    return out + [{"rule": f"Ant: {REAIM} - {ANT_METHOD} above 0 (95 % interval, every paired cell; adopted as the "
+                           "Ant's corrector)", "value": _ant_paired_text(e), "verdict": verdict}]
 
 
 def _paired_text(e: dict) -> str:
@@ -811,24 +832,35 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
             lines.append(f"| {c['proposer']} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
                          f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |")
     if ant:
-        lines += ["", f"The Ant (imperfect:moderate, stage 5, centre goal points): {ANT_METHOD} pooled per maze "
-                  f"(Wilson 95 %), grid `{ANT_GRID}`; beside it `{ANT_BEFORE}`, ours-corrector on the same cells "
-                  "(stopped at its 10; docs/corrector.md, 'The Ant with a confirmed pick'), described.", "",
-                  f"| maze | runs | success [95 % CI] | {ANT_BEFORE}: runs | {ANT_BEFORE}: success |",
-                  "|---|---|---|---|---|"]
-        for e, old in zip(ant["per_maze"], ant["before"]):
-            ci = f" [{e['ci_low']:.3f}, {e['ci_high']:.3f}]" if "ci_low" in e else ""
-            lines.append(f"| {e['maze']} | {e['runs']} | {_num(e['success'])}{ci} | {old['runs']} | "
-                         f"{_num(old['success'])} |")
-        lines += ["", f"{ANT_METHOD} - ours-corrector on the cells both ran: {_ant_paired_text(ant['paired'])}.",
-                  "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
-        lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+        lines += ant_markdown(ant)
     if levers:
         lines += levers_markdown(levers)
     for name in VARIANTS:
         if variants.get(name):
             lines += variant_markdown(variants[name])
     return "\n".join(lines) + "\n"
+
+
+def ant_markdown(ant: dict) -> list[str]:
+    """The Ant's cells per maze in ANT_GRID, ANT_REAIM and ANT_BEFORE, their paired differences and ratios."""
+    lines = ["", f"The Ant (imperfect:moderate, stage 5, centre goal points), pooled per maze (Wilson 95 %): "
+             f"`{ANT_GRID}` ({ANT_METHOD}); `{ANT_REAIM}` ({REAIM}, the Ant's corrector if its rule holds; "
+             f"docs/corrector.md, 'Aimed clear of the walls: the Ant'); `{ANT_BEFORE}`, ours-corrector on the same "
+             "cells (stopped at its 10; 'The Ant with a confirmed pick'), described. "
+             f"The rules read `{ant['grid']}`.", "",
+             f"| maze | {ANT_METHOD}: runs | success [95 % CI] | {REAIM}: runs | success [95 % CI] | "
+             f"{ANT_BEFORE}: runs | success |", "|---|---|---|---|---|---|---|"]
+    for e, new, old in zip(ant["confirm"], ant["reaim"], ant["before"]):
+        lines.append(f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} | {new['runs']} | {_rate_ci(new)} | "
+                     f"{old['runs']} | {_num(old['success'])} |")
+    lines += ["", f"{REAIM} - {ANT_METHOD} on the cells both ran: {_ant_paired_text(ant['reaim_paired'])}.",
+              f"{ANT_METHOD} - ours-corrector on the cells both ran: {_ant_paired_text(ant['paired'])}.",
+              "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
+    return lines + [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+
+
+def _rate_ci(e: dict) -> str:
+    return _num(e["success"]) + (f" [{e['ci_low']:.3f}, {e['ci_high']:.3f}]" if "ci_low" in e else "")
 
 
 def _helps(entry: dict) -> str:
@@ -1108,7 +1140,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
-             ANT_BEFORE, ANT_GRID)
+             ANT_BEFORE, ANT_GRID, ANT_REAIM)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -1205,14 +1237,17 @@ def _known(variants: dict) -> None:
 
 
 def _ant_text(ant: dict) -> str:
-    """The Ant's cells per maze in ANT_GRID and, beside, in ANT_BEFORE, with their pooled difference."""
+    """The Ant's cells per maze in ANT_GRID, ANT_REAIM and ANT_BEFORE, with their pooled differences from ANT_GRID."""
     def cells(per_maze):
         ran = [e for e in per_maze if e["runs"]]
         low = sum(e["success"] < ANT_FLOOR for e in ran)
         return (", ".join(f"{e['maze']} {e['success']:.3f} ({e['runs']} run{'s' * (e['runs'] > 1)})" for e in ran)
                 + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
-    return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['per_maze'])}. {ANT_BEFORE} (ours-corrector, stopped): "
-            f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}")
+    return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['confirm'])}. {ANT_BEFORE} (ours-corrector, stopped): "
+            f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}. "
+            f"{ANT_REAIM} ({REAIM}): {cells(ant['reaim'])}; {REAIM} - {ANT_METHOD} on the cells both ran: "
+            f"{_ant_paired_text(ant['reaim_paired'])}"
+            + (f" (adopted: the Ant's rules read {ANT_REAIM})" if ant["reaim_adopted"] else ""))
 
 
 def _ant_paired_text(e: dict) -> str:
