@@ -95,3 +95,64 @@ def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, t
     assert main(["show", str(run)]) == 0
     assert (f"(proposer calls: {before} in the search, {data['proposer_calls'] - before} in the correction)"
             in capsys.readouterr().out)
+
+
+def unfinished(runs, tmp_path, pid: int, half_line: bool = True):
+    """The 'ours' run as a killed or running one would leave it: no result.json, its step log under the temporary
+    name the run writes it to (the last line half-written)."""
+    import shutil
+
+    run = tmp_path / "unfinished"
+    shutil.copytree(runs / "ours", run)
+    (run / "result.json").unlink()
+    log = run / f".steps.jsonl.{pid}.tmp"
+    (run / "steps.jsonl").rename(log)
+    if half_line:
+        with log.open("a") as fh:
+            fh.write('{"step": 999, "event": "exp')
+    return run, [json.loads(line) for line in (runs / "ours" / "steps.jsonl").read_text().splitlines()]
+
+
+def test_show_tells_an_interrupted_run_by_its_step_log_so_far(runs, tmp_path, capsys):
+    run, steps = unfinished(runs, tmp_path, pid=4242)
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("split_doorway · point · ours · geometric · seed 0: not finished")
+    assert "state: interrupted (no live process holds the folder): the same command resumes it" in out
+    assert f"so far: {len(steps)} search steps (" in out  # the half-written line is not a step
+    expands = sum(s["event"] == "expand" for s in steps)
+    assert f"expand {expands}" in out and f"{steps[-1]['proposer_calls']} proposer calls" in out
+    assert "search done" in out and "correction:" not in out  # ours has no correction
+
+
+def test_show_tells_a_running_run_and_its_correction_so_far(runs, tmp_path, capsys):
+    import os
+
+    from specrefine.core.runfolder import _start_time
+
+    run, _ = unfinished(runs, tmp_path, pid=os.getpid(), half_line=False)
+    (run / ".lock").write_text(f"{os.getpid()} {_start_time(os.getpid())}\n")
+    log = run / f".steps.jsonl.{os.getpid()}.tmp"
+    with log.open("a") as fh:
+        for step in ({"step": 50, "event": "correct-check", "path": ["S", "x0", "x1", "G"], "p": 0.5},
+                     {"step": 51, "event": "correct-leg", "accepted": "split", "proposer_calls": 7},
+                     {"step": 52, "event": "correct-leg", "accepted": None, "proposer_calls": 8}):
+            fh.write(json.dumps(step) + "\n")
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert f"state: running (pid {os.getpid()})" in out and ", 8 proposer calls" in out
+    assert "correction: the found path's fresh check 0.500 over 3 legs; 2 legs tried, 1 alternatives taken (split 1)" \
+        in out
+    assert "last step: correct-leg (#52), " in out
+
+
+def test_show_reads_no_linked_step_log_and_a_folder_no_run_started_in_is_refused(runs, tmp_path, capsys):
+    target = tmp_path / "elsewhere.jsonl"
+    target.write_text('{"step": 0, "event": "expand"}\n')
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / ".steps.jsonl.7.tmp").symlink_to(target)
+    assert main(["show", str(empty)]) == 2
+    assert "result.json" in capsys.readouterr().err

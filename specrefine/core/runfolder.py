@@ -78,6 +78,20 @@ def _start_time(pid: int) -> str:
     return fields.rsplit(")", 1)[1].split()[19]
 
 
+def live_holder(out) -> int | None:
+    """The pid of the live process whose run holds ``out`` (its ``.lock`` names it), else None: no lock, a lock left
+    by a dead process, or one that is not a regular file (read without following a link)."""
+    try:
+        fd = os.open(Path(out) / LOCK, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError:
+        return None
+    try:
+        owner = os.pread(fd, 100, 0).decode(errors="replace") if stat.S_ISREG(os.fstat(fd).st_mode) else ""
+    finally:
+        os.close(fd)
+    return int(owner.split()[0]) if owner.split() and _alive(owner) else None
+
+
 def _alive(owner: str) -> bool:
     try:
         pid, _, started = owner.strip().partition(" ")

@@ -6,7 +6,9 @@ prints the run's summary (the input task beside the refined one), its path leg b
 from the search's rollouts and its measured success among the episodes that started it), where the wall time
 went, what it asked of the proposer (and, for a corrector, how much of it in the correction), the official
 environment's result if ``specrefine official`` has run, and the paths of its pictures and
-files.  A folder that is not a finished run is one line (exit 2).
+files.  A run not finished yet (still going, or interrupted) is shown from its step log so far: whether a live
+process holds the folder, the search's steps and proposer calls, and the correction's progress.  A folder no run
+has started in is one line (exit 2).
 """
 
 from __future__ import annotations
@@ -43,6 +45,10 @@ def load_run(run_dir) -> dict:
 
 def show(run_dir) -> str:
     run_dir = Path(run_dir)
+    if not (run_dir / "result.json").exists() and not (run_dir / "result.json").is_symlink():
+        unfinished = unfinished_text(run_dir)
+        if unfinished:
+            return unfinished
     data = load_run(run_dir)
     try:
         parts = [RunResult(data, run_dir).summary(), path_text(data), time_text(data), cost_text(run_dir, data),
@@ -120,6 +126,112 @@ def calls_before_correction(path: Path) -> int | None:
     return None
 
 
+def unfinished_text(run_dir: Path) -> str | None:
+    """A run started in ``run_dir`` and not finished (no result.json): what it runs, whether a live process still
+    holds the folder, and its step log so far (the temporary file ``.steps.jsonl.PID.tmp`` that becomes steps.jsonl
+    once the run is measured); None where no run has started here."""
+    from ..core.records import read_json
+    from ..core.runfolder import live_holder
+
+    try:
+        record = read_json(run_dir / "run.json", "run.json")
+    except SpecrefineError:
+        record = None
+    pid, log = live_holder(run_dir), _step_log(run_dir)
+    if not isinstance(record, dict) and log is None:
+        return None
+    record = record if isinstance(record, dict) else {}
+    what = " · ".join(str(record[key]) for key in ("maze", "agent", "method", "proposer") if key in record)
+    lines = [f"{what or run_dir}" + (f" · seed {record['seed']}" if "seed" in record else "") + ": not finished"]
+    lines.append(f"state: running (pid {pid})" if pid is not None else
+                 "state: interrupted (no live process holds the folder): the same command resumes it from its cache")
+    steps = _steps(log) if log is not None else []
+    if not steps:
+        return "\n".join(lines + ["no search step logged yet"])
+    counts: dict[str, int] = {}
+    for step in steps:
+        counts[step.get("event", "?")] = counts.get(step.get("event", "?"), 0) + 1
+    calls = next((s["proposer_calls"] for s in reversed(steps) if isinstance(s.get("proposer_calls"), int)), None)
+    lines.append(f"so far: {len(steps)} search steps ("
+                 + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
+                 + (f", {calls} proposer calls" if calls is not None else ""))
+    lines += [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
+    return "\n".join(lines)
+
+
+def _step_log(run_dir: Path) -> Path | None:
+    """The newest step log a run is writing (or a killed one left) in ``run_dir``: a regular file, never a link."""
+    import re
+    import stat
+
+    logs = []
+    for path in run_dir.glob(".steps.jsonl.*.tmp"):
+        try:
+            st = path.lstat()
+        except OSError:
+            continue
+        if re.fullmatch(r"\.steps\.jsonl\.\d+\.tmp", path.name) and stat.S_ISREG(st.st_mode):
+            logs.append((st.st_mtime, path))
+    return max(logs)[1] if logs else None
+
+
+def _steps(path: Path) -> list[dict]:
+    """The step log's whole lines (the last may be half-written while the run goes)."""
+    try:
+        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError:
+        return []
+    steps = []
+    for line in lines:
+        try:
+            step = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(step, dict):
+            steps.append(step)
+    return steps
+
+
+def _correction_so_far(steps: list[dict]) -> str:
+    """The correction's fresh check of the found path and the legs it has tried, where it has begun."""
+    check = next((s for s in steps if s.get("event") == "correct-check"), None)
+    if check is None:
+        return ""
+    legs = [s for s in steps if s.get("event") == "correct-leg"]
+    taken: dict[str, int] = {}
+    for s in legs:
+        if s.get("accepted"):
+            taken[str(s["accepted"])] = taken.get(str(s["accepted"]), 0) + 1
+    path = check.get("path") or []
+    return (f"correction: the found path's fresh check {_rate(check.get('p'))} over {max(len(path) - 1, 0)} legs; "
+            f"{len(legs)} legs tried, {sum(taken.values())} alternatives taken"
+            + (" (" + ", ".join(f"{kind} {n}" for kind, n in taken.items()) + ")" if taken else ""))
+
+
+def _phase(steps: list[dict], log: Path) -> str:
+    """Where the run is after its last logged step, and how long ago the log was written."""
+    import time
+
+    try:
+        ago = f", {_duration(time.time() - log.stat().st_mtime)} ago"
+    except OSError:
+        ago = ""
+    last = steps[-1].get("event")
+    if last in ("done", "correct-done"):
+        return f"search done{ago}: measuring the found path (then calibration)"
+    return f"last step: {last} (#{steps[-1].get('step', len(steps) - 1)}){ago}"
+
+
+def _duration(seconds: float) -> str:
+    seconds = max(seconds, 0.0)
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else \
+        f"{seconds / 3600:.1f} h"
+
+
+def _rate(p) -> str:
+    return f"{p:.3f}" if isinstance(p, (int, float)) else "?"
+
+
 def official_text(run_dir: Path) -> str:
     path = run_dir / "official.json"
     if not path.exists():
@@ -143,8 +255,10 @@ def files_text(run_dir: Path) -> str:
 # --- the command (specrefine show) ---------------------------------------------------------------------------
 def add_arguments(parser) -> None:
     parser.description = ("A finished run at a glance: its summary (the input task beside the refined one), its path "
-                          "leg by leg with estimates and measured success, where the time went, and its pictures.")
-    parser.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a finished 'specrefine refine' output folder")
+                          "leg by leg with estimates and measured success, where the time went, and its pictures. "
+                          "A run not finished yet (running or interrupted) is shown from its step log so far.")
+    parser.add_argument("run_dir", metavar="RUN_DIR", type=Path,
+                        help="a 'specrefine refine' output folder (finished, running or interrupted)")
 
 
 def run(args, parser=None) -> int:
