@@ -156,3 +156,38 @@ def test_show_reads_no_linked_step_log_and_a_folder_no_run_started_in_is_refused
     (empty / ".steps.jsonl.7.tmp").symlink_to(target)
     assert main(["show", str(empty)]) == 2
     assert "result.json" in capsys.readouterr().err
+
+
+def test_show_gives_a_sweep_cell_by_cell_done_running_stopped_and_failed(tmp_path, capsys):
+    import csv
+    import os
+
+    from specrefine.core.runfolder import _start_time
+    from specrefine.runs.sweep import grid, read_table, run_sweep
+
+    cells = grid(["u_maze"], ["dirl"], ["geometric"], [0, 1, 2, 3], agent="point", rollouts=8, episodes=16)
+    table = run_sweep(cells, tmp_path, workers=1)
+    rows = read_table(table)
+    done, running, stopped, failed = rows
+    with table.open() as fh:
+        raw = list(csv.DictReader(fh))
+    raw[3].update(status="failed", error="RuntimeError: boom")
+    with table.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(raw[0]))
+        writer.writeheader()
+        writer.writerows([raw[0], raw[3]])
+    for row, live in ((running, True), (stopped, False)):
+        folder = tmp_path / "cells" / row["cell"]
+        (folder / "result.json").unlink()
+        (folder / "steps.jsonl").rename(folder / f".steps.jsonl.{os.getpid()}.tmp")
+        if live:
+            (folder / ".lock").write_text(f"{os.getpid()} {_start_time(os.getpid())}\n")
+    capsys.readouterr()
+    assert main(["show", str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == f"sweep {tmp_path}: 4 cells begun (1 done, 1 running, 1 stopped, 1 failed)"
+    state = {line.split()[1]: line.split()[0] for line in out[1:]}
+    assert state == {done["cell"]: "done", running["cell"]: "running", stopped["cell"]: "stopped",
+                     failed["cell"]: "failed"}
+    first = next(line for line in out if done["cell"] in line)
+    assert f"{done['success_rate']:.3f} [{done['success_ci_low']:.3f}, " in first and "RuntimeError: boom" in out[-1]

@@ -7,8 +7,8 @@ from the search's rollouts and its measured success among the episodes that star
 went, what it asked of the proposer (and, for a corrector, how much of it in the correction), the official
 environment's result if ``specrefine official`` has run, and the paths of its pictures and
 files.  A run not finished yet (still going, or interrupted) is shown from its step log so far: whether a live
-process holds the folder, the search's steps and proposer calls, and the correction's progress.  A folder no run
-has started in is one line (exit 2).
+process holds the folder, the search's steps and proposer calls, and the correction's progress; a sweep's folder,
+cell by cell.  A folder no run has started in is one line (exit 2).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def load_run(run_dir) -> dict:
 def show(run_dir) -> str:
     run_dir = Path(run_dir)
     if not (run_dir / "result.json").exists() and not (run_dir / "result.json").is_symlink():
-        unfinished = unfinished_text(run_dir)
+        unfinished = sweep_text(run_dir) or unfinished_text(run_dir)
         if unfinished:
             return unfinished
     data = load_run(run_dir)
@@ -157,6 +157,47 @@ def unfinished_text(run_dir: Path) -> str | None:
                  + (f", {calls} proposer calls" if calls is not None else ""))
     lines += [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
     return "\n".join(lines)
+
+
+def sweep_text(out: Path) -> str | None:
+    """A sweep folder at a glance: each cell it has begun (``sweep.json``), done (its success, path legs and proposer
+    calls from ``results.csv``), failed, running (its progress so far), stopped midway (a killed sweep's: the same
+    command resumes it) or waiting; None where ``out`` is no sweep."""
+    from ..core.runfolder import live_holder
+    from ..core.tables import read_table
+    from .sweep import is_done, known_cells
+
+    cells = known_cells(out)
+    if not cells:
+        return None
+    table = out / "results.csv"
+    rows = {r["cell"]: r for r in read_table(table)} if table.is_file() else {}
+    lines, states = [], {}
+    for cell in cells:
+        row, folder = rows.get(cell), out / "cells" / cell
+        state = ("done" if is_done(row) else "failed") if row else "running" if live_holder(folder) else \
+            "stopped" if (folder / "run.json").exists() else "waiting"
+        states[state] = states.get(state, 0) + 1
+        lines.append(f"  {state:<9}{cell}  {_cell_detail(state, row, folder)}".rstrip())
+    counts = ", ".join(f"{n} {state}" for state, n in states.items())
+    return "\n".join([f"sweep {out}: {len(cells)} cells begun ({counts})"] + lines)
+
+
+def _cell_detail(state: str, row: dict | None, folder: Path) -> str:
+    if state == "done":
+        return (f"{row['success_rate']:.3f} [{row['success_ci_low']:.3f}, {row['success_ci_high']:.3f}], "
+                f"{_whole(row.get('path_edges'))} legs, {_whole(row.get('proposer_calls'))} proposer calls, "
+                f"{row['wall_seconds']:.0f} s")
+    if state == "failed":
+        return str(row.get("error") or row.get("status"))
+    if state in ("running", "stopped"):
+        progress = (unfinished_text(folder) or "").splitlines()
+        return "; ".join(line for line in progress[2:] if not line.startswith("so far"))
+    return ""
+
+
+def _whole(count) -> str:
+    return f"{count:.0f}" if isinstance(count, (int, float)) and not isinstance(count, bool) else "?"
 
 
 def _step_log(run_dir: Path) -> Path | None:

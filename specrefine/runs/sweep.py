@@ -436,6 +436,13 @@ def check_params(cells: list[Cell], out_root: Path) -> None:
     write_atomic(record, json.dumps({"cells": known}, indent=1, sort_keys=True))
 
 
+def known_cells(out) -> dict:
+    """The cells a sweep folder ``out`` has begun ({cell id: {param: value}} from its ``sweep.json``; {} without
+    one), or a one-line SweepError."""
+    record = Path(out) / "sweep.json"
+    return _recorded_cells(record) if record.exists() or record.is_symlink() else {}
+
+
 def _recorded_cells(record: Path) -> dict:
     """``sweep.json``'s cells ({cell id: {param: value}}), or a one-line SweepError."""
     try:
