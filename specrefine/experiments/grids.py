@@ -903,7 +903,7 @@ def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, li
 def add_arguments(p) -> None:
     from ..core.argtypes import bounded_int
 
-    p.description = __doc__.split("\n")[0]
+    p.description = __doc__.split("\n\n")[0]
     sub = p.add_subparsers(dest="grids_command", required=True, metavar="{list,show,args,plan,status}")
     sub.add_parser("list", help="every grid: name, agent, cells, where it was fixed")
     for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),

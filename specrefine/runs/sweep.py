@@ -649,7 +649,7 @@ def add_arguments(p) -> None:
     """The sweep's options (``specrefine sweep``)."""
     from .pipeline import METHODS
 
-    p.description = __doc__.split("\n")[0]
+    p.description = __doc__.split("\n\n")[0]
     p.add_argument("--mazes", nargs="+", default=None,
                    help="maze names or files, gr:NAME (a Gymnasium-Robotics map, e.g. gr:U_MAZE) or random:RxC:SEED; "
                         "MAZE=SPEC runs that maze with the task SPEC (e.g. 'x=(a | b) -> G') (default: none: name "

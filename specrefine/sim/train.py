@@ -397,7 +397,7 @@ def train(agent: str, frames: int, out, resume: bool = False, progress: bool = T
 
 # --- command line -----------------------------------------------------------------------------
 def add_arguments(ap) -> None:
-    ap.description = __doc__.splitlines()[0]
+    ap.description = __doc__.split("\n\n")[0]
     ap.add_argument("--agent", choices=list(AGENTS), required=True, help="the agent to train (required)")
     ap.add_argument("--out", type=out_path, default=None,
                     help="run directory (checkpoint, log, curve) (default: none; required for training)")
