@@ -14,6 +14,7 @@ cell by cell.  A folder no run has started in is one line (exit 2).
 from __future__ import annotations
 
 import json
+from collections import Counter
 from pathlib import Path
 
 from ..core.errors import SpecrefineError
@@ -148,9 +149,7 @@ def unfinished_text(run_dir: Path) -> str | None:
     steps = _steps(log) if log is not None else []
     if not steps:
         return "\n".join(lines + ["no search step logged yet"])
-    counts: dict[str, int] = {}
-    for step in steps:
-        counts[step.get("event", "?")] = counts.get(step.get("event", "?"), 0) + 1
+    counts = Counter(str(step.get("event", "?")) for step in steps)
     calls = next((s["proposer_calls"] for s in reversed(steps) if isinstance(s.get("proposer_calls"), int)), None)
     lines.append(f"so far: {len(steps)} search steps ("
                  + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
@@ -172,12 +171,12 @@ def sweep_text(out: Path) -> str | None:
         return None
     table = out / "results.csv"
     rows = {r["cell"]: r for r in read_table(table)} if table.is_file() else {}
-    lines, states = [], {}
+    lines, states = [], Counter()
     for cell in cells:
         row, folder = rows.get(cell), out / "cells" / cell
         state = ("done" if is_done(row) else "failed") if row else "running" if live_holder(folder) else \
             "stopped" if (folder / "run.json").exists() else "waiting"
-        states[state] = states.get(state, 0) + 1
+        states[state] += 1
         lines.append(f"  {state:<9}{cell}  {_cell_detail(state, row, folder)}".rstrip())
     counts = ", ".join(f"{n} {state}" for state, n in states.items())
     return "\n".join([f"sweep {out}: {len(cells)} cells begun ({counts})"] + lines)
@@ -187,7 +186,7 @@ def _cell_detail(state: str, row: dict | None, folder: Path) -> str:
     if state == "done":
         return (f"{row['success_rate']:.3f} [{row['success_ci_low']:.3f}, {row['success_ci_high']:.3f}], "
                 f"{_whole(row.get('path_edges'))} legs, {_whole(row.get('proposer_calls'))} proposer calls, "
-                f"{row['wall_seconds']:.0f} s")
+                f"{_whole(row.get('wall_seconds'))} s")
     if state == "failed":
         return str(row.get("error") or row.get("status"))
     if state in ("running", "stopped"):
@@ -239,10 +238,7 @@ def _correction_so_far(steps: list[dict]) -> str:
     if check is None:
         return ""
     legs = [s for s in steps if s.get("event") == "correct-leg"]
-    taken: dict[str, int] = {}
-    for s in legs:
-        if s.get("accepted"):
-            taken[str(s["accepted"])] = taken.get(str(s["accepted"]), 0) + 1
+    taken = Counter(str(s["accepted"]) for s in legs if s.get("accepted"))
     path = check.get("path") or []
     return (f"correction: the found path's fresh check {_rate(check.get('p'))} over {max(len(path) - 1, 0)} legs; "
             f"{len(legs)} legs tried, {sum(taken.values())} alternatives taken"
