@@ -191,3 +191,16 @@ def test_show_gives_a_sweep_cell_by_cell_done_running_stopped_and_failed(tmp_pat
                      failed["cell"]: "failed"}
     first = next(line for line in out if done["cell"] in line)
     assert f"{done['success_rate']:.3f} [{done['success_ci_low']:.3f}, " in first and "RuntimeError: boom" in out[-1]
+
+
+def test_show_tells_a_run_measured_but_not_yet_written(runs, tmp_path, capsys):
+    """Once measured, the step log has its own name while the run measures the input task and draws its pictures."""
+    import shutil
+
+    run = tmp_path / "measured"
+    shutil.copytree(runs / "ours", run)
+    (run / "result.json").unlink()
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert "state: interrupted" in out and "search, measurement and calibration done, " in out

@@ -200,7 +200,8 @@ def _whole(count) -> str:
 
 
 def _step_log(run_dir: Path) -> Path | None:
-    """The newest step log a run is writing (or a killed one left) in ``run_dir``: a regular file, never a link."""
+    """The newest step log a run is writing (or a killed one left) in ``run_dir``, else its steps.jsonl once
+    measured: a regular file, never a link."""
     import re
     import stat
 
@@ -212,7 +213,10 @@ def _step_log(run_dir: Path) -> Path | None:
             continue
         if re.fullmatch(r"\.steps\.jsonl\.\d+\.tmp", path.name) and stat.S_ISREG(st.st_mode):
             logs.append((st.st_mtime, path))
-    return max(logs)[1] if logs else None
+    if not logs:  # measured already: the log has its own name while the run draws its pictures and writes its result
+        final = run_dir / "steps.jsonl"
+        return final if final.is_file() and not final.is_symlink() else None
+    return max(logs)[1]
 
 
 def _steps(path: Path) -> list[dict]:
@@ -254,6 +258,8 @@ def _phase(steps: list[dict], log: Path) -> str:
     except OSError:
         ago = ""
     last = steps[-1].get("event")
+    if log.name == "steps.jsonl":
+        return f"search, measurement and calibration done{ago}: measuring the input task, drawing, writing its result"
     if last in ("done", "correct-done"):
         return f"search done{ago}: measuring the found path (then calibration)"
     return f"last step: {last} (#{steps[-1].get('step', len(steps) - 1)}){ago}"
