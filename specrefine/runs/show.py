@@ -146,16 +146,19 @@ def unfinished_text(run_dir: Path) -> str | None:
     lines = [f"{what or run_dir}" + (f" · seed {record['seed']}" if "seed" in record else "") + ": not finished"]
     lines.append(f"state: running (pid {pid})" if pid is not None else
                  "state: interrupted (no live process holds the folder): the same command resumes it from its cache")
+    return "\n".join(lines + _progress(log))
+
+
+def _progress(log: Path | None) -> list[str]:
+    """What a run's step log says so far: its steps by kind with the proposer calls, the correction, the phase."""
     steps = _steps(log) if log is not None else []
     if not steps:
-        return "\n".join(lines + ["no search step logged yet"])
+        return ["no search step logged yet"]
     counts = Counter(str(step.get("event", "?")) for step in steps)
     calls = next((s["proposer_calls"] for s in reversed(steps) if isinstance(s.get("proposer_calls"), int)), None)
-    lines.append(f"so far: {len(steps)} search steps ("
-                 + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
-                 + (f", {calls} proposer calls" if calls is not None else ""))
-    lines += [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
-    return "\n".join(lines)
+    lines = [f"so far: {len(steps)} search steps (" + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
+             + (f", {calls} proposer calls" if calls is not None else "")]
+    return lines + [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
 
 
 def sweep_text(out: Path) -> str | None:
@@ -190,8 +193,7 @@ def _cell_detail(state: str, row: dict | None, folder: Path) -> str:
     if state == "failed":
         return str(row.get("error") or row.get("status"))
     if state in ("running", "stopped"):
-        progress = (unfinished_text(folder) or "").splitlines()
-        return "; ".join(line for line in progress[2:] if not line.startswith("so far"))
+        return "; ".join(line for line in _progress(_step_log(folder)) if not line.startswith("so far"))
     return ""
 
 
