@@ -351,6 +351,13 @@ register_method("ours-corrector-reaim", ours_variant(**CORRECTOR | dict(confirm_
                 "proposer call, the waypoint at either end of it aimed at the point of its region nearest the "
                 "centre among those as clear of walls as the region allows (the region, so the task, unchanged)",
                 colour="#e65100")
+#: ours-corrector-redraw: confirm, whose correction runs a second pass on a fresh draw (docs/corrector.md, "A second
+#: draw for the Ant")
+register_method("ours-corrector-redraw", ours_variant(**CORRECTOR | dict(confirm_pick=True, correct_passes=2)),
+                "beyond the paper: ours-corrector-confirm whose correction, when done, runs once more from the path "
+                "it left on a fresh draw of its own (new first states, a budget of one proposer split per leg), so "
+                "that a leg chosen on one draw's rollouts is judged again on rollouts that did not choose it",
+                colour="#3e2723")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
