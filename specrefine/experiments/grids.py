@@ -840,6 +840,10 @@ GRIDS = {g.name: g for g in (
                        "fixed 2026-12-02 03:57 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with the re-aim", "ant_reaim", code="dee7bc8",
                        method="ours-corrector-reaim", split_pick="confirmed"),  # the Ant's default there
+    ant_corrector_grid("ant-corrector-redraw", "docs/corrector.md, 'A second draw for the Ant' (issue 39; fixed "
+                       "2026-12-02 08:30 UTC before its first cell ran; one confirm cell's pilot informed it): "
+                       "ant-corrector-confirm's cells with a second correction pass on a fresh draw", "ant_redraw",
+                       code="96e357e", method="ours-corrector-redraw", split_pick="confirmed"),
     ant_oracle_grid("ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed "
                     "2026-11-27 13:45 UTC before its first cell ran)", "ours", "oracle_spread", code="e08c8b9"),
     ant_oracle_grid("ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC "
