@@ -282,11 +282,12 @@ SECOND_DRAW = CHECK_SEED_OFFSET + PASS_SEED_STEP
 PASS_BOOK = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (4.5, 6.0): [5.25]}
 
 
-def test_a_second_pass_splits_a_leg_that_was_lucky_on_the_draw_that_chose_it():
+@pytest.mark.parametrize("confirm_pick", [False, True])  # True: ours-corrector-redraw, the Ant's (confirm + 2 passes)
+def test_a_second_pass_splits_a_leg_that_was_lucky_on_the_draw_that_chose_it(confirm_pick):
     # the first pass splits 3 -> 6 (0.75) through 4.5, whose legs never fail on its draw; on the second draw
     # 4.5 -> 6 loses a fifth, and the second pass splits it through 5.25
     ev = LegTable(LUCKY, FRESH, by_seed={SECOND_DRAW: {(4.5, 6.0): 0.8}})
-    g, result = run(ev, AnswerBook(PASS_BOOK), correct_rollouts=4, correct_passes=2)
+    g, result = run(ev, AnswerBook(PASS_BOOK), correct_rollouts=4, correct_passes=2, confirm_pick=confirm_pick)
     assert xs(result) == [0.0, 3.0, 4.5, 5.25, 6.0, 10.0]
     assert check_refines(result.graph, g) == []
     assert {seed for *_, seed in ev.calls if seed is not None} == {CHECK_SEED_OFFSET, SECOND_DRAW}

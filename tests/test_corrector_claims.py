@@ -298,7 +298,9 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
                                  "stopped): u_chain_1 0.800 (3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals "
                                  "0.800 (1 run); below 0.85 on 3 of 3 mazes run. Difference on the cells both ran: "
                                  f"no cell in both yet. {cc.ANT_REAIM} ({cc.REAIM}): no cell yet; {cc.REAIM} - "
-                                 f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet")
+                                 f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet. {cc.ANT_REDRAW} "
+                                 f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
+                                 "no cell in both yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -314,30 +316,52 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     assert "below 0.85 on 1 of 9 mazes run" in text and "over 7 cells (Newcombe 95 %, pooled). " in text
 
 
-@pytest.mark.parametrize("reaim_rate, adopted", [(0.99, True), (0.9, False)])
-def test_the_reaiming_corrector_is_shown_beside_confirm_and_read_by_the_ants_rules_once_adopted(tmp_path, reaim_rate,
-                                                                                              adopted):
-    """ant-corrector-reaim's rule (docs/corrector.md): adopted if reaim - confirm over the 27 paired cells has a 95 %
-    interval above 0; until every cell ran it is undecided and the rules read the confirm grid."""
+@pytest.mark.parametrize("grid", sorted(cc.ANT_CANDIDATES))
+@pytest.mark.parametrize("rate, adopted", [(0.99, True), (0.9, False)])
+def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rules_once_adopted(tmp_path, grid, rate,
+                                                                                               adopted):
+    """ant-corrector-reaim's and ant-corrector-redraw's rule (docs/corrector.md): adopted if it - confirm over the 27
+    paired cells has a 95 % interval above 0; until every cell ran it is undecided and the rules read confirm."""
+    method = cc.ANT_CANDIDATES[grid]
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
-    lay_grid(tmp_path, cc.ANT_REAIM, lambda maze, m, p: reaim_rate, drop=25)  # two cells: u_chain_1 seeds 0, 1
+    lay_grid(tmp_path, grid, lambda maze, m, p: rate, drop=25)  # two cells: u_chain_1 seeds 0, 1
     ant = cc.ant_study(tmp_path)
-    assert ant["grid"] == cc.ANT_GRID and ant["reaim_paired"]["cells"] == 2 and not ant["reaim_adopted"]
+    entry = next(c for c in ant["candidates"] if c["grid"] == grid)
+    assert ant["grid"] == cc.ANT_GRID and entry["paired"]["cells"] == 2 and not entry["adopted"]
     rules = [v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant")]
     assert rules[0]["rule"].startswith(f"Ant ({cc.ANT_METHOD})")
-    assert rules[-1]["verdict"] == "undecided (2 of 27 cells)"
-    assert f"{cc.ANT_REAIM} ({cc.REAIM}): u_chain_1 {reaim_rate:.3f} (2 runs); below" in cc._ant_text(ant)
+    mine = next(v for v in rules if v["rule"].startswith(f"Ant: {method} - "))
+    assert mine["verdict"] == "undecided (2 of 27 cells)"
+    assert f"{grid} ({method}): u_chain_1 {rate:.3f} (2 runs); below" in cc._ant_text(ant)
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_1 | 3 | 0.900 [" in md and f"`{cc.ANT_BEFORE}`, ours-corrector" in md
-    lay_grid(tmp_path, cc.ANT_REAIM, lambda maze, m, p: reaim_rate)
+    assert f"{method} - {cc.ANT_METHOD} on the cells both ran: +{rate - 0.9:.3f} [" in md
+    lay_grid(tmp_path, grid, lambda maze, m, p: rate)
     ant = cc.ant_study(tmp_path)
-    assert ant["reaim_adopted"] is adopted and ant["grid"] == (cc.ANT_REAIM if adopted else cc.ANT_GRID)
+    entry = next(c for c in ant["candidates"] if c["grid"] == grid)
+    assert entry["adopted"] is adopted and ant["grid"] == (grid if adopted else cc.ANT_GRID)
     rules = [v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant")]
-    assert rules[-1]["verdict"] == ("adopted" if adopted else "not adopted")
-    assert rules[0]["verdict"] == ("holds" if adopted else "does not hold")  # reaim 0.99 everywhere; confirm 0.84
-    assert rules[0]["rule"].startswith(f"Ant ({cc.REAIM if adopted else cc.ANT_METHOD})")
+    mine = next(v for v in rules if v["rule"].startswith(f"Ant: {method} - "))
+    assert mine["verdict"] == ("adopted" if adopted else "not adopted")
+    assert rules[0]["verdict"] == ("holds" if adopted else "does not hold")  # 0.99 everywhere; confirm 0.84
+    assert rules[0]["rule"].startswith(f"Ant ({method if adopted else cc.ANT_METHOD})")
     assert ("(adopted: the Ant's rules read" in cc._ant_text(ant)) is adopted
+
+
+def test_where_both_candidates_hold_the_one_with_the_higher_pooled_success_is_read(tmp_path):
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
+    lay_grid(tmp_path, cc.ANT_REAIM, lambda maze, m, p: 0.97)
+    lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.99)
+    ant = cc.ant_study(tmp_path)
+    assert [c["adopted"] for c in ant["candidates"]] == [True, True]
+    assert [c["pooled"] for c in ant["candidates"]] == pytest.approx([0.97, 0.99])
+    assert (ant["grid"], ant["method"]) == (cc.ANT_REDRAW, cc.REDRAW)
+    rules = {v["rule"].split(" - ")[0]: v["verdict"] for v in cc.verdicts(cc.point_study(tmp_path), ant)
+             if v["rule"].startswith("Ant: ours-corrector-re") and " above 0 " in v["rule"]}
+    assert rules == {f"Ant: {cc.REAIM}": f"holds; {cc.REDRAW} read (higher pooled success)",
+                     f"Ant: {cc.REDRAW}": "adopted"}
 
 
 def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):
@@ -825,11 +849,12 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     lines = table.strip().splitlines()
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 3  # + the two held-out mixes + the Ant's three rules
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 4  # + the two held-out mixes + the Ant's four rules
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
-    assert rules[-3].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-2].startswith(f"Ant: {cc.ANT_METHOD}")
-    assert rules[-1].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
+    assert rules[-4].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-3].startswith(f"Ant: {cc.ANT_METHOD}")
+    assert rules[-2].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
+    assert rules[-1].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
 

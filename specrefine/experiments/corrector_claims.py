@@ -5,7 +5,8 @@
 Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
 and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
 alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corrector-spread`` and
-``ant-corrector-reaim`` beside it; reaim read instead once its adoption rule holds) with the
+``ant-corrector-reaim`` and ``ant-corrector-redraw`` beside it; one of them read instead once its adoption rule holds)
+with the
 Ant scaling grid's one-shot;
 writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
 rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
@@ -148,9 +149,13 @@ ANT_GRID, ANT_METHOD = "ant-corrector-confirm", "ours-corrector-confirm"
 #: the same cells with ours-corrector at the fixed code (stopped at 10 of 27): shown beside, cell for cell
 ANT_BEFORE = "ant-corrector-spread"
 ANT_FIRST = "ant-corrector"  # ours-corrector before spread start states (stopped at 10 of 27; ant.csv)
-#: the same cells with the re-aiming corrector (docs/corrector.md, "Aimed clear of the walls: the Ant"): the Ant's rules
-#: read it instead of ANT_GRID once REAIM - ANT_METHOD over every paired cell has a 95 % interval above 0
+#: the same cells with the re-aiming corrector (docs/corrector.md, "Aimed clear of the walls: the Ant") and with a
+#: second correction pass ("A second draw for the Ant"): the Ant's rules read one of them instead of ANT_GRID once it
+#: - ANT_METHOD over every paired cell has a 95 % interval above 0; where both do, the one with the higher pooled
+#: success
 ANT_REAIM, REAIM = "ant-corrector-reaim", "ours-corrector-reaim"
+ANT_REDRAW, REDRAW = "ant-corrector-redraw", "ours-corrector-redraw"
+ANT_CANDIDATES = {ANT_REAIM: REAIM, ANT_REDRAW: REDRAW}
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
@@ -278,19 +283,28 @@ def table_name(maze: str) -> str:
 
 
 def ant_study(root: Path = ROOT) -> dict | None:
-    """The Ant's rules on ``ANT_GRID`` (``ANT_METHOD``), or on ``ANT_REAIM`` once adopted, with ``ANT_BEFORE``'s cells
-    (ours-corrector) and ``ANT_REAIM``'s beside and their pooled differences from ANT_METHOD on the cells both ran;
-    None while no grid has a cell."""
-    confirm = _ant_grid_study(ANT_GRID, ANT_METHOD, root)
-    before, reaim = _ant_grid_study(ANT_BEFORE, METHOD, root), _ant_grid_study(ANT_REAIM, REAIM, root)
-    if not any(e["runs"] for e in confirm["per_maze"] + before["per_maze"] + reaim["per_maze"]):
+    """The Ant's rules on ``ANT_GRID`` (``ANT_METHOD``), or on the ``ANT_CANDIDATES`` grid adopted, with
+    ``ANT_BEFORE``'s cells (ours-corrector) and each candidate's beside and their pooled differences from ANT_METHOD
+    on the cells both ran; None while no grid has a cell."""
+    confirm, before = _ant_grid_study(ANT_GRID, ANT_METHOD, root), _ant_grid_study(ANT_BEFORE, METHOD, root)
+    studies = {grid: _ant_grid_study(grid, method, root) for grid, method in ANT_CANDIDATES.items()}
+    if not any(e["runs"] for study in (confirm, before, *studies.values()) for e in study["per_maze"]):
         return None
-    reaim_paired = _ant_paired((ANT_REAIM, REAIM), (ANT_GRID, ANT_METHOD), root)
-    adopted = reaim_paired["complete"] and reaim_paired["ci"][0] > 0
-    now, grid, method = (reaim, ANT_REAIM, REAIM) if adopted else (confirm, ANT_GRID, ANT_METHOD)
+    candidates = [_ant_candidate(grid, method, studies[grid], root) for grid, method in ANT_CANDIDATES.items()]
+    adopted = max((c for c in candidates if c["adopted"]), key=lambda c: c["pooled"], default=None)
+    now, grid, method = (studies[adopted["grid"]], adopted["grid"], adopted["method"]) if adopted else \
+        (confirm, ANT_GRID, ANT_METHOD)
     return now | {"grid": grid, "method": method, "confirm": confirm["per_maze"], "before": before["per_maze"],
-                  "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root),
-                  "reaim": reaim["per_maze"], "reaim_paired": reaim_paired, "reaim_adopted": adopted}
+                  "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates}
+
+
+def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
+    """A candidate for the Ant's corrector: its cells per maze, its paired difference from ANT_METHOD, whether its
+    rule holds (every paired cell ran, the 95 % interval above 0) and its pooled success."""
+    paired = _ant_paired((grid, method), (ANT_GRID, ANT_METHOD), root)
+    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
+    return {"grid": grid, "method": method, "per_maze": study["per_maze"], "paired": paired,
+            "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan}
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
@@ -299,7 +313,7 @@ def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
     maze_rows = []
     for maze in SCALING_MAZES:
         k, n, runs = episodes_of(rows, maze, method, proposer, ANT_SEEDS)
-        entry = {"maze": maze, "runs": runs, "success": k / n if n else math.nan}
+        entry = {"maze": maze, "runs": runs, "successes": k, "episodes": n, "success": k / n if n else math.nan}
         if n:
             entry["ci_low"], entry["ci_high"] = wilson_ci(k, n)
         maze_rows.append(entry)
@@ -740,7 +754,7 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
 
 
 def _ant_verdicts(ant: dict) -> list[dict]:
-    """The Ant's floor and ratio rules on the adopted grid, and the re-aiming corrector's adoption rule."""
+    """The Ant's floor and ratio rules on the adopted grid, and each candidate corrector's adoption rule."""
     floor = f"Ant ({ant['method']}), imperfect:moderate: at least {ANT_FLOOR} on every maze"
     if not any(e["runs"] for e in ant["per_maze"]):
         out = [{"rule": floor, "value": f"{ant['grid']}: no cell yet", "verdict": "not run yet"}]
@@ -754,11 +768,20 @@ def _ant_verdicts(ant: dict) -> list[dict]:
                 "verdict": _verdict(not low, complete)},
                {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                 "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
-    e = ant["reaim_paired"]
-    verdict = ("adopted" if ant["reaim_adopted"] else "not adopted") if e["complete"] else \
-        f"undecided ({e['cells']} of {e['expected']} cells)"
-    return out + [{"rule": f"Ant: {REAIM} - {ANT_METHOD} above 0 (95 % interval, every paired cell; adopted as the "
-                           "Ant's corrector)", "value": _ant_paired_text(e), "verdict": verdict}]
+    return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]]
+
+
+def _candidate_verdict(candidate: dict, read: str) -> dict:
+    """A candidate's adoption rule: "adopted" when the Ant's rules read it, "holds" when its rule holds but another
+    candidate with a higher pooled success is read."""
+    e = candidate["paired"]
+    if not e["complete"]:
+        verdict = f"undecided ({e['cells']} of {e['expected']} cells)"
+    else:
+        verdict = "not adopted" if not candidate["adopted"] else "adopted" if candidate["method"] == read else \
+            f"holds; {read} read (higher pooled success)"
+    return {"rule": f"Ant: {candidate['method']} - {ANT_METHOD} above 0 (95 % interval, every paired cell; adopted "
+                    "as the Ant's corrector)", "value": _ant_paired_text(e), "verdict": verdict}
 
 
 def _paired_text(e: dict) -> str:
@@ -842,18 +865,23 @@ def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers
 
 
 def ant_markdown(ant: dict) -> list[str]:
-    """The Ant's cells per maze in ANT_GRID, ANT_REAIM and ANT_BEFORE, their paired differences and ratios."""
+    """The Ant's cells per maze in ANT_GRID, each of ANT_CANDIDATES and ANT_BEFORE, their paired differences and
+    ratios."""
+    candidates = ant["candidates"]
     lines = ["", f"The Ant (imperfect:moderate, stage 5, centre goal points), pooled per maze (Wilson 95 %): "
-             f"`{ANT_GRID}` ({ANT_METHOD}); `{ANT_REAIM}` ({REAIM}, the Ant's corrector if its rule holds; "
-             f"docs/corrector.md, 'Aimed clear of the walls: the Ant'); `{ANT_BEFORE}`, ours-corrector on the same "
-             "cells (stopped at its 10; 'The Ant with a confirmed pick'), described. "
-             f"The rules read `{ant['grid']}`.", "",
-             f"| maze | {ANT_METHOD}: runs | success [95 % CI] | {REAIM}: runs | success [95 % CI] | "
-             f"{ANT_BEFORE}: runs | success |", "|---|---|---|---|---|---|---|"]
-    for e, new, old in zip(ant["confirm"], ant["reaim"], ant["before"]):
-        lines.append(f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} | {new['runs']} | {_rate_ci(new)} | "
-                     f"{old['runs']} | {_num(old['success'])} |")
-    lines += ["", f"{REAIM} - {ANT_METHOD} on the cells both ran: {_ant_paired_text(ant['reaim_paired'])}.",
+             f"`{ANT_GRID}` ({ANT_METHOD}); " + "; ".join(f"`{c['grid']}` ({c['method']}, the Ant's corrector if "
+                                                          "its rule holds)" for c in candidates)
+             + " (docs/corrector.md, 'Aimed clear of the walls: the Ant' and 'A second draw for the Ant'); "
+             f"`{ANT_BEFORE}`, ours-corrector on the same cells (stopped at its 10; 'The Ant with a confirmed pick'), "
+             f"described. The rules read `{ant['grid']}`.", "",
+             f"| maze | {ANT_METHOD}: runs | success [95 % CI] | "
+             + "".join(f"{c['method']}: runs | success [95 % CI] | " for c in candidates)
+             + f"{ANT_BEFORE}: runs | success |", "|---|---|---|" + "---|---|" * len(candidates) + "---|---|"]
+    for i, (e, old) in enumerate(zip(ant["confirm"], ant["before"])):
+        new = "".join(f"{c['per_maze'][i]['runs']} | {_rate_ci(c['per_maze'][i])} | " for c in candidates)
+        lines.append(f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} | {new}{old['runs']} | {_num(old['success'])} |")
+    lines += [""] + [f"{c['method']} - {ANT_METHOD} on the cells both ran: {_ant_paired_text(c['paired'])}."
+                     for c in candidates] + [
               f"{ANT_METHOD} - ours-corrector on the cells both ran: {_ant_paired_text(ant['paired'])}.",
               "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
     return lines + [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
@@ -1140,7 +1168,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
-             ANT_BEFORE, ANT_GRID, ANT_REAIM)
+             ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -1237,7 +1265,8 @@ def _known(variants: dict) -> None:
 
 
 def _ant_text(ant: dict) -> str:
-    """The Ant's cells per maze in ANT_GRID, ANT_REAIM and ANT_BEFORE, with their pooled differences from ANT_GRID."""
+    """The Ant's cells per maze in ANT_GRID, ANT_BEFORE and each of ANT_CANDIDATES, with their pooled differences
+    from ANT_GRID."""
     def cells(per_maze):
         ran = [e for e in per_maze if e["runs"]]
         low = sum(e["success"] < ANT_FLOOR for e in ran)
@@ -1245,9 +1274,10 @@ def _ant_text(ant: dict) -> str:
                 + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
     return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['confirm'])}. {ANT_BEFORE} (ours-corrector, stopped): "
             f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}. "
-            f"{ANT_REAIM} ({REAIM}): {cells(ant['reaim'])}; {REAIM} - {ANT_METHOD} on the cells both ran: "
-            f"{_ant_paired_text(ant['reaim_paired'])}"
-            + (f" (adopted: the Ant's rules read {ANT_REAIM})" if ant["reaim_adopted"] else ""))
+            + ". ".join(f"{c['grid']} ({c['method']}): {cells(c['per_maze'])}; {c['method']} - {ANT_METHOD} on the "
+                        f"cells both ran: {_ant_paired_text(c['paired'])}"
+                        + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
+                        for c in ant["candidates"]))
 
 
 def _ant_paired_text(e: dict) -> str:
