@@ -137,7 +137,8 @@ def test_show_tells_a_running_run_and_its_correction_so_far(runs, tmp_path, caps
     with log.open("a") as fh:
         for step in ({"step": 50, "event": "correct-check", "path": ["S", "x0", "x1", "G"], "p": 0.5},
                      {"step": 51, "event": "correct-leg", "accepted": "split", "proposer_calls": 7},
-                     {"step": 52, "event": "correct-leg", "accepted": None, "proposer_calls": 8}):
+                     {"step": 52, "event": "correct-leg", "accepted": None, "proposer_calls": 8},
+                     {"step": 53, "event": "correct-done", "path": ["S", "x0", "x2", "x1", "G"], "p": 0.9}):
             fh.write(json.dumps(step) + "\n")
     capsys.readouterr()
     assert main(["show", str(run)]) == 0
@@ -145,7 +146,13 @@ def test_show_tells_a_running_run_and_its_correction_so_far(runs, tmp_path, caps
     assert f"state: running (pid {os.getpid()})" in out and ", 8 proposer calls" in out
     assert "correction: the found path's fresh check 0.500 over 3 legs; 2 legs tried, 1 alternatives taken (split 1)" \
         in out
-    assert "last step: correct-leg (#52), " in out
+    assert "last step: correct-done (#53), " in out  # not "search done": another pass may follow
+    with log.open("a") as fh:  # a second pass on a fresh draw (correct_passes=2) begins
+        fh.write(json.dumps({"step": 54, "event": "correct-check", "path": ["S", "x0", "x2", "x1", "G"], "p": 0.8,
+                             "correct_pass": 2}) + "\n")
+    assert main(["show", str(run)]) == 0
+    assert "fresh check 0.500 over 3 legs; pass 2's fresh check 0.800 over 4 legs; 2 legs tried" in \
+        capsys.readouterr().out
 
 
 def test_show_reads_no_linked_step_log_and_a_folder_no_run_started_in_is_refused(runs, tmp_path, capsys):

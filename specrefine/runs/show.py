@@ -239,16 +239,23 @@ def _steps(path: Path) -> list[dict]:
 
 
 def _correction_so_far(steps: list[dict]) -> str:
-    """The correction's fresh check of the found path and the legs it has tried, where it has begun."""
-    check = next((s for s in steps if s.get("event") == "correct-check"), None)
-    if check is None:
+    """The correction's fresh check of the found path (and the latest pass's, where a later pass began) and the legs
+    it has tried, where it has begun."""
+    checks = [s for s in steps if s.get("event") == "correct-check"]
+    if not checks:
         return ""
     legs = [s for s in steps if s.get("event") == "correct-leg"]
     taken = Counter(str(s["accepted"]) for s in legs if s.get("accepted"))
-    path = check.get("path") or []
-    return (f"correction: the found path's fresh check {_rate(check.get('p'))} over {max(len(path) - 1, 0)} legs; "
-            f"{len(legs)} legs tried, {sum(taken.values())} alternatives taken"
+    latest = checks[-1]
+    later = (f"; pass {latest.get('correct_pass', len(checks))}'s fresh check {_rate(latest.get('p'))} over "
+             f"{_legs(latest)} legs" if len(checks) > 1 else "")
+    return (f"correction: the found path's fresh check {_rate(checks[0].get('p'))} over {_legs(checks[0])} legs"
+            f"{later}; {len(legs)} legs tried, {sum(taken.values())} alternatives taken"
             + (" (" + ", ".join(f"{kind} {n}" for kind, n in taken.items()) + ")" if taken else ""))
+
+
+def _legs(step: dict) -> int:
+    return max(len(step.get("path") or []) - 1, 0)
 
 
 def _phase(steps: list[dict], log: Path) -> str:
@@ -262,7 +269,7 @@ def _phase(steps: list[dict], log: Path) -> str:
     last = steps[-1].get("event")
     if log.name == "steps.jsonl":
         return f"search, measurement and calibration done{ago}: measuring the input task, drawing, writing its result"
-    if last in ("done", "correct-done"):
+    if last == "done":  # a correction pass's end ("correct-done") may be followed by another pass
         return f"search done{ago}: measuring the found path (then calibration)"
     return f"last step: {last} (#{steps[-1].get('step', len(steps) - 1)}){ago}"
 
