@@ -50,6 +50,13 @@ region's centre among those as clear of walls as the region allows (``Evaluator.
 centred near a corridor's wall leaves its leg hugging that wall; aimed at the corridor's middle line the leg keeps
 clear of it, and the region, and so the task, stays the same. Judged like any alternative.
 
+``crosscheck`` (method ``ours-corrector-crosscheck``): an alternative that wins on the check's draw replaces the path
+only if it also beats it over the same window on a second draw of its own (new first states, the path checked there
+too and kept up to date as the first): the best of several alternatives on one draw is the winner of that draw, and
+where the differences are a rollout or two (the Ant's legs lose a fraction of a per cent each) the draw picks it as
+much as the policy does. On the second draw a strictly higher score suffices (a tie keeps the path). It costs
+evaluations, never a proposer call.
+
 Every alternative is a refinement of the same input edge (a longer or shorter chain of waypoints), so the refined
 graph still implies the input graph (Theorem 4.1, checked like every refinement). What the correction sees is what
 a real proposer's reply gives: waypoints, pictures and rollouts.
@@ -68,6 +75,7 @@ from .common import Leg, LegEstimates, SubtaskEvaluator, estimate_legs, live_sta
 from .shortcut import Shortcut, add_shortcuts, shortcuts
 
 CHECK_SEED_OFFSET = 104_729  # the correction's fresh rollouts: apart from the search's, polish's and the measurement's
+CROSS_SEED_OFFSET = 32_452_843  # ``crosscheck``'s second draw: apart from the check's and each pass's
 PASS_SEED_STEP = 15_485_863  # each further pass of the correction (SearchConfig.correct_passes) draws apart again
 
 
@@ -175,7 +183,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             split_leg: Callable, may_split: Callable[[], bool], reach: float, clearance: float,
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
             first_win: bool = False, advance: bool = False,
-            roadmap: Callable | None = None, reaim: Callable | None = None) -> tuple[TaskGraph, list[str], Check]:
+            roadmap: Callable | None = None, reaim: Callable | None = None,
+            crosscheck: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -187,10 +196,15 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     after its live legs replaces the path where it gets nearer the leg's end, and while the path is dead only its dead
     legs are tried (module doc); ``roadmap(a, b, start)`` -> a ``roadmap.Chain`` over the run's pooled waypoints,
     offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's); ``reaim(region)`` ->
-    the point a re-aimed waypoint of that region aims at (module doc)."""
+    the point a re-aimed waypoint of that region aims at; ``crosscheck``: a win is taken only if it also wins on a
+    second draw (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
-    log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities)
+    if crosscheck:
+        state.second = check_path(graph, path, evaluator, rollouts=rollouts, seed=seed + CROSS_SEED_OFFSET,
+                                  start=graph.region(path[0]))
+    log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities,
+        **({"p_second": state.second.p} if crosscheck else {}))
     tried: set = set()
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
@@ -208,7 +222,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             tried=seen, accepted=accepted)
     if lean:
         _prune(state, reach, clearance, log)
-    log("correct-done", path=state.path, p=state.check.p, probabilities=state.check.probabilities)
+    log("correct-done", path=state.path, p=state.check.p, probabilities=state.check.probabilities,
+        **({"p_second": state.second.p} if crosscheck else {}))
     return state.graph, state.path, state.check
 
 
@@ -280,14 +295,24 @@ class _State:
     seed: int
     lean: bool
     advance: bool = False
+    second: Check | None = None  # ``crosscheck``: the path's check on the second draw
 
     def score(self, check: Check) -> float:
         return lean_score(check) if self.lean else check.p
 
-    def start_of_leg(self, i: int):
-        """Where leg ``i`` of the path starts on the fresh check: the first region, else the end states of the
-        previous leg's successes (None where none succeeded)."""
-        return self.graph.region(self.path[0]) if i == 0 else start_of(self.check.results[i - 1])
+    def start_of_leg(self, i: int, check: Check | None = None):
+        """Where leg ``i`` of the path starts on the fresh check (or on ``check``): the first region, else the end
+        states of the previous leg's successes (None where none succeeded)."""
+        return self.graph.region(self.path[0]) if i == 0 else start_of((check or self.check).results[i - 1])
+
+    def crosschecked(self, alt_graph: TaskGraph, alt_path: list[str], s: int, e: int) -> tuple[bool, float, float]:
+        """Whether ``alt_path`` beats the path over the window path[s] .. path[e] on the second draw -> (it does,
+        the path's score there, the alternative's)."""
+        seed, start = self.seed + CROSS_SEED_OFFSET, self.start_of_leg(s, self.second)
+        alt = check_path(alt_graph, alt_path[s:alt_path.index(self.path[e]) + 1], self.evaluator,
+                         rollouts=self.rollouts, seed=seed, start=start)
+        current = self.score(Check(results=self.second.results[s:e]))
+        return self.score(alt) > current, current, self.score(alt)
 
     def judge(self, leg: int, options: list) -> tuple[Judged, str | None]:
         """Judge ``options`` (kind, graph, path) against the path over the window around ``leg``; the best replaces
@@ -311,11 +336,20 @@ class _State:
             for entry, gain in zip(tried, gains):
                 if gain is not None:
                     entry["nearer"] = gain
+        if wins and self.second is not None:
+            wins, here, there = self.crosschecked(best[1], best[2], s, e)
+            tried[next(i for i, option in enumerate(judged) if option is best)] |= {
+                "p_window_second": there, "p_current_second": here}
         if wins:
+            second_start = self.start_of_leg(s, self.second) if self.second is not None else None
             self.graph, self.path = best[1], best[2]
             rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=self.seed,
                               start=start)
             self.check = Check(results=check.results[:s] + rest.results, path=list(self.path))
+            if self.second is not None:
+                rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts,
+                                  seed=self.seed + CROSS_SEED_OFFSET, start=second_start)
+                self.second = Check(results=self.second.results[:s] + rest.results, path=list(self.path))
         return Judged(current, tried), best[0] if wins else None
 
 

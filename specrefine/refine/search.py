@@ -94,6 +94,8 @@ class SearchConfig:
     #                              the budget left, the path goes back to the edge it replaced, corrected as before
     correct_reaim: bool = False  # beyond the paper: the correction also offers a weak leg's end waypoints aimed at
     #                              their regions' clearest points (correct.py; method ours-corrector-reaim)
+    correct_crosscheck: bool = False  # beyond the paper: the correction takes a win only if it also wins on a second
+    #                                   draw (correct.py; method ours-corrector-crosscheck)
     correct_advance: bool = False  # beyond the paper: a dead leg's split cut after its live legs replaces the path
     #                                where it gets nearer the leg's end (correct.py; method ours-corrector-advance)
     correct_roadmap: bool = False  # beyond the paper: a dead leg of a dead path is first offered a chain over every
@@ -571,7 +573,8 @@ class RefinementSearch:
                                       min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
-                                      reaim=self.evaluator.clearest if self.cfg.correct_reaim else None)
+                                      reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
+                                      crosscheck=self.cfg.correct_crosscheck)
         return path, check
 
     def _roadmap_chain(self, graph, a, b, start):

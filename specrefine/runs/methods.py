@@ -358,6 +358,13 @@ register_method("ours-corrector-redraw", ours_variant(**CORRECTOR | dict(confirm
                 "it left on a fresh draw of its own (new first states, a budget of one proposer split per leg), so "
                 "that a leg chosen on one draw's rollouts is judged again on rollouts that did not choose it",
                 colour="#3e2723")
+#: ours-corrector-crosscheck: confirm, whose correction takes an alternative only where it also wins on a second draw
+#: (docs/corrector.md, "Wins checked on a second draw")
+register_method("ours-corrector-crosscheck",
+                ours_variant(**CORRECTOR | dict(confirm_pick=True, correct_crosscheck=True)),
+                "beyond the paper: ours-corrector-confirm whose correction takes an alternative that wins on the "
+                "check's fresh rollouts only if it also beats the path over the same legs on a second fresh draw "
+                "of its own (new first states; no proposer call)", colour="#4e342e")
 register_method("ours-corrector-retry", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
                                                                        empty_retries=2)),
                 "beyond the paper: ours-corrector-precise asking the proposer again, up to twice, when its reply "
