@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from test_corrector import LUCKY, AnswerBook, LegTable, run, xs
+from test_corrector import FAR_DEAD, LUCKY, ONWARD, AnswerBook, EdgeQueue, LegTable, run, xs
 
 from specrefine.core.graph import check_refines
 from specrefine.refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET
@@ -59,3 +59,13 @@ def test_ours_corrector_crosscheck_runs_end_to_end_and_logs_both_draws(tmp_path)
     done = next(s for s in steps if s["event"] == "correct-done")
     assert 0.0 <= done["p_second"] <= 1.0
     assert get_method("ours-corrector-crosscheck").name == result["method"] == "ours-corrector-crosscheck"
+
+
+def test_ground_won_on_a_dead_path_is_not_crosschecked():
+    # a dead window scores 0 on both draws whatever replaces it: advance's "nearer" rule judges it, as without
+    book = EdgeQueue(ONWARD)
+    g, result = run(LegTable(FAR_DEAD), book, correct_rollouts=4, correct_while_dead=True, correct_advance=True,
+                    correct_crosscheck=True)
+    assert xs(result) == [0.0, 3.0, 6.0, 8.0, 10.0] and check_refines(result.graph, g) == []
+    advanced = [s for s in result.steps if s["event"] == "correct-leg" and s["accepted"] == "advance"]
+    assert len(advanced) == 1 and all("p_window_second" not in t for t in advanced[0]["tried"])

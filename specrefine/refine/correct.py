@@ -336,7 +336,7 @@ class _State:
             for entry, gain in zip(tried, gains):
                 if gain is not None:
                     entry["nearer"] = gain
-        if wins and self.second is not None:
+        if wins and self.second is not None and current > 0.0:  # a dead window's advance is judged by ground won
             wins, here, there = self.crosschecked(best[1], best[2], s, e)
             tried[next(i for i, option in enumerate(judged) if option is best)] |= {
                 "p_window_second": there, "p_current_second": here}
