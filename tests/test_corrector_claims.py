@@ -337,9 +337,10 @@ def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rule
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_1 | 3 | 0.900 [" in md and f"`{cc.ANT_BEFORE}`, ours-corrector" in md
     assert f"{method} - {cc.ANT_METHOD} on the cells both ran: +{rate - 0.9:.3f} [" in md
-    lay_grid(tmp_path, grid, lambda maze, m, p: rate)
+    lay_grid(tmp_path, grid, lambda maze, m, p: rate, calls_of=lambda m: 6)  # twice confirm's 3 calls a cell
     ant = cc.ant_study(tmp_path)
     entry = next(c for c in ant["candidates"] if c["grid"] == grid)
+    assert f"| {method} | 27 | 2.00x | 1.00x | " in cc.markdown(cc.point_study(tmp_path), ant)
     assert entry["adopted"] is adopted and ant["grid"] == (grid if adopted else cc.ANT_GRID)
     rules = [v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant")]
     mine = next(v for v in rules if v["rule"].startswith(f"Ant: {method} - "))

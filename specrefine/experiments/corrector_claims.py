@@ -303,8 +303,11 @@ def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
     rule holds (every paired cell ran, the 95 % interval above 0) and its pooled success."""
     paired = _ant_paired((grid, method), (ANT_GRID, ANT_METHOD), root)
     k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
+    rows = load(GRIDS[grid].tables + GRIDS[ANT_GRID].tables, root)
     return {"grid": grid, "method": method, "per_maze": study["per_maze"], "paired": paired,
-            "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan}
+            "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan,
+            "cost_vs_confirm": costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, ANT_METHOD),
+            "cost_vs_ours": study["costs"]}
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
@@ -883,8 +886,20 @@ def ant_markdown(ant: dict) -> list[str]:
     lines += [""] + [f"{c['method']} - {ANT_METHOD} on the cells both ran: {_ant_paired_text(c['paired'])}."
                      for c in candidates] + [
               f"{ANT_METHOD} - ours-corrector on the cells both ran: {_ant_paired_text(ant['paired'])}.",
+              "", "Cost of each candidate: mean proposer calls and evaluations over those of "
+              f"{ANT_METHOD} and of ours on the cells both ran.", "",
+              "| method | pairs with confirm | calls | evaluations | pairs with ours | calls | evaluations |",
+              "|---|---|---|---|---|---|---|"] + [
+              f"| {c['method']} | {_cost_cells(c['cost_vs_confirm'])} | {_cost_cells(c['cost_vs_ours'])} |"
+              for c in candidates] + [
               "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
     return lines + [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+
+
+def _cost_cells(c: dict) -> str:
+    """A cost's pairs, proposer calls and evaluations ratios as three table cells."""
+    return " | ".join([str(c["pairs"])] + ["—" if math.isnan(c[key]) else f"{c[key]:.2f}x"
+                                           for key in ("proposer_calls_ratio", "evaluations_ratio")])
 
 
 def _rate_ci(e: dict) -> str:
