@@ -201,7 +201,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
     if crosscheck:
-        state.second = check_path(graph, path, evaluator, rollouts=rollouts, seed=seed + CROSS_SEED_OFFSET,
+        state.second = check_path(graph, path, evaluator, rollouts=rollouts, seed=state.second_seed,
                                   start=graph.region(path[0]))
     log("correct-check", path=path, p=state.check.p, probabilities=state.check.probabilities,
         **({"p_second": state.second.p} if crosscheck else {}))
@@ -297,6 +297,10 @@ class _State:
     advance: bool = False
     second: Check | None = None  # ``crosscheck``: the path's check on the second draw
 
+    @property
+    def second_seed(self) -> int:
+        return self.seed + CROSS_SEED_OFFSET
+
     def score(self, check: Check) -> float:
         return lean_score(check) if self.lean else check.p
 
@@ -308,11 +312,10 @@ class _State:
     def crosschecked(self, alt_graph: TaskGraph, alt_path: list[str], s: int, e: int) -> tuple[bool, float, float]:
         """Whether ``alt_path`` beats the path over the window path[s] .. path[e] on the second draw -> (it does,
         the path's score there, the alternative's)."""
-        seed, start = self.seed + CROSS_SEED_OFFSET, self.start_of_leg(s, self.second)
         alt = check_path(alt_graph, alt_path[s:alt_path.index(self.path[e]) + 1], self.evaluator,
-                         rollouts=self.rollouts, seed=seed, start=start)
-        current = self.score(Check(results=self.second.results[s:e]))
-        return self.score(alt) > current, current, self.score(alt)
+                         rollouts=self.rollouts, seed=self.second_seed, start=self.start_of_leg(s, self.second))
+        current, score = self.score(Check(results=self.second.results[s:e])), self.score(alt)
+        return score > current, current, score
 
     def judge(self, leg: int, options: list) -> tuple[Judged, str | None]:
         """Judge ``options`` (kind, graph, path) against the path over the window around ``leg``; the best replaces
@@ -343,14 +346,15 @@ class _State:
         if wins:
             second_start = self.start_of_leg(s, self.second) if self.second is not None else None
             self.graph, self.path = best[1], best[2]
-            rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=self.seed,
-                              start=start)
-            self.check = Check(results=check.results[:s] + rest.results, path=list(self.path))
+            self.check = self._checked_from(s, check, start, self.seed)
             if self.second is not None:
-                rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts,
-                                  seed=self.seed + CROSS_SEED_OFFSET, start=second_start)
-                self.second = Check(results=self.second.results[:s] + rest.results, path=list(self.path))
+                self.second = self._checked_from(s, self.second, second_start, self.second_seed)
         return Judged(current, tried), best[0] if wins else None
+
+    def _checked_from(self, s: int, check: Check, start, seed: int) -> Check:
+        """``check``'s legs before leg ``s``, and the (new) path's legs from there estimated again from ``start``."""
+        rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=seed, start=start)
+        return Check(results=check.results[:s] + rest.results, path=list(self.path))
 
 
 def _furthest(graph: TaskGraph, path: list[str], leg: int, s: int, judged: list) -> tuple[tuple | None, list]:
