@@ -301,9 +301,9 @@ def ant_study(root: Path = ROOT) -> dict | None:
 def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
     """A candidate for the Ant's corrector: its cells per maze, its paired difference from ANT_METHOD, whether its
     rule holds (every paired cell ran, the 95 % interval above 0) and its pooled success."""
-    paired = _ant_paired((grid, method), (ANT_GRID, ANT_METHOD), root)
-    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
     rows = load(GRIDS[grid].tables + GRIDS[ANT_GRID].tables, root)
+    paired = _ant_paired_rows(rows, method, ANT_METHOD)
+    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
     return {"grid": grid, "method": method, "per_maze": study["per_maze"], "paired": paired,
             "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan,
             "cost_vs_confirm": costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, ANT_METHOD),
@@ -331,11 +331,16 @@ def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
 
 def _ant_paired(first: tuple[str, str], second: tuple[str, str], root: Path) -> dict:
     """``first`` - ``second`` (each a grid and its method) pooled over the cells both ran (``levers.lever_check``)."""
+    return _ant_paired_rows(load(GRIDS[first[0]].tables + GRIDS[second[0]].tables, root), first[1], second[1])
+
+
+def _ant_paired_rows(rows: list[dict], first: str, second: str) -> dict:
+    """``first`` - ``second`` (methods) pooled over the Ant's cells both finished in ``rows``."""
     from .levers import lever_check
 
-    rows = [r for r in load(GRIDS[first[0]].tables + GRIDS[second[0]].tables, root) if cmp.is_done(r)]
-    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m} for m in (first[1], second[1])}
-    return lever_check(by[first[1]], by[second[1]], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
+    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m and cmp.is_done(r)}
+          for m in (first, second)}
+    return lever_check(by[first], by[second], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
 
 
 def levers_study(root: Path = ROOT) -> dict | None:
