@@ -149,16 +149,22 @@ def unfinished_text(run_dir: Path) -> str | None:
     return "\n".join(lines + _progress(log))
 
 
-def _progress(log: Path | None) -> list[str]:
-    """What a run's step log says so far: its steps by kind with the proposer calls, the correction, the phase."""
+def _progress(log: Path | None, counts: bool = True) -> list[str]:
+    """What a run's step log says so far: its steps by kind with the proposer calls (``counts``), the correction,
+    the phase."""
     steps = _steps(log) if log is not None else []
     if not steps:
         return ["no search step logged yet"]
+    lines = [_counts(steps)] if counts else []
+    return lines + [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
+
+
+def _counts(steps: list[dict]) -> str:
+    """The steps logged by kind, with the proposer calls so far."""
     counts = Counter(str(step.get("event", "?")) for step in steps)
     calls = next((s["proposer_calls"] for s in reversed(steps) if isinstance(s.get("proposer_calls"), int)), None)
-    lines = [f"so far: {len(steps)} search steps (" + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
-             + (f", {calls} proposer calls" if calls is not None else "")]
-    return lines + [line for line in (_correction_so_far(steps), _phase(steps, log)) if line]
+    return (f"so far: {len(steps)} search steps (" + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
+            + (f", {calls} proposer calls" if calls is not None else ""))
 
 
 def sweep_text(out: Path) -> str | None:
@@ -193,7 +199,7 @@ def _cell_detail(state: str, row: dict | None, folder: Path) -> str:
     if state == "failed":
         return str(row.get("error") or row.get("status"))
     if state in ("running", "stopped"):
-        return "; ".join(line for line in _progress(_step_log(folder)) if not line.startswith("so far"))
+        return "; ".join(_progress(_step_log(folder), counts=False))
     return ""
 
 
