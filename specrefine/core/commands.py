@@ -45,6 +45,8 @@ COMMANDS: dict[str, Command] = {
                                 "the corrector grids' rules decided from their shipped tables"),
     "corrector-diagnosis": Command("specrefine.experiments.corrector_diagnosis",
                                    "where ours-corrector still loses and where its proposer calls go"),
+    "correction-ledger": Command("specrefine.experiments.correction_ledger",
+                                 "what each run's correction decided, and its last check against the measured success"),
     "figures": Command("specrefine.experiments.figures", "the paper's Figures 4-6 from a sweep table"),
     "bench": Command("specrefine.bench.__main__", "throughput benchmarks: evaluator, gymenv, train, refine"),
     "notebook": Command("specrefine.runs.notebook", "executed copies of the numbered notebooks"),

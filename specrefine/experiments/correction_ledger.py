@@ -1,0 +1,140 @@
+"""What each run's correction decided, one row per run, read from its run folder (issue 39).
+
+    specrefine correction-ledger runs/ant_corrector_redraw --out data/results/corrector/ledger/redraw
+
+Descriptive, no rule. For every finished run whose search corrected its path (``correct-check`` steps in its
+``steps.jsonl``): its passes; the path's legs at the first check and at the end; the legs it tried to correct; the
+alternatives it took, by kind; the wins a second draw refuted (``ours-corrector-crosscheck``); and each pass's fresh
+estimate of the path at its end, beside the success measured in the run's fresh episodes. The last of those estimates
+minus the measured success says how much the correction's own check flatters the path it chose (it chose the path on
+those rollouts). Writes ``ledger.csv`` and ``ledger.md``; without ``--out`` prints the summary.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import SpecrefineError
+from ..core.results import wilson_ci
+from ..core.runfolder import ensure_dir, locked, write_atomic
+from .corrector_diagnosis import events
+from .taxonomy import Run, read_runs
+
+COLUMNS = ("cell", "maze", "agent", "method", "proposer", "seed", "passes", "legs_at_check", "legs_at_end",
+           "legs_tried", "taken", "taken_by_kind", "refuted", "check_p", "pass_end_p", "last_p", "success_rate",
+           "episodes", "last_p_minus_success", "last_p_above_interval")
+
+
+def refuted(step: dict) -> int:
+    """The wins of one ``correct-leg`` step that the second draw refuted (the path scored at least as well there)."""
+    return sum(1 for t in step["tried"] if "p_window_second" in t and t["p_window_second"] <= t["p_current_second"])
+
+
+def taken_kinds(row: dict) -> Counter:
+    """A row's ``taken_by_kind`` ("split:2 bypass:1") as counts."""
+    return Counter({kind: int(n) for kind, n in (entry.split(":") for entry in row["taken_by_kind"].split())})
+
+
+def ledger_row(run: Run) -> dict | None:
+    """The row of one run, or None where its search made no correction."""
+    checks, dones = events(run, "correct-check"), events(run, "correct-done")
+    if not checks or not dones:
+        return None
+    r, legs = run.result, events(run, "correct-leg")
+    taken = Counter(s["accepted"] for s in legs if s["accepted"])
+    success, episodes = float(r["success_rate"]), int(r["episodes"])
+    high = wilson_ci(round(success * episodes), episodes)[1]
+    return {"cell": run.cell, "maze": r["maze"], "agent": r.get("agent", ""), "method": r["method"],
+            "proposer": r["proposer"], "seed": r["seed"], "passes": len(dones),
+            "legs_at_check": len(checks[0]["path"]) - 1, "legs_at_end": len(dones[-1]["path"]) - 1,
+            "legs_tried": len(legs), "taken": sum(taken.values()),
+            "taken_by_kind": " ".join(f"{kind}:{n}" for kind, n in sorted(taken.items())),
+            "refuted": sum(map(refuted, legs)), "check_p": float(checks[0]["p"]),
+            "pass_end_p": ";".join(f"{d['p']:.4f}" for d in dones), "last_p": float(dones[-1]["p"]),
+            "success_rate": success, "episodes": episodes,
+            "last_p_minus_success": float(dones[-1]["p"]) - success,
+            "last_p_above_interval": float(dones[-1]["p"]) > high}
+
+
+def ledger(runs: list[Run]) -> list[dict]:
+    rows = [row for row in map(ledger_row, runs) if row is not None]
+    if not rows:
+        raise SpecrefineError("no finished run with a correction (correct-check steps) in the folders given")
+    return sorted(rows, key=lambda row: (row["method"], row["proposer"], row["seed"], row["maze"]))
+
+
+def to_csv(rows: list[dict]) -> str:
+    def cell(v) -> str:
+        return f"{v:.6g}" if isinstance(v, float) else str(v)
+    return "".join(",".join(cell(row[c]) for c in COLUMNS) + "\n" for row in [dict(zip(COLUMNS, COLUMNS)), *rows])
+
+
+def markdown(rows: list[dict]) -> str:
+    lines = ["Every proposer here is offline, NOT a VLM. Descriptive (no rule); `specrefine correction-ledger` "
+             "(specrefine/experiments/correction_ledger.py) from the run folders.", "",
+             "| method | proposer | runs | fresh estimate at the check | at the end of the last pass | measured "
+             "| last - measured | last above the measured 95 % interval | taken | refuted |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for (method, proposer), group in _groups(rows).items():
+        kinds = sum(map(taken_kinds, group), Counter())
+        lines.append(f"| {method} | {proposer} | {len(group)} | {np.mean([g['check_p'] for g in group]):.3f} | "
+                     f"{np.mean([g['last_p'] for g in group]):.3f} | "
+                     f"{np.mean([g['success_rate'] for g in group]):.3f} | "
+                     f"{np.mean([g['last_p_minus_success'] for g in group]):+.3f} | "
+                     f"{sum(g['last_p_above_interval'] for g in group)} of {len(group)} | "
+                     f"{' '.join(f'{k} {n}' for k, n in sorted(kinds.items())) or 'none'} | "
+                     f"{sum(g['refuted'] for g in group)} |")
+    lines += ["", "Per run (`pass_end_p`: each pass's fresh estimate of the path at its end):", "",
+              "| maze | method | seed | passes | legs at check | legs at end | tried | taken | refuted | check | "
+              "pass ends | measured |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['maze']} | {r['method']} | {r['seed']} | {r['passes']} | {r['legs_at_check']} | "
+              f"{r['legs_at_end']} | {r['legs_tried']} | {r['taken_by_kind'] or 'none'} | {r['refuted']} | "
+              f"{r['check_p']:.3f} | {r['pass_end_p'].replace(';', ', ')} | {r['success_rate']:.3f} |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def _groups(rows: list[dict]) -> dict[tuple, list[dict]]:
+    groups: dict[tuple, list[dict]] = {}
+    for row in rows:
+        groups.setdefault((row["method"], row["proposer"]), []).append(row)
+    return groups
+
+
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
+
+    p.description = __doc__.split("\n\n")[0]
+    p.add_argument("runs", nargs="+", type=Path, help="sweep folders (their cells/) or run folders")
+    p.add_argument("--out", type=out_path, default=None,
+                   help="folder for ledger.csv and ledger.md (default: the summary printed only)")
+
+
+def run(args, p) -> int:
+    try:
+        rows = ledger(read_runs(args.runs))
+        text = markdown(rows)
+        if args.out is None:
+            print(text, end="")
+            return 0
+        with locked(ensure_dir(args.out)):
+            write_atomic(args.out / "ledger.csv", to_csv(rows))
+            write_atomic(args.out / "ledger.md", text)
+    except (SpecrefineError, OSError) as exc:
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{len(rows)} runs with a correction -> {args.out}/ledger.{{csv,md}}")
+    return 0
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("correction-ledger", argv, prog="python -m specrefine.experiments.correction_ledger")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

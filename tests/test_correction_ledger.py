@@ -1,0 +1,67 @@
+"""The correction ledger (issue 39): one row per corrected run, from hand-made run folders."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import subprocess
+import sys
+
+import pytest
+
+from specrefine.experiments.correction_ledger import ledger, to_csv
+from specrefine.experiments.taxonomy import read_runs
+
+
+def write_run(folder, *, steps, success=180, maze="u_chain_4", seed=0, method="ours-corrector-redraw"):
+    folder.mkdir(parents=True)
+    result = {"maze": maze, "agent": "ant", "method": method, "proposer": "imperfect:moderate", "seed": seed,
+              "success_rate": success / 200, "episodes": 200, "path": ["S", "a", "G"]}
+    (folder / "result.json").write_text(json.dumps(result))
+    (folder / "steps.jsonl").write_text("".join(json.dumps(s) + "\n" for s in steps))
+
+
+def leg(accepted, *tried):
+    return {"event": "correct-leg", "p_leg": 0.9, "p_window": 0.8, "accepted": accepted, "tried": list(tried)}
+
+
+TWO_PASSES = [
+    {"event": "correct-check", "path": ["S", "G"], "p": 0.5, "correct_pass": 1},
+    leg("split", {"kind": "split", "p_window": 0.9}, {"kind": "bypass", "p_window": 0.7}),
+    leg(None, {"kind": "split", "p_window": 0.95, "p_window_second": 0.8, "p_current_second": 0.85}),  # refuted
+    {"event": "correct-done", "path": ["S", "a", "b", "G"], "p": 0.97, "correct_pass": 1},
+    {"event": "correct-check", "path": ["S", "a", "b", "G"], "p": 0.93, "correct_pass": 2},
+    leg("bypass", {"kind": "bypass", "p_window": 0.99, "p_window_second": 0.98, "p_current_second": 0.9}),
+    {"event": "correct-done", "path": ["S", "a", "G"], "p": 0.99, "correct_pass": 2},
+    {"event": "done"}]
+
+
+@pytest.fixture
+def sweep(tmp_path):
+    write_run(tmp_path / "sweep" / "cells" / "redrawn", steps=TWO_PASSES)
+    write_run(tmp_path / "sweep" / "cells" / "uncorrected", steps=[{"event": "done"}], method="ours", seed=1)
+    write_run(tmp_path / "sweep" / "cells" / "unfinished", steps=TWO_PASSES[:3], seed=2)
+    return tmp_path / "sweep"
+
+
+def test_a_run_s_passes_taken_alternatives_refutations_and_last_check_are_read(sweep):
+    (row,) = ledger(read_runs([sweep]))  # the uncorrected and the unfinished runs have no row
+    assert (row["passes"], row["legs_at_check"], row["legs_at_end"], row["legs_tried"]) == (2, 1, 2, 3)
+    assert (row["taken"], row["taken_by_kind"], row["refuted"]) == (2, "bypass:1 split:1", 1)
+    assert row["check_p"] == 0.5 and row["pass_end_p"] == "0.9700;0.9900" and row["last_p"] == 0.99
+    assert row["last_p_minus_success"] == pytest.approx(0.09)
+    assert row["last_p_above_interval"] is True  # 0.99 is above the Wilson interval of 180 of 200
+    table = list(csv.DictReader(io.StringIO(to_csv([row]))))
+    assert table[0]["taken_by_kind"] == "bypass:1 split:1" and float(table[0]["last_p"]) == pytest.approx(0.99)
+
+
+def test_the_command_writes_its_tables_and_a_folder_without_corrections_is_one_line(sweep, tmp_path):
+    cmd = [sys.executable, "-m", "specrefine.cli", "correction-ledger"]
+    ok = subprocess.run(cmd + [str(sweep), "--out", str(tmp_path / "out")], capture_output=True, text=True)
+    assert ok.returncode == 0, ok.stderr
+    md = (tmp_path / "out" / "ledger.md").read_text()
+    assert "| ours-corrector-redraw | imperfect:moderate | 1 | 0.500 | 0.990 | 0.900 | +0.090 | 1 of 1 |" in md
+    assert len((tmp_path / "out" / "ledger.csv").read_text().splitlines()) == 2
+    bad = subprocess.run(cmd + [str(sweep / "cells" / "uncorrected")], capture_output=True, text=True)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "Traceback" not in bad.stderr
