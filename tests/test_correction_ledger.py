@@ -63,5 +63,6 @@ def test_the_command_writes_its_tables_and_a_folder_without_corrections_is_one_l
     md = (tmp_path / "out" / "ledger.md").read_text()
     assert "| ours-corrector-redraw | imperfect:moderate | 1 | 0.500 | 0.990 | 0.900 | +0.090 | 1 of 1 |" in md
     assert len((tmp_path / "out" / "ledger.csv").read_text().splitlines()) == 2
+    assert (tmp_path / "out" / "ledger.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     bad = subprocess.run(cmd + [str(sweep / "cells" / "uncorrected")], capture_output=True, text=True)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "Traceback" not in bad.stderr

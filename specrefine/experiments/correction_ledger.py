@@ -7,7 +7,8 @@ Descriptive, no rule. For every finished run whose search corrected its path (``
 alternatives it took, by kind; the wins a second draw refuted (``ours-corrector-crosscheck``); and each pass's fresh
 estimate of the path at its end, beside the success measured in the run's fresh episodes. The last of those estimates
 minus the measured success says how much the correction's own check flatters the path it chose (it chose the path on
-those rollouts). Writes ``ledger.csv`` and ``ledger.md``; without ``--out`` prints the summary.
+those rollouts). Writes ``ledger.csv``, ``ledger.md`` and ``ledger.png`` (each run's last check against its measured
+success, with the measured success's 95 % interval); without ``--out`` prints the summary.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
-from ..core.runfolder import ensure_dir, locked, write_atomic
+from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from .corrector_diagnosis import events
 from .taxonomy import Run, read_runs
 
@@ -97,6 +98,26 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def figure(rows: list[dict]):
+    """Each run's last fresh check (x) against its measured success and 95 % interval (y), a marker per method;
+    a run below the diagonal was flattered by its check."""
+    from ..pictures.render import subplots
+
+    fig, ax = subplots(figsize=(5.2, 5.0))
+    for (method, proposer), group in _groups(rows).items():
+        x = np.array([g["last_p"] for g in group])
+        y = np.array([g["success_rate"] for g in group])
+        ci = np.array([wilson_ci(round(g["success_rate"] * g["episodes"]), g["episodes"]) for g in group])
+        ax.errorbar(x, y, yerr=[y - ci[:, 0], ci[:, 1] - y], fmt="o", ms=4, capsize=2, label=f"{method} ({proposer})")
+    low = min(min(r["last_p"] for r in rows), min(r["success_rate"] for r in rows), 0.9) - 0.02
+    ax.plot([low, 1.0], [low, 1.0], color="grey", lw=1, ls="--", label="check = measured")
+    ax.set(xlim=(low, 1.005), ylim=(low, 1.005), xlabel="the correction's last fresh check of the path",
+           ylabel="measured success (fresh episodes, 95 % interval)", title="Does the last check flatter the path?")
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
 def _groups(rows: list[dict]) -> dict[tuple, list[dict]]:
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
@@ -123,10 +144,11 @@ def run(args, p) -> int:
         with locked(ensure_dir(args.out)):
             write_atomic(args.out / "ledger.csv", to_csv(rows))
             write_atomic(args.out / "ledger.md", text)
+            save_figure(figure(rows), args.out / "ledger.png", dpi=110)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
-    print(f"{len(rows)} runs with a correction -> {args.out}/ledger.{{csv,md}}")
+    print(f"{len(rows)} runs with a correction -> {args.out}/ledger.{{csv,md,png}}")
     return 0
 
 
