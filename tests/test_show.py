@@ -144,7 +144,7 @@ def test_show_tells_a_running_run_and_its_correction_so_far(runs, tmp_path, caps
     assert main(["show", str(run)]) == 0
     out = capsys.readouterr().out
     assert f"state: running (pid {os.getpid()})" in out and ", 8 proposer calls" in out
-    assert "correction: the found path's fresh check 0.500 over 3 legs; 2 legs tried, 1 alternatives taken (split 1)" \
+    assert "correction: the found path's fresh check 0.500 over 3 legs; 2 legs tried, 1 alternative taken (split 1)" \
         in out
     assert "last step: correct-done (#53), " in out  # not "search done": another pass may follow
     with log.open("a") as fh:  # a second pass on a fresh draw (correct_passes=2) begins

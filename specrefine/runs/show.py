@@ -256,8 +256,12 @@ def _correction_so_far(steps: list[dict]) -> str:
     later = (f"; pass {latest.get('correct_pass', len(checks))}'s fresh check {_rate(latest.get('p'))} over "
              f"{_legs(latest)} legs" if len(checks) > 1 else "")
     return (f"correction: the found path's fresh check {_rate(checks[0].get('p'))} over {_legs(checks[0])} legs"
-            f"{later}; {len(legs)} legs tried, {sum(taken.values())} alternatives taken"
+            f"{later}; {_n(len(legs), 'leg')} tried, {_n(sum(taken.values()), 'alternative')} taken"
             + (" (" + ", ".join(f"{kind} {n}" for kind, n in taken.items()) + ")" if taken else ""))
+
+
+def _n(count: int, noun: str) -> str:
+    return f"{count} {noun}" + ("" if count == 1 else "s")
 
 
 def _legs(step: dict) -> int:
