@@ -148,7 +148,7 @@ def run(args, p) -> int:
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
-    print(f"{len(rows)} runs with a correction -> {args.out}/ledger.{{csv,md,png}}")
+    print(f"{len(rows)} run{'' if len(rows) == 1 else 's'} with a correction -> {args.out}/ledger.{{csv,md,png}}")
     return 0
 
 
