@@ -104,12 +104,14 @@ def figure(rows: list[dict]):
     from ..pictures.render import subplots
 
     fig, ax = subplots(figsize=(5.2, 5.0))
+    low = 1.0
     for (method, proposer), group in _groups(rows).items():
         x = np.array([g["last_p"] for g in group])
         y = np.array([g["success_rate"] for g in group])
         ci = np.array([wilson_ci(round(g["success_rate"] * g["episodes"]), g["episodes"]) for g in group])
         ax.errorbar(x, y, yerr=[y - ci[:, 0], ci[:, 1] - y], fmt="o", ms=4, capsize=2, label=f"{method} ({proposer})")
-    low = min(min(r["last_p"] for r in rows), min(r["success_rate"] for r in rows), 0.9) - 0.02
+        low = min(low, x.min(), ci[:, 0].min())
+    low = min(low, 0.9) - 0.02
     ax.plot([low, 1.0], [low, 1.0], color="grey", lw=1, ls="--", label="check = measured")
     ax.set(xlim=(low, 1.005), ylim=(low, 1.005), xlabel="the correction's last fresh check of the path",
            ylabel="measured success (fresh episodes, 95 % interval)", title="Does the last check flatter the path?")
