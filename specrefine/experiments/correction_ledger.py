@@ -13,6 +13,8 @@ success, with the measured success's 95 % interval); without ``--out`` prints th
 
 from __future__ import annotations
 
+import csv
+import io
 import sys
 from collections import Counter
 from pathlib import Path
@@ -47,7 +49,7 @@ def ledger_row(run: Run) -> dict | None:
         return None
     r, legs = run.result, events(run, "correct-leg")
     taken = Counter(s["accepted"] for s in legs if s["accepted"])
-    success, episodes = float(r["success_rate"]), int(r["episodes"])
+    success, episodes, last = float(r["success_rate"]), int(r["episodes"]), float(dones[-1]["p"])
     high = wilson_ci(round(success * episodes), episodes)[1]
     return {"cell": run.cell, "maze": r["maze"], "agent": r.get("agent", ""), "method": r["method"],
             "proposer": r["proposer"], "seed": r["seed"], "passes": len(dones),
@@ -55,10 +57,9 @@ def ledger_row(run: Run) -> dict | None:
             "legs_tried": len(legs), "taken": sum(taken.values()),
             "taken_by_kind": " ".join(f"{kind}:{n}" for kind, n in sorted(taken.items())),
             "refuted": sum(map(refuted, legs)), "check_p": float(checks[0]["p"]),
-            "pass_end_p": ";".join(f"{d['p']:.4f}" for d in dones), "last_p": float(dones[-1]["p"]),
-            "success_rate": success, "episodes": episodes,
-            "last_p_minus_success": float(dones[-1]["p"]) - success,
-            "last_p_above_interval": float(dones[-1]["p"]) > high}
+            "pass_end_p": ";".join(f"{d['p']:.4f}" for d in dones), "last_p": last,
+            "success_rate": success, "episodes": episodes, "last_p_minus_success": last - success,
+            "last_p_above_interval": last > high}
 
 
 def ledger(runs: list[Run]) -> list[dict]:
@@ -69,9 +70,11 @@ def ledger(runs: list[Run]) -> list[dict]:
 
 
 def to_csv(rows: list[dict]) -> str:
-    def cell(v) -> str:
-        return f"{v:.6g}" if isinstance(v, float) else str(v)
-    return "".join(",".join(cell(row[c]) for c in COLUMNS) + "\n" for row in [dict(zip(COLUMNS, COLUMNS)), *rows])
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
 
 
 def markdown(rows: list[dict]) -> str:
@@ -133,7 +136,7 @@ def add_arguments(p) -> None:
     p.description = __doc__.split("\n\n")[0]
     p.add_argument("runs", nargs="+", type=Path, help="sweep folders (their cells/) or run folders")
     p.add_argument("--out", type=out_path, default=None,
-                   help="folder for ledger.csv and ledger.md (default: the summary printed only)")
+                   help="folder for ledger.csv, ledger.md and ledger.png (default: the summary printed only)")
 
 
 def run(args, p) -> int:
