@@ -47,6 +47,8 @@ COMMANDS: dict[str, Command] = {
                                    "where ours-corrector still loses and where its proposer calls go"),
     "correction-ledger": Command("specrefine.experiments.correction_ledger",
                                  "what each run's correction decided, and its last check against the measured success"),
+    "chain-agreement": Command("specrefine.experiments.chain_agreement",
+                               "a run's path estimated leg by leg (chained) and as whole episodes, side by side"),
     "figures": Command("specrefine.experiments.figures", "the paper's Figures 4-6 from a sweep table"),
     "bench": Command("specrefine.bench.__main__", "throughput benchmarks: evaluator, gymenv, train, refine"),
     "notebook": Command("specrefine.runs.notebook", "executed copies of the numbered notebooks"),
