@@ -79,12 +79,13 @@ def agreement(run_dir: Path, *, legs: int | None = None, n: int = 1000, seed: in
     chain_p = math.prod(r.p for r in chain.results)
     k_chain, k_eps = round(chain_p * n), int(episodes.successes)
     low, high = newcombe_ci(k_chain, n, k_eps, n)
+    episode_ci = wilson_ci(k_eps, n)
     lost = np.bincount(episodes.legs_done[~episodes.success], minlength=len(chosen))[:len(chosen)]
     return {"run": run_dir.name, "maze": result.get("maze", ""), "agent": policy.agent,
             "method": result.get("method", ""), "proposer": result.get("proposer", ""), "seed": result.get("seed", ""),
             "legs": len(chosen), "n": n, "chain_successes": " ".join(str(r.successes) for r in chain.results),
             "chain_p": chain_p, "episode_successes": k_eps, "episode_p": k_eps / n,
-            "episode_ci_low": wilson_ci(k_eps, n)[0], "episode_ci_high": wilson_ci(k_eps, n)[1],
+            "episode_ci_low": episode_ci[0], "episode_ci_high": episode_ci[1],
             "episode_lost_at": " ".join(str(int(v)) for v in lost), "difference": chain_p - k_eps / n,
             "difference_ci_low": low, "difference_ci_high": high,
             "verdict": "chain above" if low > 0 else "chain below" if high < 0 else "agree"}
