@@ -69,3 +69,6 @@ def test_the_command_writes_its_tables_and_bad_runs_are_one_line(finished_run, t
     policy = json.loads((other / "policy.json").read_text())
     (other / "policy.json").write_text(json.dumps(policy | {"legs": policy["legs"][:-1]}))
     assert "not one run's records" in one_line(other)
+    late = tmp_path / "late"
+    assert "no compositional policy" in one_line(finished_run, no_policy, "--out", late)  # checked before simulating
+    assert not (late / "agreement.csv").exists()

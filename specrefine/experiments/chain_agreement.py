@@ -128,16 +128,24 @@ def add_arguments(p) -> None:
                    help="folder for agreement.csv and agreement.md (default: the table printed only)")
 
 
+def write_tables(out: Path, rows: list[dict]) -> None:
+    with locked(ensure_dir(out)):
+        write_atomic(out / "agreement.csv", to_csv(rows))
+        write_atomic(out / "agreement.md", markdown(rows))
+
+
 def run(args, p) -> int:
     try:
-        rows = [agreement(run_dir, legs=args.legs, n=args.n, seed=args.seed) for run_dir in args.runs]
-        text = markdown(rows)
+        for run_dir in args.runs:  # every run's records checked before minutes of simulation
+            run_path(run_dir, args.legs)
+        rows = []
+        for run_dir in args.runs:
+            rows.append(agreement(run_dir, legs=args.legs, n=args.n, seed=args.seed))
+            if args.out is not None:  # written after each run: an interrupted comparison keeps the runs it finished
+                write_tables(args.out, rows)
         if args.out is None:
-            print(text, end="")
+            print(markdown(rows), end="")
             return 0
-        with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "agreement.csv", to_csv(rows))
-            write_atomic(args.out / "agreement.md", text)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
         return 2
