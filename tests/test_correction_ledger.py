@@ -10,7 +10,8 @@ import sys
 
 import pytest
 
-from specrefine.experiments.correction_ledger import ledger, to_csv
+from specrefine.core.tables import csv_text
+from specrefine.experiments.correction_ledger import COLUMNS, ledger
 from specrefine.experiments.taxonomy import read_runs
 
 
@@ -52,7 +53,7 @@ def test_a_run_s_passes_taken_alternatives_refutations_and_last_check_are_read(s
     assert row["check_p"] == 0.5 and row["pass_end_p"] == "0.9700;0.9900" and row["last_p"] == 0.99
     assert row["last_p_minus_success"] == pytest.approx(0.09)
     assert row["last_p_above_interval"] is True  # 0.99 is above the Wilson interval of 180 of 200
-    table = list(csv.DictReader(io.StringIO(to_csv([row]))))
+    table = list(csv.DictReader(io.StringIO(csv_text([row], COLUMNS))))
     assert table[0]["taken_by_kind"] == "bypass:1 split:1" and float(table[0]["last_p"]) == pytest.approx(0.99)
 
 

@@ -17,6 +17,15 @@ from .paths import regular_file
 KNOBS = ("w", "d", "k")  # the search settings a sweep can vary; a table from before their columns ran the paper's
 
 
+def csv_text(rows: list[dict], columns) -> str:
+    """``rows`` as CSV text with a header of ``columns`` (quoted where needed, "\\n" line ends), for write_atomic."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, columns, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
+
+
 def goal_points_of(row: dict) -> str:
     """Where a row's (or a result's, or a run configuration's) legs aimed: ``goal_points``, the paper's rule for
     tables and results from before the option."""

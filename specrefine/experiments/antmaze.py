@@ -13,8 +13,6 @@ here is offline, NOT a VLM.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from pathlib import Path
 
@@ -25,7 +23,7 @@ from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
 from ..core.results import difference_text, rate_text, wilson_ci
 from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
-from ..core.tables import goal_points_of
+from ..core.tables import csv_text, goal_points_of
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS
 from ..runs.official import OFFICIAL_JSON, run_official
@@ -150,11 +148,7 @@ def main(argv=None) -> int:
         out = ensure_dir(args.out)
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, FIELDS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(out / "official.csv", buf.getvalue())
+    write_atomic(out / "official.csv", csv_text(rows, FIELDS))
     write_atomic(out / "table.md", table(rows) + "\n")
     save_figure(figure(rows), out / "figure.png", dpi=110)
     print(f"{len(rows)} runs -> {out}: official.csv, table.md, figure.png")

@@ -20,8 +20,6 @@ the previous leg's successes, ``evaluator.spread_draw``). Writes ``agreement.csv
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import sys
 from pathlib import Path
@@ -32,6 +30,7 @@ from ..core.errors import SpecrefineError
 from ..core.records import read_result
 from ..core.results import newcombe_ci, wilson_ci
 from ..core.runfolder import ensure_dir, locked, write_atomic
+from ..core.tables import csv_text
 
 COLUMNS = ("run", "maze", "agent", "method", "proposer", "seed", "legs", "n", "chain_successes", "chain_p",
            "episode_successes", "episode_p", "episode_ci_low", "episode_ci_high", "episode_lost_at", "difference",
@@ -91,14 +90,6 @@ def agreement(run_dir: Path, *, legs: int | None = None, n: int = 1000, seed: in
             "verdict": "chain above" if low > 0 else "chain below" if high < 0 else "agree"}
 
 
-def to_csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    return buf.getvalue()
-
-
 def markdown(rows: list[dict]) -> str:
     lines = ["Every proposer here is offline, NOT a VLM. Descriptive (no rule); `specrefine chain-agreement` "
              "(specrefine/experiments/chain_agreement.py) from the run folders: each run's found path (its first "
@@ -130,7 +121,7 @@ def add_arguments(p) -> None:
 
 def write_tables(out: Path, rows: list[dict]) -> None:
     with locked(ensure_dir(out)):
-        write_atomic(out / "agreement.csv", to_csv(rows))
+        write_atomic(out / "agreement.csv", csv_text(rows, COLUMNS))
         write_atomic(out / "agreement.md", markdown(rows))
 
 

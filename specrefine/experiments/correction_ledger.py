@@ -13,8 +13,6 @@ success, with the measured success's 95 % interval); without ``--out`` prints th
 
 from __future__ import annotations
 
-import csv
-import io
 import sys
 from collections import Counter
 from pathlib import Path
@@ -24,6 +22,7 @@ import numpy as np
 from ..core.errors import SpecrefineError
 from ..core.results import wilson_ci
 from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
+from ..core.tables import csv_text
 from .corrector_diagnosis import events
 from .taxonomy import Run, read_runs
 
@@ -67,14 +66,6 @@ def ledger(runs: list[Run]) -> list[dict]:
     if not rows:
         raise SpecrefineError("no finished run with a correction (correct-check steps) in the folders given")
     return sorted(rows, key=lambda row: (row["method"], row["proposer"], row["seed"], row["maze"]))
-
-
-def to_csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    return buf.getvalue()
 
 
 def markdown(rows: list[dict]) -> str:
@@ -147,7 +138,7 @@ def run(args, p) -> int:
             print(text, end="")
             return 0
         with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "ledger.csv", to_csv(rows))
+            write_atomic(args.out / "ledger.csv", csv_text(rows, COLUMNS))
             write_atomic(args.out / "ledger.md", text)
             save_figure(figure(rows), args.out / "ledger.png", dpi=110)
     except (SpecrefineError, OSError) as exc:

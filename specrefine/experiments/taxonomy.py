@@ -26,7 +26,6 @@ Writes ``taxonomy.csv`` (one row per run below the oracle, with every cause that
 from __future__ import annotations
 
 import csv
-import io
 import json
 import sys
 from collections import Counter, defaultdict
@@ -38,6 +37,7 @@ from ..core.mazes import random_name
 from ..core.records import read_result
 from ..core.results import wilson_ci
 from ..core.runfolder import ensure_dir, locked, write_atomic
+from ..core.tables import csv_text
 
 CAUSES = ("budget-spent", "repair-gave-up", "split-declined-dead-legs", "no-split-offered", "estimate-refuted",
           "weak-legs-accepted")
@@ -168,14 +168,6 @@ def summary_md(rows: list[dict], runs: list[Run], margin: float = MARGIN) -> str
     return "\n".join(lines) + "\n"
 
 
-def to_csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    return buf.getvalue()
-
-
 def read_runs(folders: list[Path]) -> list[Run]:
     """Every finished run under the sweep folders (their ``cells/*``) or run folders given."""
     runs = []
@@ -207,7 +199,7 @@ def run(args, p) -> int:
             print(text, end="")
             return 0
         with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "taxonomy.csv", to_csv(rows))
+            write_atomic(args.out / "taxonomy.csv", csv_text(rows, COLUMNS))
             write_atomic(args.out / "taxonomy.md", text)
     except (SpecrefineError, OSError) as exc:
         print(f"{p.prog}: error: {exc}", file=sys.stderr)
