@@ -1,10 +1,24 @@
-"""Shared test setup: headless matplotlib for every test (and the notebooks they run); notebook tiers."""
+"""Shared test setup: headless matplotlib for every test (and the notebooks they run); notebook tiers; a finished
+point run to read."""
 
 import os
+from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory) -> Path:
+    """A finished point run (u_maze, ours, geometric), one per test module, read-only to the tests: they tamper
+    with copies."""
+    from specrefine.cli import main as cli_main
+
+    out = tmp_path_factory.mktemp("finished") / "run"
+    assert cli_main(["refine", "u_maze", "--method", "ours", "--proposer", "geometric", "--rollouts", "8",
+                     "--episodes", "8", "--quiet", "--out", str(out)]) == 0
+    return out
 
 
 def pytest_addoption(parser):

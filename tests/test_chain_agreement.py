@@ -8,21 +8,10 @@ import math
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-from specrefine.cli import main as cli_main
 from specrefine.experiments.chain_agreement import agreement
-
-
-@pytest.fixture(scope="module")
-def finished_run(tmp_path_factory) -> Path:
-    """A finished point run (u_maze, ours, geometric), read-only to the tests: they tamper with copies."""
-    out = tmp_path_factory.mktemp("agreement") / "run"
-    assert cli_main(["refine", "u_maze", "--method", "ours", "--proposer", "geometric", "--rollouts", "8",
-                     "--episodes", "8", "--quiet", "--out", str(out)]) == 0
-    return out
 
 
 def test_the_row_holds_both_estimates_of_the_same_legs(finished_run):

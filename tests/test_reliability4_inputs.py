@@ -81,15 +81,6 @@ def test_a_huge_gymnasium_map_is_refused_and_the_largest_allowed_parses():
 
 
 # --- items 8 and 9: one schema for a run's policy.json and result.json, before any episode -------------------
-@pytest.fixture(scope="module")
-def finished_run(tmp_path_factory) -> Path:
-    """A finished point run (u_maze, ours, geometric), read-only to the tests: they tamper with copies."""
-    out = tmp_path_factory.mktemp("reliability4") / "run"
-    assert cli_main(["refine", "u_maze", "--method", "ours", "--proposer", "geometric", "--rollouts", "8",
-                     "--episodes", "8", "--quiet", "--out", str(out)]) == 0
-    return out
-
-
 def _grid(f):
     return lambda d: d.update(maze_grid=[f(row) for row in d["maze_grid"]])
 
