@@ -4,6 +4,7 @@ run, a base install refines without the extras, and docs/cli.md names what --hel
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import re
 import subprocess
@@ -63,6 +64,39 @@ def test_each_command_has_help(command, capsys):
     with pytest.raises(SystemExit) as done:
         cli.main([command, "--help"])
     assert done.value.code == 0 and f"usage: specrefine {command}" in capsys.readouterr().out
+
+
+REQUIRED = {  # the least each command's parser takes (nothing is read: the command's run is replaced)
+    "refine": ["u_maze"], "official": ["x"], "grids": ["list"], "train": ["--agent", "point"], "calibrate": ["x"],
+    "failures": ["x"], "taxonomy": ["x", "--oracle", "x"], "corrector-diagnosis": ["x", "--reference", "x"],
+    "correction-ledger": ["x"], "chain-agreement": ["x"], "figures": ["x"], "bench": ["evaluator"],
+    "notebook": ["executed"], "show": ["x"]}
+
+
+@pytest.mark.parametrize("command", list(cli.COMMANDS))
+def test_a_file_error_midway_is_one_line_on_every_command(command, monkeypatch, capsys):
+    """An OSError no command foresaw (a full disk while writing) is one line and exit 2, not a traceback; a closed
+    pipe (BrokenPipeError, its subclass) stays quiet."""
+    from specrefine.core import commands
+
+    module = commands._module(command)
+
+    def full_disk(args, parser):
+        raise OSError(errno.ENOSPC, "No space left on device", "out/table.csv")
+
+    monkeypatch.setattr(module, "run", full_disk)
+    argv = [command, *REQUIRED.get(command, [])]
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.splitlines() == [f"specrefine {command}: error: [Errno {errno.ENOSPC}] No space left on device: "
+                                "'out/table.csv'"], err
+
+    def closed_pipe(args, parser):
+        raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+    monkeypatch.setattr(module, "run", closed_pipe)
+    monkeypatch.setattr(commands, "silence_stdout", lambda: None)
+    assert cli.main(argv) == 1 and "error" not in capsys.readouterr().err
 
 
 def test_old_module_paths_take_the_same_options():

@@ -133,8 +133,8 @@ def _command_in(argv: list[str]) -> str:
 
 
 def _run(name: str, args, parser) -> int:
-    """Run a parsed command: a SpecrefineError it lets through is one line and exit 2, Ctrl-C exit 130, and a closed
-    pipe (``... | head``) no traceback."""
+    """Run a parsed command: a SpecrefineError or OSError it lets through is one line and exit 2, Ctrl-C exit 130,
+    and a closed pipe (``... | head``) no traceback."""
     try:
         return _module(name).run(args, parser) or 0
     except SpecrefineError as exc:
@@ -146,4 +146,7 @@ def _run(name: str, args, parser) -> int:
     except BrokenPipeError:
         silence_stdout()
         return 1
+    except OSError as exc:  # after BrokenPipeError, its subclass: a file the command could not read or write
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
+        return 2
 

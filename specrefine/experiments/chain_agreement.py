@@ -21,7 +21,6 @@ the previous leg's successes, ``evaluator.spread_draw``). Writes ``agreement.csv
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -126,20 +125,16 @@ def write_tables(out: Path, rows: list[dict]) -> None:
 
 
 def run(args, p) -> int:
-    try:
-        for run_dir in args.runs:  # every run's records checked before minutes of simulation
-            run_path(run_dir, args.legs)
-        rows = []
-        for run_dir in args.runs:
-            rows.append(agreement(run_dir, legs=args.legs, n=args.n, seed=args.seed))
-            if args.out is not None:  # written after each run: an interrupted comparison keeps the runs it finished
-                write_tables(args.out, rows)
-        if args.out is None:
-            print(markdown(rows), end="")
-            return 0
-    except (SpecrefineError, OSError) as exc:
-        print(f"{p.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    for run_dir in args.runs:  # every run's records checked before minutes of simulation
+        run_path(run_dir, args.legs)
+    rows = []
+    for run_dir in args.runs:
+        rows.append(agreement(run_dir, legs=args.legs, n=args.n, seed=args.seed))
+        if args.out is not None:  # written after each run: an interrupted comparison keeps the runs it finished
+            write_tables(args.out, rows)
+    if args.out is None:
+        print(markdown(rows), end="")
+        return 0
     print(f"{len(rows)} run{'' if len(rows) == 1 else 's'} compared -> {args.out}/agreement.{{csv,md}}")
     return 0
 

@@ -13,7 +13,6 @@ success, with the measured success's 95 % interval); without ``--out`` prints th
 
 from __future__ import annotations
 
-import sys
 from collections import Counter
 from pathlib import Path
 
@@ -131,19 +130,15 @@ def add_arguments(p) -> None:
 
 
 def run(args, p) -> int:
-    try:
-        rows = ledger(read_runs(args.runs))
-        text = markdown(rows)
-        if args.out is None:
-            print(text, end="")
-            return 0
-        with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "ledger.csv", csv_text(rows, COLUMNS))
-            write_atomic(args.out / "ledger.md", text)
-            save_figure(figure(rows), args.out / "ledger.png", dpi=110)
-    except (SpecrefineError, OSError) as exc:
-        print(f"{p.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    rows = ledger(read_runs(args.runs))
+    text = markdown(rows)
+    if args.out is None:
+        print(text, end="")
+        return 0
+    with locked(ensure_dir(args.out)):
+        write_atomic(args.out / "ledger.csv", csv_text(rows, COLUMNS))
+        write_atomic(args.out / "ledger.md", text)
+        save_figure(figure(rows), args.out / "ledger.png", dpi=110)
     print(f"{len(rows)} run{'' if len(rows) == 1 else 's'} with a correction -> {args.out}/ledger.{{csv,md,png}}")
     return 0
 

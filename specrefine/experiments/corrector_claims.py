@@ -1102,22 +1102,18 @@ def run(args, p) -> int:
         if not path.is_file() or path.is_symlink():
             print(f"{p.prog}: error: --fill {path}: not a regular file", file=sys.stderr)
             return 2
-    try:
-        point, ant, held_out = point_study(), ant_study(), held_out_study()
-        levers = levers_study()
-        variants = variant_studies()
-        record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
-                  "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
-                  "front": front(point, held_out, levers=levers, ant=ant, **variants)}
-        with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
-            write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
-            save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
-        for path in args.fill:
-            fill(path, record["front"])
-    except (SpecrefineError, OSError) as exc:
-        print(f"{p.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    point, ant, held_out = point_study(), ant_study(), held_out_study()
+    levers = levers_study()
+    variants = variant_studies()
+    record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
+              "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
+              "front": front(point, held_out, levers=levers, ant=ant, **variants)}
+    with locked(ensure_dir(args.out)):
+        write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
+        write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
+        save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
+    for path in args.fill:
+        fill(path, record["front"])
     print(f"-> {args.out}/claims.md")
     return 0
 

@@ -218,9 +218,6 @@ def run(args, p) -> int:
         with locked(ensure_dir(args.out)):
             write_atomic(args.out / "diagnosis.md", text)
             write_atomic(args.out / "diagnosis.json", json.dumps(s, indent=1) + "\n")
-    except (SpecrefineError, OSError) as exc:
-        print(f"{p.prog}: error: {exc}", file=sys.stderr)
-        return 2
     except (KeyError, IndexError) as exc:
         print(f"{p.prog}: error: a run folder lacks what a finished {METHOD} run logs ({exc!r})", file=sys.stderr)
         return 2

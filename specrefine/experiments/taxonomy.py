@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import csv
 import json
-import sys
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -191,19 +190,15 @@ def add_arguments(p) -> None:
 
 
 def run(args, p) -> int:
-    try:
-        runs = read_runs(args.runs)
-        rows = classify(runs, oracle_means(args.oracle), args.margin)
-        text = summary_md(rows, runs, args.margin)
-        if args.out is None:
-            print(text, end="")
-            return 0
-        with locked(ensure_dir(args.out)):
-            write_atomic(args.out / "taxonomy.csv", csv_text(rows, COLUMNS))
-            write_atomic(args.out / "taxonomy.md", text)
-    except (SpecrefineError, OSError) as exc:
-        print(f"{p.prog}: error: {exc}", file=sys.stderr)
-        return 2
+    runs = read_runs(args.runs)
+    rows = classify(runs, oracle_means(args.oracle), args.margin)
+    text = summary_md(rows, runs, args.margin)
+    if args.out is None:
+        print(text, end="")
+        return 0
+    with locked(ensure_dir(args.out)):
+        write_atomic(args.out / "taxonomy.csv", csv_text(rows, COLUMNS))
+        write_atomic(args.out / "taxonomy.md", text)
     print(f"{len(rows)} of {len(runs)} runs below the oracle -> {args.out}/taxonomy.{{csv,md}}")
     return 0
 
