@@ -5,8 +5,10 @@
 # The grid's definition is the checkout's, read once before the first step; the sweep is the pinned commit's.
 # Environment: CODE (instead of the grid's commit; a grid without one runs the checkout's HEAD), OUT (the sweep
 # folder; parts with their own sit under it), SHIPPED (the table; grids with one table only), WORKERS, PYTHON,
-# TREE (scripts/pinned_sweep.sh), DRY_RUN=1 (print the pinned_sweep.sh commands, run nothing). Relative paths are
-# taken from the checkout's root. Every value is passed as one argument, never run as shell code (no eval).
+# TREE (scripts/pinned_sweep.sh), DRY_RUN=1 (print the pinned_sweep.sh commands, run nothing), MAZES and SEEDS
+# (space-separated: only those of the grid's cells, the same cells in the same folder and table; a name the grid
+# does not hold is refused). Relative paths are taken from the checkout's root. Every value is passed as one
+# argument, never run as shell code (no eval).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -19,17 +21,22 @@ py=${PYTHON:-$root/.venv/bin/python}
 grids() { PYTHONPATH=$root "$py" -m specrefine.experiments.grids "$@"; }
 split() { "$py" -c 'import shlex, sys; sys.stdout.write("".join(a + "\0" for a in shlex.split(sys.argv[1])))' "$1"; }
 
+subset=()  # MAZES, SEEDS: split on spaces only, never globbed
+read -ra mazes <<<"${MAZES:-}"
+read -ra seeds <<<"${SEEDS:-}"
+[ "${#mazes[@]}" -eq 0 ] || subset+=(--mazes "${mazes[@]}")
+[ "${#seeds[@]}" -eq 0 ] || subset+=(--seeds "${seeds[@]}")
 options=()
 [ -z "${OUT:-}" ] || options+=(--out "$OUT")
 [ -z "${SHIPPED:-}" ] || options+=(--shipped "$SHIPPED")
-plan=$(grids plan "$name" ${options[@]+"${options[@]}"})  # a bad name: its line, exit 2
+plan=$(grids plan "$name" ${options[@]+"${options[@]}"} ${subset[@]+"${subset[@]}"})  # a bad name: its line, exit 2
 code=${CODE:-}
 steps=()  # per step: OUT, TABLE and the sweep's arguments (shell-quoted, as grids args prints them)
 while IFS=$'\t' read -r kind part step out table; do
     case $kind in
         code) [ -n "$code" ] || code=$part ;;
         step) steps+=("$out" "$table" "$(grids args "$name" --part "$part" --step "$step" \
-                                         ${WORKERS:+--workers "$WORKERS"})") ;;
+                                         ${WORKERS:+--workers "$WORKERS"} ${subset[@]+"${subset[@]}"})") ;;
     esac
 done <<<"$plan"
 [ "$code" != - ] || code=$(git rev-parse --short HEAD)

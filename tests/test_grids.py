@@ -98,6 +98,38 @@ def test_sweep_args_parse_back_to_the_grids_cells(name, tmp_path, monkeypatch):
         assert list(dict.fromkeys(parsed)) == grids.part_cells(g, i, root=root)
 
 
+@pytest.mark.parametrize("name, mazes, seeds", [("ant-corrector-redraw", ("u_chain_5",), (0,)),
+                                                ("ant-corrector-redraw", ("u_chain_3", "u_chain_2_subgoals"), (2, 1)),
+                                                ("repair", None, (1,)), ("paper-sweep", ("u_maze",), None)])
+def test_a_subset_runs_the_grids_own_cells_in_its_order(name, mazes, seeds, tmp_path, monkeypatch):
+    g = grids.GRIDS[name]
+    root = tmp_path.resolve()
+    tree = root / "runs" / f"code_{g.code}"
+    tree.mkdir(parents=True)
+    monkeypatch.chdir(tree)
+    subset = grids.Subset(mazes, seeds)
+    then = (["--goal-points", "sampled"] if g.goal_points is None else []) + \
+        (["--split-pick", "estimate"] if g.split_pick is None else [])
+    for i in range(len(g.parts)):
+        parsed = [c for args in grids.sweep_args(g, i, root=root, subset=subset) for c in sweep.cells_of(
+            sweep.parser().parse_args(args + then + ([] if "--policy" in args else ["--policy", "shipped"])))]
+        expected = [c for c in grids.part_cells(g, i, root=root)
+                    if (mazes is None or c.maze in mazes) and (seeds is None or c.seed in seeds)]
+        assert parsed == expected and expected  # the same ids, in the grid's order (not the subset's)
+
+
+def test_a_subset_outside_the_grid_is_refused_in_one_line(capsys):
+    for argv in (["args", "ant-corrector-redraw", "--part", "0", "--mazes", "u_chain_9"],
+                 ["plan", "ant-corrector-redraw", "--seeds", "0", "7"], ["plan", "repair", "--mazes", "u_chian_2"]):
+        with pytest.raises(SystemExit) as exit_:
+            grids.main(argv)
+        err = capsys.readouterr().err
+        assert exit_.value.code == 2 and err.count("\n") == 1 and "has no" in err, err
+    assert grids.main(["plan", "ant-corrector-redraw", "--mazes", "u_chain_5", "--seeds", "1"]) == 0
+    assert [line.split("\t")[:3] for line in capsys.readouterr().out.splitlines()] == [["code", "96e357e"],
+                                                                                      ["step", "0", "0"]]
+
+
 def test_args_cli_prints_one_step_and_refuses_an_unknown_grid(capsys):
     command = [sys.executable, "-m", "specrefine.experiments.grids", "args", "repair", "--part", "0", "--step", "1"]
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, env=os.environ | {"PYTHONPATH": str(ROOT)})
@@ -151,6 +183,20 @@ def test_run_grid_takes_code_out_and_workers_from_the_environment_and_refuses_ba
         done = subprocess.run(["bash", str(ROOT / "scripts" / "run_grid.sh"), name], capture_output=True, text=True,
                               env=os.environ | {"DRY_RUN": "1", "PYTHON": sys.executable} | env)
         assert done.returncode == 2 and done.stdout == "" and done.stderr.count("\n") == 1
+
+
+def test_run_grid_runs_the_subset_named_by_mazes_and_seeds():
+    redraw = ("CODE=96e357e OUT=runs/ant_corrector_redraw SHIPPED=data/results/corrector/ant_redraw.csv bash "
+              "scripts/pinned_sweep.sh --agent ant --evaluation adaptive --goal-points centre --split-pick confirmed "
+              "--policy data/policies/ant_stage5.pt --workers 1 --mazes {} --methods ours-corrector-redraw "
+              "--proposers imperfect:moderate --seeds {}")
+    assert _dry_run("ant-corrector-redraw", MAZES="u_chain_5", SEEDS="0", WORKERS="1") == [
+        redraw.format("u_chain_5", 0)]
+    assert _dry_run("ant-corrector-redraw", MAZES=" u_chain_3  u_chain_2 ", SEEDS="2 1", WORKERS="1") == [
+        redraw.format("u_chain_2 u_chain_3", s) for s in (1, 2)]
+    done = subprocess.run(["bash", str(ROOT / "scripts" / "run_grid.sh"), "ant-corrector-redraw"], capture_output=True,
+                          text=True, env=os.environ | {"DRY_RUN": "1", "PYTHON": sys.executable, "MAZES": "u_chain_*"})
+    assert done.returncode == 2 and done.stdout == "" and "has no mazes u_chain_*" in done.stderr
 
 
 def test_status_counts_each_parts_done_rows_and_names_the_rest(tmp_path, capsys):

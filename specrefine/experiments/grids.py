@@ -100,12 +100,43 @@ def _axes(g: ExperimentGrid, part: Part) -> dict:
             "proposers": part.proposers, "seeds": part.seeds if part.seeds is not None else g.seeds}
 
 
-def _steps(g: ExperimentGrid, part: Part) -> list[dict]:
-    """The axes of each sweep of a part, in order."""
+@dataclass(frozen=True)
+class Subset:
+    """Some of a grid's cells, the same cells in the same order (``run_grid.sh`` with MAZES or SEEDS): a long cell
+    run alone, or short ones in the tail of a session. None: every maze or seed."""
+    mazes: tuple | None = None
+    seeds: tuple | None = None
+
+    def check(self, g: ExperimentGrid) -> None:
+        """A name outside the grid would run a cell the grid does not hold: refused."""
+        from ..core.mazes import benchmark_mazes
+
+        for axis, chosen in (("mazes", self.mazes), ("seeds", self.seeds)):
+            held = {v for part in g.parts for v in (_axes(g, part)[axis] or sorted(benchmark_mazes()))}
+            if chosen is not None and (extra := [v for v in chosen if v not in held]):
+                raise GridError(f"grid {g.name} has no {axis} {' '.join(map(str, extra))} "
+                                f"(its {axis}: {' '.join(map(str, sorted(held)))})")
+
+    def apply(self, axes: dict) -> dict | None:
+        """``axes`` cut to the subset, None where nothing is left."""
+        from ..core.mazes import benchmark_mazes
+
+        cut = dict(axes)
+        if self.mazes is not None:
+            cut["mazes"] = tuple(m for m in (axes["mazes"] or sorted(benchmark_mazes())) if m in self.mazes)
+        if self.seeds is not None:
+            cut["seeds"] = tuple(s for s in axes["seeds"] if s in self.seeds)
+        return None if (self.mazes is not None and not cut["mazes"]) or not cut["seeds"] else cut
+
+
+EVERY = Subset()
+
+
+def _steps(g: ExperimentGrid, part: Part, subset: Subset = EVERY) -> list[dict]:
+    """The axes of each sweep of a part, in order (those of ``subset``: its steps with something left)."""
     axes = _axes(g, part)
-    if not part.split:
-        return [axes]
-    return [axes | {part.split: (value,)} for value in axes[part.split]]
+    steps = [axes] if not part.split else [axes | {part.split: (value,)} for value in axes[part.split]]
+    return [cut for step in steps if (cut := subset.apply(step)) is not None]
 
 
 def _policy(g: ExperimentGrid, part: Part, root: Path) -> str:
@@ -128,7 +159,8 @@ def _part(g: ExperimentGrid, index: int) -> Part:
     return g.parts[index]
 
 
-def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int | None = None) -> list[list[str]]:
+def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int | None = None,
+               subset: Subset = EVERY) -> list[list[str]]:
     """The ``specrefine.runs.sweep`` arguments (no ``--out``) of each step of part ``index``, in order."""
     part = _part(g, index)
     common = ["--agent", g.agent]
@@ -146,7 +178,7 @@ def sweep_args(g: ExperimentGrid, index: int, *, root: Path = ROOT, workers: int
         common += [f"--{name}", str(value)]
     common += ["--workers", str(workers or g.workers)]
     out = []
-    for axes in _steps(g, part):
+    for axes in _steps(g, part, subset):
         args = list(common)
         if axes["mazes"] is not None:
             args += ["--mazes", *axes["mazes"]]
@@ -875,9 +907,10 @@ def show(g: ExperimentGrid, root: Path = ROOT) -> list[str]:
             + shlex.join(args) for i in range(len(g.parts)) for args in sweep_args(g, i, root=root)]
 
 
-def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) -> list[str]:
+def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None, subset: Subset = EVERY) -> list[str]:
     """What run_grid.sh reads, fields separated by tabs (a path may hold spaces): 'code COMMIT' (or 'code -': the
-    checkout's HEAD), then 'step PART STEP OUT TABLE' per sweep, in order."""
+    checkout's HEAD), then 'step PART STEP OUT TABLE' per sweep of ``subset``, in order."""
+    subset.check(g)
     if shipped and len(g.tables) > 1:
         raise GridError(f"grid {g.name} writes {len(g.tables)} tables: SHIPPED names one table only")
     for name, path in (("OUT", out), ("SHIPPED", shipped)):
@@ -885,7 +918,7 @@ def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None) 
             raise GridError(f"{name}={path!r}: name a path (not empty, no tab or line break)")
     lines = [f"code\t{g.code or '-'}"]
     for i in range(len(g.parts)):
-        for j in range(len(_steps(g, g.parts[i]))):
+        for j in range(len(_steps(g, g.parts[i], subset))):
             lines.append(f"step\t{i}\t{j}\t{g.part_out(i, out)}\t{shipped or g.part_table(i)}")
     return lines
 
@@ -921,6 +954,12 @@ def add_arguments(p) -> None:
             sp.add_argument("--step", type=int, default=0, help="the step of the part, from 0")
             sp.add_argument("--workers", type=bounded_int("workers"), default=None,
                             help="local processes of the sweep (default: the grid's)")
+        if name in ("args", "plan"):
+            sp.add_argument("--mazes", nargs="+", default=None, metavar="MAZE",
+                            help="only these of the grid's mazes (the same cells; steps left empty are dropped) "
+                                 "(default: all)")
+            sp.add_argument("--seeds", nargs="+", type=int, default=None, metavar="SEED",
+                            help="only these of the grid's seeds (default: all)")
         if name == "status":
             sp.add_argument("--missing", action="store_true", help="list the cells still to run")
         if name == "plan":
@@ -928,6 +967,10 @@ def add_arguments(p) -> None:
                                                         "(default: the grid's)")
             sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids) "
                                                             "(default: the grid's)")
+
+
+def _subset(args) -> Subset:
+    return Subset(tuple(args.mazes) if args.mazes else None, tuple(args.seeds) if args.seeds else None)
 
 
 def main(argv=None) -> int:
@@ -953,9 +996,11 @@ def run(args, p) -> int:
                 if args.missing:
                     print("".join(f"  {cell}\n" for cell in missing), end="")
         elif args.grids_command == "plan":
-            print("\n".join(plan(g, args.out, args.shipped)))
+            print("\n".join(plan(g, args.out, args.shipped, _subset(args))))
         else:
-            steps = sweep_args(g, args.part, workers=args.workers)
+            subset = _subset(args)
+            subset.check(g)
+            steps = sweep_args(g, args.part, workers=args.workers, subset=subset)
             if not 0 <= args.step < len(steps):
                 raise GridError(f"part {args.part} of grid {g.name} has steps 0-{len(steps) - 1}, not {args.step}")
             print(shlex.join(steps[args.step]))
