@@ -67,3 +67,41 @@ def test_the_command_writes_its_tables_and_a_folder_without_corrections_is_one_l
     assert (tmp_path / "out" / "ledger.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     bad = subprocess.run(cmd + [str(sweep / "cells" / "uncorrected")], capture_output=True, text=True)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "Traceback" not in bad.stderr
+
+
+def test_keep_carries_the_rows_of_runs_whose_folders_are_gone(sweep, tmp_path):
+    """A new machine has lost earlier runs' folders: --keep keeps their ledger rows, byte for byte, and a cell given
+    again gets its row from its folder; without --keep the ledger is what the folders given hold."""
+    import shutil
+
+    cmd = [sys.executable, "-m", "specrefine.cli", "correction-ledger"]
+    out = tmp_path / "out"
+    assert subprocess.run(cmd + [str(sweep), "--out", str(out)], capture_output=True, text=True).returncode == 0
+    first = (out / "ledger.csv").read_text().splitlines()
+    later = tmp_path / "later"
+    write_run(later / "cells" / "u_chain_5", steps=TWO_PASSES, maze="u_chain_5", success=170)
+    kept = subprocess.run(cmd + [str(later), "--out", str(out), "--keep"], capture_output=True, text=True)
+    assert kept.returncode == 0 and "2 runs with a correction (1 kept from the ledger)" in kept.stdout, kept.stderr
+    lines = (out / "ledger.csv").read_text().splitlines()
+    assert len(lines) == 3 and first[1] in lines and any(line.startswith("u_chain_5,u_chain_5,") for line in lines)
+    assert "| ours-corrector-redraw | imperfect:moderate | 2 |" in (out / "ledger.md").read_text()
+    shutil.rmtree(sweep / "cells" / "redrawn")  # the same cell again, measured differently: its folder's row wins
+    write_run(sweep / "cells" / "redrawn", steps=TWO_PASSES, success=150)
+    assert subprocess.run(cmd + [str(sweep), "--out", str(out), "--keep"], capture_output=True,
+                          text=True).returncode == 0
+    rows = list(csv.DictReader(io.StringIO((out / "ledger.csv").read_text())))
+    assert sorted((r["cell"], float(r["success_rate"])) for r in rows) == [("redrawn", 0.75), ("u_chain_5", 0.85)]
+    assert subprocess.run(cmd + [str(later), "--out", str(out)], capture_output=True, text=True).returncode == 0
+    assert len((out / "ledger.csv").read_text().splitlines()) == 2  # without --keep: the folders given only
+
+
+def test_keep_refuses_a_file_that_is_not_its_ledger_and_needs_out(sweep, tmp_path):
+    cmd = [sys.executable, "-m", "specrefine.cli", "correction-ledger", str(sweep)]
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "ledger.csv").write_text("cell,maze\nx,y\n")
+    for argv in (["--out", str(out), "--keep"], ["--keep"]):
+        done = subprocess.run(cmd + argv, capture_output=True, text=True)
+        assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+        assert "Traceback" not in done.stderr
+    assert (out / "ledger.csv").read_text() == "cell,maze\nx,y\n" and not (out / "ledger.md").exists()

@@ -13,6 +13,7 @@ success, with the measured success's 95 % interval); without ``--out`` prints th
 
 from __future__ import annotations
 
+import csv
 from collections import Counter
 from pathlib import Path
 
@@ -60,11 +61,35 @@ def ledger_row(run: Run) -> dict | None:
             "last_p_above_interval": last > high}
 
 
+INTS = ("seed", "passes", "legs_at_check", "legs_at_end", "legs_tried", "taken", "refuted", "episodes")
+FLOATS = ("check_p", "last_p", "success_rate", "last_p_minus_success")
+
+
 def ledger(runs: list[Run]) -> list[dict]:
     rows = [row for row in map(ledger_row, runs) if row is not None]
     if not rows:
         raise SpecrefineError("no finished run with a correction (correct-check steps) in the folders given")
+    return _sorted(rows)
+
+
+def _sorted(rows: list[dict]) -> list[dict]:
     return sorted(rows, key=lambda row: (row["method"], row["proposer"], row["seed"], row["maze"]))
+
+
+def read_ledger(path: Path) -> list[dict]:
+    """The rows of a ledger.csv this command wrote, typed as ``ledger_row`` makes them; none if there is no file."""
+    if not path.exists():
+        return []
+    try:
+        with path.open(newline="") as fh:
+            reader = csv.DictReader(fh)
+            if tuple(reader.fieldnames or ()) != COLUMNS:
+                raise ValueError("its columns are not a ledger's")
+            return [{**row, **{c: int(row[c]) for c in INTS}, **{c: float(row[c]) for c in FLOATS},
+                     "last_p_above_interval": {"True": True, "False": False}[row["last_p_above_interval"]]}
+                    for row in reader]
+    except (ValueError, KeyError, TypeError, csv.Error, UnicodeDecodeError) as exc:
+        raise SpecrefineError(f"--keep: {path} is not a ledger this command wrote ({exc})") from None
 
 
 def markdown(rows: list[dict]) -> str:
@@ -127,10 +152,18 @@ def add_arguments(p) -> None:
     p.add_argument("runs", nargs="+", type=Path, help="sweep folders (their cells/) or run folders")
     p.add_argument("--out", type=out_path, default=None,
                    help="folder for ledger.csv, ledger.md and ledger.png (default: the summary printed only)")
+    p.add_argument("--keep", action="store_true",
+                   help="keep the rows of --out's ledger.csv whose cells are not among RUNS (their folders may be gone "
+                        "with another machine); a cell among RUNS gets its row from its folder (default: off)")
 
 
 def run(args, p) -> int:
+    if args.keep and args.out is None:
+        p.error("--keep needs --out (the ledger whose rows it keeps)")
     rows = ledger(read_runs(args.runs))
+    given = {row["cell"] for row in rows}
+    kept = [row for row in read_ledger(args.out / "ledger.csv") if row["cell"] not in given] if args.keep else []
+    rows = _sorted(rows + kept)
     text = markdown(rows)
     if args.out is None:
         print(text, end="")
@@ -139,7 +172,8 @@ def run(args, p) -> int:
         write_atomic(args.out / "ledger.csv", csv_text(rows, COLUMNS))
         write_atomic(args.out / "ledger.md", text)
         save_figure(figure(rows), args.out / "ledger.png", dpi=110)
-    print(f"{len(rows)} run{'' if len(rows) == 1 else 's'} with a correction -> {args.out}/ledger.{{csv,md,png}}")
+    print(f"{len(rows)} run{'' if len(rows) == 1 else 's'} with a correction"
+          f"{f' ({len(kept)} kept from the ledger)' if args.keep else ''} -> {args.out}/ledger.{{csv,md,png}}")
     return 0
 
 
