@@ -771,8 +771,9 @@ def _ant_verdicts(ant: dict) -> list[dict]:
         ran = [e for e in ant["per_maze"] if e["runs"]]
         low = [e["maze"] for e in ran if e["success"] < ANT_FLOOR]
         ratio = ant["ratio"][0]
-        out = [{"rule": floor, "value": f"below on {len(low)} of the {len(ran)} mazes run so far (of "
-                f"{len(ant['per_maze'])})" + (f": {', '.join(low)}" if low else ""),
+        scope = "" if complete else f" run so far (of {len(ant['per_maze'])})"
+        out = [{"rule": floor, "value": f"below on {len(low)} of the {len(ran)} mazes{scope}"
+                + (f": {', '.join(low)}" if low else ""),
                 "verdict": _verdict(not low, complete)},
                {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                 "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
