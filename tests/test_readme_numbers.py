@@ -7,6 +7,7 @@ row; floats are compared as README prints them, verdicts exactly.
 """
 from __future__ import annotations
 
+import csv
 import importlib.util
 import json
 import math
@@ -885,3 +886,30 @@ def test_the_corrector_s_ant_room_is_the_oracle_confirm_check():
     assert len(rates) == 4
     readme = " ".join((ROOT / "README.md").read_text().split())
     assert f"U-chain 4 and 5 with and without subgoals reach {min(rates):.3f}-{max(rates):.3f} per maze" in readme
+
+
+def test_the_ants_adopted_corrector_sentence_is_its_tables():
+    """README's sentence on the Ant's adopted corrector: its lowest maze, its cells below the control, its cost and
+    its ledger, recomputed from ant_redraw.csv, ant_confirm.csv and the redraw ledger.csv."""
+    from specrefine.experiments import corrector_claims as cc
+
+    ant = cc.ant_study(ROOT)
+    read = next(c for c in ant["candidates"] if c["method"] == ant["method"])
+    assert read["adopted"] and ant["method"] == "ours-corrector-redraw"
+    lo, hi = read["paired"]["ci"]
+    low = min(ant["per_maze"], key=lambda e: e["success"])
+    below = sum(redraw < confirm for _, redraw, confirm in read["paired"]["rows"])
+    one = [next(e for e in table if e["maze"] == "u_chain_1") for table in (ant["per_maze"], ant["confirm"])]
+    with (ROOT / "data/results/corrector/ledger/redraw/ledger.csv").open(newline="") as fh:
+        ledger = list(csv.DictReader(fh))
+    assert all(row["last_p_above_interval"] == "True" for row in ledger)
+    readme = " ".join(FRONT.split())
+    assert (f"over the 27 paired cells: {read['paired']['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}])") in readme
+    assert low["maze"] == "u_chain_5_subgoals" and low["success"] >= cc.ANT_FLOOR
+    assert (f"(the lowest, U-chain 5 with subgoals, {low['success']:.3f} [{low['ci_low']:.3f}, {low['ci_high']:.3f}])"
+            in readme)
+    assert (f"it is below confirm on {below} of the {read['paired']['cells']} cells (U-chain 1 pooled "
+            f"{one[0]['success']:.3f} against {one[1]['success']:.3f}); it spends "
+            f"{read['cost_vs_confirm']['proposer_calls_ratio']:.2f}x confirm's proposer calls and "
+            f"{read['cost_vs_ours']['proposer_calls_ratio']:.2f}x `ours`'s") in readme
+    assert f"on each of the {len(ledger)} runs its ledger holds" in readme
