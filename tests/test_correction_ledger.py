@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from specrefine.core.tables import csv_text
-from specrefine.experiments.correction_ledger import COLUMNS, ledger
+from specrefine.experiments.correction_ledger import COLUMNS, ledger, length_trend
 from specrefine.experiments.taxonomy import read_runs
 
 
@@ -105,3 +105,9 @@ def test_keep_refuses_a_file_that_is_not_its_ledger_and_needs_out(sweep, tmp_pat
         assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
         assert "Traceback" not in done.stderr
     assert (out / "ledger.csv").read_text() == "cell,maze\nx,y\n" and not (out / "ledger.md").exists()
+
+
+def test_the_length_trend_is_the_least_squares_slope_of_the_gap_on_the_legs():
+    rows = [{"legs_at_end": n, "last_p_minus_success": 0.01 + 0.002 * n} for n in (10, 30, 60)]
+    assert length_trend(rows) == "+0.020 per 10 legs (Pearson r +1.00) over 3 runs of 10-60 legs"
+    assert length_trend(rows[:2]) == "2 runs, too few or too alike for a trend"

@@ -107,6 +107,9 @@ def markdown(rows: list[dict]) -> str:
                      f"{sum(g['last_p_above_interval'] for g in group)} of {len(group)} | "
                      f"{' '.join(f'{k} {n}' for k, n in sorted(kinds.items())) or 'none'} | "
                      f"{sum(g['refuted'] for g in group)} |")
+    lines += ["", "Does the last check flatter longer paths more? Least squares of last - measured on the legs at "
+              "the end:", ""]
+    lines += [f"- {method} ({proposer}): {length_trend(group)}" for (method, proposer), group in _groups(rows).items()]
     lines += ["", "Per run (`pass_end_p`: each pass's fresh estimate of the path at its end):", "",
               "| maze | method | seed | passes | legs at check | legs at end | tried | taken | refuted | check | "
               "pass ends | measured |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -114,6 +117,18 @@ def markdown(rows: list[dict]) -> str:
               f"{r['legs_at_end']} | {r['legs_tried']} | {r['taken_by_kind'] or 'none'} | {r['refuted']} | "
               f"{r['check_p']:.3f} | {r['pass_end_p'].replace(';', ', ')} | {r['success_rate']:.3f} |" for r in rows]
     return "\n".join(lines) + "\n"
+
+
+def length_trend(group: list[dict]) -> str:
+    """The slope of last - measured per 10 legs at the end, and Pearson's r, over a group's runs."""
+    legs = np.array([g["legs_at_end"] for g in group], dtype=float)
+    gap = np.array([g["last_p_minus_success"] for g in group])
+    if len(group) < 3 or np.ptp(legs) == 0 or np.ptp(gap) == 0:
+        return f"{len(group)} run{'' if len(group) == 1 else 's'}, too few or too alike for a trend"
+    slope = np.polyfit(legs, gap, 1)[0]
+    r = np.corrcoef(legs, gap)[0, 1]
+    return (f"{slope * 10:+.3f} per 10 legs (Pearson r {r:+.2f}) over {len(group)} runs of "
+            f"{int(legs.min())}-{int(legs.max())} legs")
 
 
 def figure(rows: list[dict]):
