@@ -418,6 +418,16 @@ DEEP_CHECK_MIXES = ("imperfect:position_sigma=0.45,coord_grid=0.25,radius=0.25,r
                     "p_drop_turn=0.45,p_false_opening=0.4,p_wrong_branch=0.4,p_mirror_y=0.1,p_uncapped=0.7,"
                     "p_unparseable=0.05,alpha=0.5,rho=0.45")
 SCALING_MAZES = ("u_chain_1", *(m for n in range(2, 6) for m in (f"u_chain_{n}", f"u_chain_{n}_subgoals")))
+#: layouts and an error mix no run had used, for the Ant's adopted corrector (docs/corrector.md, "Fresh layouts for
+#: the Ant", fixed 2026-12-04 before it ran): four small generated mazes (sizes chosen for about an hour per Ant cell,
+#: seeds drawn by random.Random(20261204)), and the mix AI (offsets rounded to quarter cells, regions pulled to
+#: corners, dropped turns, false openings, wrong branches, mirrored replies, uncapped legs, unparseable replies, a weak
+#: follow-up, errors growing with the turns a query spans), beside the preset the Ant's rule was judged on
+ANT_FRESH_MAZES = ("random:3x3:94", "random:3x4:63", "random:4x3:2", "random:3x5:46")
+ANT_FRESH_MIXES = ("imperfect:moderate",
+                   "imperfect:position_sigma=0.35,coord_grid=0.25,radius=0.35,radius_log_sigma=0.4,corner_pull=0.3,"
+                   "p_drop_turn=0.3,p_false_opening=0.2,p_wrong_branch=0.3,p_mirror_y=0.05,p_uncapped=0.5,"
+                   "p_unparseable=0.05,rho=0.5,alpha=0.1")
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
@@ -876,6 +886,15 @@ GRIDS = {g.name: g for g in (
                        "2026-12-02 08:30 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with a second correction pass on a fresh draw", "ant_redraw",
                        code="96e357e", method="ours-corrector-redraw", split_pick="confirmed"),
+    ExperimentGrid(
+        "ant-corrector-fresh", "docs/corrector.md, 'Fresh layouts for the Ant' (issue 39; fixed 2026-12-04 before it "
+        "ran): ours-corrector-redraw and its control confirm on layouts and a mix no run had used, and the oracle",
+        "ant", parts=(Part(("ours-corrector-redraw", "ours-corrector-confirm"), ANT_FRESH_MIXES, split="proposers"),
+                      Part(("ours",), (GEOMETRIC_48,), table="data/results/corrector/ant_fresh_oracle.csv",
+                           out="oracle")),
+        seeds=(0,), mazes=ANT_FRESH_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", split_pick="confirmed", workers=1, code="96e357e",
+        table="data/results/corrector/ant_fresh.csv", out="runs/ant_corrector_fresh"),
     ant_oracle_grid("ant-oracle-spread", "docs/ant_experiments.md, 'The oracle at the fixed code' (issue 42; fixed "
                     "2026-11-27 13:45 UTC before its first cell ran)", "ours", "oracle_spread", code="e08c8b9"),
     ant_oracle_grid("ant-oracle-tunecheck", "docs/ant_experiments.md, 'Issue 42, lever 4' (fixed 2026-11-27 18:45 UTC "
