@@ -873,3 +873,29 @@ def test_corrector_claims_refuses_a_file_to_fill_that_is_missing_or_a_link_befor
         assert cc.run(args, p) == 2
         assert "not a regular file" in capsys.readouterr().err
     assert not (tmp_path / "out").exists() and target.read_text() == "x"
+
+
+def test_the_ants_fresh_layouts_are_described_cell_by_cell_with_the_paired_difference(tmp_path):
+    from specrefine.experiments import ant_fresh
+
+    assert ant_fresh.study(cc.load(GRIDS[ant_fresh.GRID].tables, tmp_path)) is None  # no cell yet
+    g = GRIDS[ant_fresh.GRID]
+    first, zero = g.mazes[0], g.mazes[1]
+
+    def rate(maze, method, proposer):
+        if method == ant_fresh.CONFIRM and maze == zero:
+            return 0.0
+        return 0.9 if method == ant_fresh.REDRAW else 0.8
+
+    lay_all_parts(tmp_path, ant_fresh.GRID, rate, calls_of=lambda m: 6 if m == ant_fresh.REDRAW else 3)
+    fresh = ant_fresh.study(cc.load(g.tables, tmp_path))
+    assert fresh["expected"] == 8 and fresh["paired"]["complete"] and fresh["pairs"] == 8
+    assert fresh["paired"]["difference"] == pytest.approx(0.9 - (0.8 * 6 / 8))  # confirm at 0 on 2 of 8 cells
+    assert fresh["zero"] == {ant_fresh.REDRAW: (0, 8), ant_fresh.CONFIRM: (2, 8)}
+    assert fresh["below"] == {ant_fresh.REDRAW: (0, 8), ant_fresh.CONFIRM: (8, 8)}
+    assert fresh["cost"] == {"proposer_calls": pytest.approx(2.0), "evaluations": pytest.approx(1.0)}
+    md = "\n".join(ant_fresh.markdown(fresh))
+    assert f"| imperfect:moderate | {first} | 0.900 | 0.800 | 0.800 |" in md
+    assert f"| AI | {zero} | 0.900 | 0.000 | 0.800 |" in md
+    assert "over 8 of 8 paired cells (Newcombe 95 %, pooled; helps)" in md
+    assert "proposer calls 2.00x, evaluations 1.00x." in md

@@ -30,6 +30,7 @@ from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, wilson_ci
 from ..core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from ..runs.sweep import read_checked_table
+from . import ant_fresh
 from . import comparison as cmp
 from .grids import (
     ADVANCE_CHECK_MAZES,
@@ -1106,11 +1107,13 @@ def run(args, p) -> int:
     point, ant, held_out = point_study(), ant_study(), held_out_study()
     levers = levers_study()
     variants = variant_studies()
-    record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, **variants,
+    fresh = ant_fresh.study(load(GRIDS[ant_fresh.GRID].tables))
+    record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "ant_fresh": fresh, **variants,
               "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
               "front": front(point, held_out, levers=levers, ant=ant, **variants)}
     with locked(ensure_dir(args.out)):
-        write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants))
+        fresh_lines = "\n".join(ant_fresh.markdown(fresh)) + "\n" if fresh else ""
+        write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants) + fresh_lines)
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
     for path in args.fill:
