@@ -82,5 +82,9 @@ def markdown(fresh: dict) -> list[str]:
                        f"{fresh['zero'][m][0]}" for m in (REDRAW, CONFIRM))
     cost = fresh["cost"]
     return lines + ["", f"{REDRAW} - {CONFIRM}: {paired}. Runs {counts}. Cost over {CONFIRM} on the "
-                        f"{fresh['pairs']} paired cells: proposer calls {cost['proposer_calls']:.2f}x, "
-                        f"evaluations {cost['evaluations']:.2f}x."]
+                        f"{fresh['pairs']} paired cells: proposer calls {_times(cost['proposer_calls'])}, "
+                        f"evaluations {_times(cost['evaluations'])}."]
+
+
+def _times(x: float) -> str:
+    return "—" if math.isnan(x) else f"{x:.2f}x"
