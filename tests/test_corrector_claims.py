@@ -899,3 +899,7 @@ def test_the_ants_fresh_layouts_are_described_cell_by_cell_with_the_paired_diffe
     assert f"| AI | {zero} | 0.900 | 0.000 | 0.800 |" in md
     assert "over 8 of 8 paired cells (Newcombe 95 %, pooled; helps)" in md
     assert "proposer calls 2.00x, evaluations 1.00x." in md
+    text = ant_fresh.front_text(fresh)
+    assert text.startswith("16 of 16 runs; redraw 0.900-0.900 per cell; redraw - confirm +0.300 [")
+    assert text.endswith("over 8 cells; runs at 0: redraw 0, confirm 2")
+    assert ant_fresh.front_text(None) == "no cell yet"

@@ -88,3 +88,18 @@ def markdown(fresh: dict) -> list[str]:
 
 def _times(x: float) -> str:
     return "—" if math.isnan(x) else f"{x:.2f}x"
+
+
+def front_text(fresh: dict | None) -> str:
+    """README's one line: how much has run, redraw's range per cell, its difference from confirm, the runs at 0."""
+    if fresh is None:
+        return "no cell yet"
+    redraw = [c[REDRAW] for c in fresh["cells"] if not math.isnan(c[REDRAW])]
+    p = fresh["paired"]
+    runs = sum(not math.isnan(c[m]) for c in fresh["cells"] for m in (REDRAW, CONFIRM))
+    span = f"redraw {min(redraw):.3f}-{max(redraw):.3f} per cell" if redraw else "redraw: no cell yet"
+    paired = (f"redraw - confirm {p['difference']:+.3f} [{p['ci'][0]:+.3f}, {p['ci'][1]:+.3f}] over {p['cells']} "
+              f"cell{'' if p['cells'] == 1 else 's'}" if p["cells"] else "no paired cell yet")
+    return (f"{runs} of {2 * fresh['expected']} runs; {span}; {paired}; runs at 0: redraw {fresh['zero'][REDRAW][0]}, "
+            f"confirm {fresh['zero'][CONFIRM][0]}")
+

@@ -1246,6 +1246,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         out["held-out"] = (f"ours-corrector {lo:.3f}-{hi:.3f} per layout and mix where ours gives {lo_o:.3f}-"
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
+    out["ant-fresh"] = ant_fresh.front_text(ant_fresh.study(load(GRIDS[ant_fresh.GRID].tables, root)))
     return out
 
 
