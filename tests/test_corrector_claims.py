@@ -211,6 +211,7 @@ def test_readme_corrector_sentences_are_the_shipped_tables():
     assert {"mild", "moderate", "ratio", "held-out", "cost", "levers", "gated", "lean", "precise",
             "trim", "ant", "spread", "recheck", "frugal", "retry", "thrift", "status"} <= set(marked)
     expected = cc.front(cc.point_study(), cc.held_out_study(), levers=cc.levers_study(), ant=cc.ant_study(),
+                        fresh=cc.ant_fresh_study(),
                         **cc.variant_studies())
     for name, text in marked.items():
         assert " ".join(text.split()) == " ".join(expected[name].split()), name

@@ -62,8 +62,8 @@ def _ratio(pairs: list[tuple[dict, dict]], key: str) -> float:
     return float(np.mean([float(a[key]) for a, _ in pairs]) / np.mean([float(b[key]) for _, b in pairs]))
 
 
-def _rate(x: float) -> str:
-    return "—" if math.isnan(x) else f"{x:.3f}"
+def _num(x: float, fmt: str = "{:.3f}") -> str:
+    return "—" if math.isnan(x) else fmt.format(x)
 
 
 def markdown(fresh: dict) -> list[str]:
@@ -76,18 +76,14 @@ def markdown(fresh: dict) -> list[str]:
              f"Ant'; described, no rule; seed 0, 200 episodes per run; AI is the new mix in "
              "specrefine/experiments/grids.py, `ANT_FRESH_MIXES`).", "",
              f"| mix | maze | {REDRAW} | {CONFIRM} | oracle |", "|---|---|---|---|---|"]
-    lines += [f"| {c['mix']} | {c['maze']} | {_rate(c[REDRAW])} | {_rate(c[CONFIRM])} | {_rate(c['oracle'])} |"
+    lines += [f"| {c['mix']} | {c['maze']} | {_num(c[REDRAW])} | {_num(c[CONFIRM])} | {_num(c['oracle'])} |"
               for c in fresh["cells"]]
     counts = "; ".join(f"{m}: below {FLOOR} {fresh['below'][m][0]} of {fresh['below'][m][1]}, at 0 "
                        f"{fresh['zero'][m][0]}" for m in (REDRAW, CONFIRM))
     cost = fresh["cost"]
     return lines + ["", f"{REDRAW} - {CONFIRM}: {paired}. Runs {counts}. Cost over {CONFIRM} on the "
-                        f"{fresh['pairs']} paired cells: proposer calls {_times(cost['proposer_calls'])}, "
-                        f"evaluations {_times(cost['evaluations'])}."]
-
-
-def _times(x: float) -> str:
-    return "—" if math.isnan(x) else f"{x:.2f}x"
+                        f"{fresh['pairs']} paired cells: proposer calls {_num(cost['proposer_calls'], '{:.2f}x')}, "
+                        f"evaluations {_num(cost['evaluations'], '{:.2f}x')}."]
 
 
 def front_text(fresh: dict | None) -> str:

@@ -299,6 +299,11 @@ def ant_study(root: Path = ROOT) -> dict | None:
                   "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates}
 
 
+def ant_fresh_study(root: Path = ROOT) -> dict | None:
+    """The Ant's corrector on the fresh layouts (``ant_fresh``), from its grid's tables under ``root``."""
+    return ant_fresh.study(load(GRIDS[ant_fresh.GRID].tables, root))
+
+
 def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
     """A candidate for the Ant's corrector: its cells per maze, its paired difference from ANT_METHOD, whether its
     rule holds (every paired cell ran, the 95 % interval above 0) and its pooled success."""
@@ -1107,10 +1112,10 @@ def run(args, p) -> int:
     point, ant, held_out = point_study(), ant_study(), held_out_study()
     levers = levers_study()
     variants = variant_studies()
-    fresh = ant_fresh.study(load(GRIDS[ant_fresh.GRID].tables))
+    fresh = ant_fresh_study()
     record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "ant_fresh": fresh, **variants,
               "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)],
-              "front": front(point, held_out, levers=levers, ant=ant, **variants)}
+              "front": front(point, held_out, levers=levers, ant=ant, fresh=fresh, **variants)}
     with locked(ensure_dir(args.out)):
         fresh_lines = "\n".join(ant_fresh.markdown(fresh)) + "\n" if fresh else ""
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants) + fresh_lines)
@@ -1182,9 +1187,9 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          ant: dict | None = None, **variants: dict | None) -> dict[str, str]:
+          ant: dict | None = None, fresh: dict | None = None, **variants: dict | None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
-    their ``VARIANTS`` name)."""
+    their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
@@ -1246,7 +1251,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         out["held-out"] = (f"ours-corrector {lo:.3f}-{hi:.3f} per layout and mix where ours gives {lo_o:.3f}-"
                            f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
                            f"{held_out['zero']['ours']} of {held_out['runs']}")
-    out["ant-fresh"] = ant_fresh.front_text(ant_fresh.study(load(GRIDS[ant_fresh.GRID].tables, root)))
+    out["ant-fresh"] = ant_fresh.front_text(fresh)
     return out
 
 
