@@ -10,7 +10,7 @@ import re
 import sys
 from pathlib import Path
 
-from specrefine.core.results import difference_text, newcombe_ci, rate_text
+from specrefine.core.results import difference_text, newcombe_ci, rate_text, wilson_ci
 from specrefine.core.runfolder import write_atomic
 from specrefine.experiments.legs import kind_table
 
@@ -31,6 +31,22 @@ def paired_reports(folder: Path) -> dict[tuple[int, int], dict[str, dict]]:
 
 def pooled(reports: list[dict]) -> tuple[int, int]:
     return sum(r["walls"]["success"] for r in reports), sum(r["episodes"] for r in reports)
+
+
+def worst_legs(path: int, reports: list[dict], top: int = 2) -> list[str]:
+    """Table rows of the ``top`` legs of one path that lose the most episodes, pooled over its reports."""
+    legs = reports[0]["legs"]
+    lost = [sum(r["walls"]["per_leg"][i][k] for r in reports for k in ("flipped", "avoid", "timeout"))
+            for i in range(len(legs))]
+    started = [sum(r["walls"]["per_leg"][i]["started"] for r in reports) for i in range(len(legs))]
+    rows = []
+    for i in sorted(range(len(legs)), key=lambda i: -lost[i])[:top]:
+        lo, hi = wilson_ci(lost[i], started[i])
+        turn = legs[i]["turn_deg"]
+        rows.append(f"| u_chain_2 s{path} | {i} | {'first' if turn is None else f'{turn:.0f}'} | "
+                    f"{legs[i]['length_m']:.1f} | {lost[i]} / {started[i]:,} = {lost[i] / started[i]:.4f} "
+                    f"[{lo:.4f}, {hi:.4f}] | {lost[i]} of {sum(lost)} |")
+    return rows
 
 
 def table(folder: Path) -> str:
@@ -55,6 +71,11 @@ def table(folder: Path) -> str:
     lines += ["", f"Pairs where slow-turn succeeds more often: {sum(d > 0 for d in diffs)}, less often: "
                   f"{sum(d < 0 for d in diffs)}, as often: {sum(d == 0 for d in diffs)}. Rule (fixed before the run): "
                   f"**{verdict}** (Newcombe 95 %, as if independent; the episodes are paired, so it is conservative)."]
+    lines += ["", "Where a path loses its episodes (both rules and every seed pooled): its two legs that lose the most",
+              "", "| path | leg | turn (deg) | length (m) | lost / started | share of the path's lost episodes |",
+              "|---|---|---|---|---|---|"]
+    for path in sorted({p for p, _ in pairs}):
+        lines += worst_legs(path, [r for (p, _), reports in pairs.items() if p == path for r in reports.values()])
     for rule in RULES:
         lines += ["", f"Lost episodes by kind of leg, {rule} (legs counted once per report):", "",
                   kind_table(by_rule[rule])]

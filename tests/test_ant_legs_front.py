@@ -197,3 +197,39 @@ def test_stage9_checks_table_regenerates():
     with contextlib.redirect_stdout(out):
         summary.main(STAGE9, "stage9", "stage5")
     assert out.getvalue() == (STAGE9 / "checks.md").read_text()
+
+
+SCALE = ROOT / "data" / "results" / "ant" / "switching_scale"
+_spec = importlib.util.spec_from_file_location("switching_scale_table", ROOT / "scripts" / "switching_scale_table.py")
+switching_scale_table = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(switching_scale_table)
+
+
+def test_switching_scale_table_regenerates(tmp_path):
+    for f in SCALE.glob("*.json"):
+        shutil.copy(f, tmp_path / f.name)
+    assert switching_scale_table.main(tmp_path) == (SCALE / "checks.md").read_text()
+
+
+def test_front_switching_scale_recomputes():
+    pairs = switching_scale_table.paired_reports(SCALE)
+    assert len(pairs) == 30  # 3 paths x 10 episode seeds, both rules
+    by_rule = {rule: [r[rule] for r in pairs.values()] for rule in switching_scale_table.RULES}
+    slow, at = (switching_scale_table.pooled(by_rule[rule]) for rule in ("slow-turn", "at-region"))
+    expected = f"{slow[0]} of {slow[1]} against {at[0]} of {at[1]}, {difference_text(*slow, *at)}"
+    assert front("slow-turn scale") == expected
+
+    def turning(rule):
+        row = next(line for line in kind_table(by_rule[rule]).splitlines() if line.startswith("| turning |"))
+        return f"{100 * float(row.split('|')[-2].split()[0]):.2f} %"
+
+    assert front("slow-turn scale turning") == f"{turning('slow-turn')} against {turning('at-region')}"
+
+
+def test_switching_scale_table_pairs_only_what_both_rules_finished(tmp_path):
+    for f in SCALE.glob("u_chain_2_s0_centre_*_seed100[12].json"):
+        shutil.copy(f, tmp_path / f.name)
+    (tmp_path / "u_chain_2_s0_centre_slow-turn_seed1002.json").unlink()  # its at-region partner is left alone
+    pairs = switching_scale_table.paired_reports(tmp_path)
+    assert list(pairs) == [(0, 1001)]
+    assert "1 (path, episode seed) pairs" in switching_scale_table.table(tmp_path)
