@@ -309,3 +309,14 @@ def test_cli_keeps_its_files_when_stdout_is_closed(tmp_path):
     os.close(write_end)
     assert (proc.returncode, proc.stderr) == (1, "")
     assert all((out / name).stat().st_size > 0 for name in ("figure4.png", "claims.md", "claims.json"))
+
+
+def test_mean_ratio_is_the_ratio_of_means_over_paired_rows():
+    import math
+
+    from specrefine.experiments.comparison import mean_ratio
+
+    pairs = [({"calls": "30"}, {"calls": "10"}), ({"calls": "10"}, {"calls": "30"})]
+    assert mean_ratio(pairs, "calls") == 1.0  # not the mean of the per-pair ratios (5/3)
+    assert mean_ratio(pairs[:1], "calls") == 3.0
+    assert math.isnan(mean_ratio([], "calls"))

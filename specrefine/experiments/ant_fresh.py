@@ -10,9 +10,7 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from .comparison import is_done
+from .comparison import is_done, mean_ratio
 from .grids import GEOMETRIC_48, GRIDS
 from .levers import lever_check
 
@@ -49,17 +47,11 @@ def study(rows: list[dict]) -> dict | None:
     return {"cells": per_cell, "expected": len(cells), "paired": lever_check(sides[REDRAW], sides[CONFIRM], cells),
             "below": {m: _count(sides[m], lambda r: r < FLOOR) for m in (REDRAW, CONFIRM)},
             "zero": {m: _count(sides[m], lambda r: r == 0.0) for m in (REDRAW, CONFIRM)},
-            "cost": {key: _ratio(pairs, key) for key in ("proposer_calls", "evaluations")}, "pairs": len(pairs)}
+            "cost": {key: mean_ratio(pairs, key) for key in ("proposer_calls", "evaluations")}, "pairs": len(pairs)}
 
 
 def _count(side: dict, test) -> tuple[int, int]:
     return sum(1 for r in side.values() if test(float(r["success_rate"]))), len(side)
-
-
-def _ratio(pairs: list[tuple[dict, dict]], key: str) -> float:
-    if not pairs:
-        return math.nan
-    return float(np.mean([float(a[key]) for a, _ in pairs]) / np.mean([float(b[key]) for _, b in pairs]))
 
 
 def _num(x: float, fmt: str = "{:.3f}") -> str:

@@ -71,6 +71,14 @@ ROOMS_CLAIM_TEXT = "success over 1-5 rooms"  # the paper: flat for ours, falling
 OFFLINE_NOTE = "every proposer here is offline, NOT a VLM (geometric: a planner on the map; imperfect:*: error model)"
 
 
+def mean_ratio(pairs: list[tuple[dict, dict]], key: str) -> float:
+    """Mean of ``key`` over the first rows of ``pairs`` over its mean over the second (NaN without pairs): a cost
+    ratio over paired cells, as the corrector claims state proposer calls and evaluations."""
+    if not pairs:
+        return math.nan
+    return float(np.mean([float(a[key]) for a, _ in pairs]) / np.mean([float(b[key]) for _, b in pairs]))
+
+
 def _task_rows(rows, agent: str) -> list[dict]:
     """The rows of ``agent`` on each maze's own task (not another task or agent, nor a row cut short before its
     seed)."""

@@ -214,13 +214,9 @@ def costs(rows, proposer, mazes, seeds, first=METHOD, second="ours") -> dict:
     by = {(r["maze"], r["method"], r["seed"]): r for r in rows if r["proposer"] == proposer and cmp.is_done(r)}
     pairs = [(by[(m, first, s)], by[(m, second, s)]) for m in mazes for s in seeds
              if (m, first, s) in by and (m, second, s) in by]
-
-    def ratio(key):
-        return float(np.mean([float(a[key]) for a, _ in pairs]) / np.mean([float(b[key]) for _, b in pairs])) \
-            if pairs else math.nan
-
-    return {"proposer": proposer, "pairs": len(pairs), "evaluations_ratio": ratio("evaluations"),
-            "proposer_calls_ratio": ratio("proposer_calls"), "sim_steps_ratio": ratio("sim_steps")}
+    return {"proposer": proposer, "pairs": len(pairs), "evaluations_ratio": cmp.mean_ratio(pairs, "evaluations"),
+            "proposer_calls_ratio": cmp.mean_ratio(pairs, "proposer_calls"),
+            "sim_steps_ratio": cmp.mean_ratio(pairs, "sim_steps")}
 
 
 def as_ours(cells: dict, method: str) -> dict:
