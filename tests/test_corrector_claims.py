@@ -902,5 +902,8 @@ def test_the_ants_fresh_layouts_are_described_cell_by_cell_with_the_paired_diffe
     assert "proposer calls 2.00x, evaluations 1.00x." in md
     text = ant_fresh.front_text(fresh)
     assert text.startswith("16 of 16 runs; redraw 0.900-0.900 per cell; redraw - confirm +0.300 [")
-    assert text.endswith("over 8 cells; runs at 0: redraw 0, confirm 2")
+    assert text.endswith("over 8 cells; runs at 0: redraw 0, confirm 2; the oracle (`ours`, geometric) 0.800-0.800 "
+                         "on 4 layouts")
+    no_oracle = {**fresh, "cells": [{**c, "oracle": float("nan")} for c in fresh["cells"]]}
+    assert ant_fresh.front_text(no_oracle).endswith("runs at 0: redraw 0, confirm 2")  # before the oracle has run
     assert ant_fresh.front_text(None) == "no cell yet"

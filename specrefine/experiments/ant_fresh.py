@@ -79,7 +79,8 @@ def markdown(fresh: dict) -> list[str]:
 
 
 def front_text(fresh: dict | None) -> str:
-    """README's one line: how much has run, redraw's range per cell, its difference from confirm, the runs at 0."""
+    """README's one line: how much has run, redraw's range per cell, its difference from confirm, the runs at 0 and,
+    once it has run, the oracle's range over the layouts."""
     if fresh is None:
         return "no cell yet"
     redraw = [c[REDRAW] for c in fresh["cells"] if not math.isnan(c[REDRAW])]
@@ -88,6 +89,9 @@ def front_text(fresh: dict | None) -> str:
     span = f"redraw {min(redraw):.3f}-{max(redraw):.3f} per cell" if redraw else "redraw: no cell yet"
     paired = (f"redraw - confirm {p['difference']:+.3f} [{p['ci'][0]:+.3f}, {p['ci'][1]:+.3f}] over {p['cells']} "
               f"cell{'' if p['cells'] == 1 else 's'}" if p["cells"] else "no paired cell yet")
+    oracle = {c["maze"]: c["oracle"] for c in fresh["cells"] if not math.isnan(c["oracle"])}
+    beside = (f"; the oracle (`ours`, geometric) {min(oracle.values()):.3f}-{max(oracle.values()):.3f} on "
+              f"{len(oracle)} layout{'' if len(oracle) == 1 else 's'}" if oracle else "")
     return (f"{runs} of {2 * fresh['expected']} runs; {span}; {paired}; runs at 0: redraw {fresh['zero'][REDRAW][0]}, "
-            f"confirm {fresh['zero'][CONFIRM][0]}")
+            f"confirm {fresh['zero'][CONFIRM][0]}{beside}")
 
