@@ -663,6 +663,12 @@ GRIDS = {g.name: g for g in (
         policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre",
         table="data/results/ant/antmaze_centre.csv", out="runs/antmaze_centre", code="d3488cc"),
     ExperimentGrid(
+        "antmaze-default", "docs/official_env.md, 'The AntMaze maps at the default settings' (issue 42; fixed "
+        "2026-12-04 20:00 UTC before its first cell ran)", "ant", parts=(Part(("ours",), ("geometric",)),),
+        seeds=(0, 1, 2), mazes=("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE"), policy="data/policies/ant_stage5.pt",
+        policy_in_checkout=True, evaluation="adaptive", episodes=200, goal_points="centre", split_pick="confirmed",
+        code="615bfaa", table="data/results/ant/antmaze_default.csv", out="runs/antmaze_default"),
+    ExperimentGrid(
         "taxonomy", "docs/corrector.md, 'The failure taxonomy' (issue 39; fixed 2026-11-27 before it ran)", "point",
         parts=(Part(("ours",), ("geometric",), table="data/results/corrector/taxonomy_oracle.csv", out="oracle"),
                Part(("ours", "ours-repair"), IMPERFECT[:3], split="proposers")),
