@@ -756,6 +756,24 @@ def test_the_antmaze_results_quoted_are_its_official_csv():
             "official") in doc
 
 
+def test_the_antmaze_default_grid_is_its_official_csv_in_readme_and_docs():
+    import csv
+
+    from specrefine.experiments.antmaze import headline, table
+
+    with (ROOT / "data/results/ant/antmaze_default/official.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 9  # three maps x seeds 0-2
+    assert _between(FRONT, "front antmaze default") == headline(rows, "ours (centre)", "geometric")
+    doc = (ROOT / "docs" / "official_env.md").read_text()
+    assert "<!-- antmaze default table -->\n" + table(rows) + "\n<!-- /antmaze default table -->" in doc
+    assert (ROOT / "data/results/ant/antmaze_default/table.md").read_text() == table(rows) + "\n"
+    with (ROOT / "data/results/ant/antmaze_default.csv").open() as fh:  # the sweep's table: the same runs
+        sweep = {(r["maze"], int(r["seed"])): round(float(r["success_rate"]) * int(r["episodes"]))
+                 for r in csv.DictReader(fh) if r["status"] == "ok"}
+    assert sweep == {(r["maze"], int(r["seed"])): int(r["sim_successes"]) for r in rows}
+
+
 def test_the_ant_gap_table_is_its_record():
     import json
 
