@@ -772,6 +772,19 @@ def test_the_antmaze_default_grid_is_its_official_csv_in_readme_and_docs():
         sweep = {(r["maze"], int(r["seed"])): round(float(r["success_rate"]) * int(r["episodes"]))
                  for r in csv.DictReader(fh) if r["status"] == "ok"}
     assert sweep == {(r["maze"], int(r["seed"])): int(r["sim_successes"]) for r in rows}
+    import json
+
+    from specrefine.core.results import rate_text
+
+    own = []  # each run's own episode seed: seed 0's from the table, seeds 1 and 2 from run_seeds/
+    for maze in ("U_MAZE", "MEDIUM_MAZE", "LARGE_MAZE"):
+        won = sum(int(r["official_successes"]) for r in rows if r["maze"] == f"gr:{maze}" and r["seed"] == "0")
+        for seed in (1, 2):
+            d = json.loads((ROOT / f"data/results/ant/antmaze_default/run_seeds/{maze}_seed{seed}.json").read_text())
+            assert d["seed"] == seed and d["maze"] == f"gr:{maze}" and d["episodes"] == 200
+            won += round(d["success_rate"] * d["episodes"])
+        own.append(f"{maze} {rate_text(won, 600)}")
+    assert _between(doc, "antmaze default run seeds") == ", ".join(own)
 
 
 def test_the_ant_gap_table_is_its_record():
