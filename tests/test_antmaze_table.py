@@ -80,3 +80,24 @@ def test_the_headline_quotes_one_method_per_map_in_both_simulators(tmp_path):
     _run(tmp_path, "c", "dirl", "none", 0, 0.0, 0.0)
     rows = antmaze.run_rows(tmp_path)
     assert antmaze.headline(rows, "ours", "geometric") == "U_MAZE 0.900 / 0.800, LARGE_MAZE 0.500 / —"
+
+
+def test_official_episodes_on_each_runs_own_seed_with_seed_run(tmp_path, monkeypatch, capsys):
+    seeds = []
+
+    def fake_official(run, episodes, seed):
+        seeds.append((run.name, episodes, seed))
+        (run / "official.json").write_text(json.dumps({"success_rate": 0.5, "episodes": episodes,
+                                                       "env_id": "AntMaze_UMaze-v5"}))
+
+    monkeypatch.setattr(antmaze, "run_official", fake_official)
+    _run(tmp_path, "a", "ours", "geometric", 1, 0.9)
+    _run(tmp_path, "b", "ours", "geometric", 2, 0.9)
+    assert antmaze.main([str(tmp_path), "--official", "10", "--seed", "run", "--out", str(tmp_path / "out")]) == 0
+    assert seeds == [("a", 10, 1), ("b", 10, 2)]
+    _run(tmp_path / "fixed", "c", "ours", "geometric", 2, 0.9)
+    assert antmaze.main([str(tmp_path / "fixed"), "--official", "10", "--out", str(tmp_path / "out2")]) == 0
+    assert seeds[-1] == ("c", 10, 0)  # the default: one seed for every run, as the shipped tables ran
+    with pytest.raises(SystemExit) as exit_:
+        antmaze.main([str(tmp_path), "--seed", "first", "--out", str(tmp_path / "out3")])
+    assert exit_.value.code == 2 and "an integer or 'run'" in capsys.readouterr().err

@@ -5,7 +5,8 @@ simulator and in the official ``AntMaze_*-v5``, pooled over seeds, with Wilson 9
         --out data/results/ant/antmaze
 
 Reads every finished run folder of the grid's sweep (``RUN/result.json``); with ``--official N`` it first runs
-``specrefine official RUN --episodes N`` where a run has no ``official.json`` yet (minutes per run). Writes
+``specrefine official RUN --episodes N`` where a run has no ``official.json`` yet (minutes per run), on episode seed
+``--seed`` (0), or each run's own with ``--seed run``. Writes
 ``official.csv`` (one row per run: both simulators' success), ``table.md`` (pooled per map, method and proposer,
 with the difference official - this simulator over the runs measured in both) and ``figure.png``. Every proposer
 here is offline, NOT a VLM.
@@ -13,6 +14,7 @@ here is offline, NOT a VLM.
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -32,8 +34,10 @@ FIELDS = ["maze", "method", "proposer", "seed", "sim_successes", "sim_episodes",
           "official_episodes", "env_id"]
 
 
-def run_rows(sweep_dirs, official_episodes: int | None = None, seed: int = 0) -> list[dict]:
-    """One row per finished run under each ``sweep_dir/cells``; runs without official.json get one first if asked."""
+def run_rows(sweep_dirs, official_episodes: int | None = None, seed: int | str = 0) -> list[dict]:
+    """One row per finished run under each ``sweep_dir/cells``; runs without official.json get one first if asked,
+    on episode seed ``seed``, or on each run's own seed with ``seed="run"`` (runs of a deterministic proposer often
+    save one policy, and one episode seed for all of them would repeat the same episodes)."""
     rows = []
     folders = [sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs
     for run in [r for folder in folders for r in sorted(Path(folder, "cells").glob("*/"))]:
@@ -42,7 +46,7 @@ def run_rows(sweep_dirs, official_episodes: int | None = None, seed: int = 0) ->
         result = read_result(run / "result.json")
         official = run / OFFICIAL_JSON
         if not official.is_file() and official_episodes:
-            run_official(run, official_episodes, seed)
+            run_official(run, official_episodes, int(result["seed"]) if seed == "run" else seed)
         off = json.loads(official.read_text()) if official.is_file() else None
         proposer = result["proposer"] if result["method"] in PROPOSER_METHODS else "none"  # as the sweep's table
         rows.append({"maze": result["maze"], "method": method_label(result), "proposer": proposer,
@@ -135,12 +139,24 @@ def figure(rows):
     return fig
 
 
+def episode_seed(text: str) -> int | str:
+    """``--seed``: an integer, or 'run' for each run's own seed."""
+    if text == "run":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: an integer or 'run'") from None
+
+
 def main(argv=None) -> int:
     p = OneLineParser(prog="python -m specrefine.experiments.antmaze", description=__doc__.split("\n")[0])
     p.add_argument("sweep_dirs", nargs="+", help="the AntMaze grids' sweep folders (runs/antmaze runs/antmaze_centre)")
     p.add_argument("--official", type=int, default=None, metavar="N",
                    help="run the official environment on N episodes where a run has no official.json yet")
-    p.add_argument("--seed", type=int, default=0, help="the official episodes' seed (default 0)")
+    p.add_argument("--seed", type=episode_seed, default=0,
+                   help="the official episodes' seed, or 'run': each run's own seed, so that runs which saved the "
+                        "same policy meet different episodes (default 0, as the shipped AntMaze tables ran)")
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
     try:
