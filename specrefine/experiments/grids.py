@@ -893,6 +893,13 @@ GRIDS = {g.name: g for g in (
                        "ant-corrector-confirm's cells with a second correction pass on a fresh draw", "ant_redraw",
                        code="96e357e", method="ours-corrector-redraw", split_pick="confirmed"),
     ExperimentGrid(
+        "ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC before its "
+        "first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5", "ant",
+        parts=(Part(("ours-corrector-redraw",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
+        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", split_pick="confirmed", workers=1, code="2b6a4f7",
+        table="data/results/ant/oracle_corrector.csv", out="runs/ant_oracle_corrector"),
+    ExperimentGrid(
         "ant-corrector-fresh", "docs/corrector.md, 'Fresh layouts for the Ant' (issue 39; fixed 2026-12-04 before it "
         "ran): ours-corrector-redraw and its control confirm on layouts and a mix no run had used, and the oracle",
         "ant", parts=(Part(("ours-corrector-redraw", "ours-corrector-confirm"), ANT_FRESH_MIXES, split="proposers"),
