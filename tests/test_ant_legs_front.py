@@ -233,3 +233,22 @@ def test_switching_scale_table_pairs_only_what_both_rules_finished(tmp_path):
     pairs = switching_scale_table.paired_reports(tmp_path)
     assert list(pairs) == [(0, 1001)]
     assert "1 (path, episode seed) pairs" in switching_scale_table.table(tmp_path)
+
+
+def test_lever_7_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
+    """docs/ant_experiments.md's lever 7 outcome: the rule's command on the shipped tables, its verdict and interval."""
+    from specrefine.experiments import levers
+
+    ant = ROOT / "data" / "results" / "ant"
+    out = tmp_path / "check.md"
+    assert levers.main([str(ant / "oracle_corrector.csv"), "--method", "ours-corrector-redraw", "--baseline",
+                        str(ant / "oracle_confirm.csv"), "--baseline-method", "ours-confirm", "--mazes", "u_chain_3",
+                        "u_chain_5", "--seeds", "0", "1", "2", "--out", str(out)]) == 0
+    capsys.readouterr()
+    text = out.read_text()
+    assert text == (ant / "oracle_corrector_check.md").read_text()
+    verdict, difference = re.search(r"6 of 6 cells: (\w+)\.\*\*.*difference (\S+ \[\S+ \S+\])", text).groups()
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    outcome = " ".join(docs.split("**Outcome (complete 2026-12-04 21:40")[1].split("\n\n")[0].split())
+    assert verdict == "helps" and "the correction helps the oracle" in outcome
+    assert f"**{difference}**" in outcome
