@@ -252,3 +252,21 @@ def test_lever_7_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
     outcome = " ".join(docs.split("**Outcome (complete 2026-12-04 21:40")[1].split("\n\n")[0].split())
     assert verdict == "helps" and "the correction helps the oracle" in outcome
     assert f"**{difference}**" in outcome
+
+
+def test_front_oracle_corrector_recomputes_from_its_table():
+    """README's lever 7 line: pooled success of both sides, the difference and the verdict, and the per-maze means."""
+    from specrefine.experiments import levers
+
+    ant = ROOT / "data" / "results" / "ant"
+    lever = levers._by_cell(ant / "oracle_corrector.csv", "ours-corrector-redraw", None)
+    base = levers._by_cell(ant / "oracle_confirm.csv", "ours-confirm", None)
+    cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
+    check = levers.lever_check(lever, base, cells)
+    (k1, n1), (k2, n2) = check["lever"], check["baseline"]
+    expected = (f"{k1 / n1:.3f} against {k2 / n2:.3f} over {check['cells']} cells, "
+                f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}")
+    assert front("oracle corrector") == expected
+    per_maze = [sum(float(lever[(m, s)]["success_rate"]) for s in (0, 1, 2)) / 3 for m in ("u_chain_3", "u_chain_5")]
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    assert f"({per_maze[0]:.3f} and {per_maze[1]:.3f}), at" in readme
