@@ -270,3 +270,33 @@ def test_front_oracle_corrector_recomputes_from_its_table():
     per_maze = [sum(float(lever[(m, s)]["success_rate"]) for s in (0, 1, 2)) / 3 for m in ("u_chain_3", "u_chain_5")]
     readme = " ".join((ROOT / "README.md").read_text().split())
     assert f"({per_maze[0]:.3f} and {per_maze[1]:.3f}), at" in readme
+
+
+def test_lever_7_legs_recompute_from_the_shipped_profiles():
+    """docs/ant_experiments.md's per-kind losses of lever 7's paths and of ours's on the same cells, from the JSONs."""
+    from specrefine.experiments.legs import turn_table
+
+    ant = ROOT / "data" / "results" / "ant"
+
+    def kinds(profiles) -> dict[str, list[str]]:
+        rows = [line.strip("|").split("|") for line in turn_table(profiles).splitlines()[2:]]
+        return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
+
+    lever = kinds(json.loads((ant / "oracle_corrector_legs.json").read_text()))
+    cells = {("u_chain_3", s) for s in (0, 1, 2)} | {("u_chain_5", s) for s in (0, 1, 2)}
+    ours = kinds([p for p in json.loads((ant / "scaling_centre" / "leg_profiles.json").read_text())
+                  if (p["maze"], p["seed"]) in cells])
+
+    def said(kind: str, side: dict) -> str:
+        count, started, lost, rate = side[kind]
+        return f"{lost} of {started}, {rate}"
+
+    expected = (f"turning legs {said('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+                f"against {said('turning', ours)}; straight legs {said('straight', lever)}, against "
+                f"{said('straight', ours)}")
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    found = re.search(r"<!-- lever 7 legs -->(.*?)<!-- /lever 7 legs -->", docs, flags=re.S)
+    assert found and " ".join(found.group(1).split()) == expected
+    assert lever["turning"][0] == ours["turning"][0] == "84"  # "Both have 84 turning legs"
+    assert (lever["straight"][0], ours["straight"][0]) == ("139", "91")
+    assert "(139 against 91)" in docs and "Both have 84 turning legs" in docs
