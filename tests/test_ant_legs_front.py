@@ -136,7 +136,11 @@ ORACLE_CHECKS = {"oracle spread": ("oracle_spread.csv", ["--baseline", "data/res
                  "oracle tunecheck": ("oracle_tunecheck.csv", ["--method", "ours-tunecheck", "--baseline",
                                                               "data/results/ant/oracle_spread.csv"]),
                  "oracle confirm": ("oracle_confirm.csv", ["--method", "ours-confirm", "--baseline",
-                                                          "data/results/ant/oracle_spread.csv"])}
+                                                          "data/results/ant/oracle_spread.csv"]),
+                 "oracle corrector scaling": ("oracle_corrector_scaling.csv",
+                                              ["--method", "ours-corrector-redraw", "--baseline",
+                                               "data/results/ant/oracle_confirm.csv", "--baseline-method",
+                                               "ours-confirm"])}
 
 
 def test_the_oracle_checks_regenerate_and_readme_quotes_their_summaries(tmp_path, monkeypatch):
