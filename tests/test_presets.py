@@ -30,11 +30,14 @@ def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules(
     best, paper = resolved("--agent", "ant"), resolved("--agent", "ant", "--preset", "paper")
     assert (best.evaluation, best.goal_points, best.policy) == ("adaptive", "centre", "ant_stage5")
     assert (paper.evaluation, paper.goal_points, paper.policy) == ("fixed", "sampled", "ant_stage5")
+    assert (best.method, paper.method) == ("ours-corrector-redraw", "ours")  # the paper's algorithm under paper
     assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
     point, point_paper = resolved(), resolved("--preset", "paper")
     # the point mass: the same settings but the goal points (centre since grid corrector-centre)
     assert replace(point_paper, preset="best", goal_points="centre") == point
     assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "centre", "shipped")
+    assert point.method == point_paper.method == "ours"
+    assert resolved("--agent", "ant", "--method", "ours").method == "ours"  # an explicit method wins
     assert (point_paper.evaluation, point_paper.goal_points, point_paper.policy) == ("fixed", "sampled", "shipped")
     explicit = resolved("--agent", "ant", "--preset", "paper", "--goal-points", "centre", "--policy", "shipped")
     assert (explicit.goal_points, explicit.policy, explicit.evaluation) == ("centre", "shipped", "fixed")
@@ -63,13 +66,14 @@ def test_a_run_records_its_preset_and_official_prints_it(tmp_path, capsys):
 
 
 def test_an_ant_folder_from_before_the_new_defaults_refuses_them(tmp_path, capsys):
-    """An Ant run made with the old defaults (adaptive, sampled points, ant.pt) is another run than today's."""
+    """An Ant run made with the old defaults (adaptive, sampled points, ant.pt) is another run than today's (the
+    method named, so that the error's first differences are the settings)."""
     out = tmp_path / "old"
     out.mkdir()
     old = {"maze": "u_chain_1", "agent": "ant", "method": "ours", "proposer": "geometric", "seed": 0, "rollouts": 8,
            "episodes": 10, "policy": "shipped", "w": 1, "d": 1, "k": 1, "spec": None, "evaluation": "adaptive"}
     (out / "run.json").write_text(json.dumps(old))  # refused before any Ant is built: the record is checked first
-    assert main(["refine", "u_chain_1", "--agent", "ant", *TINY, "--out", str(out)]) == 2
+    assert main(["refine", "u_chain_1", "--agent", "ant", "--method", "ours", *TINY, "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "holds another run" in err and "goal_points" in err and "policy" in err
     assert json.loads((out / "run.json").read_text()) == old

@@ -65,6 +65,7 @@ class Agent:
     default_goal_points: str = "sampled"  # where a leg aims: "sampled" (the paper) or "centre"
     default_policy: str = "shipped"  # "shipped" (data/policies/NAME.pt) or the name of another shipped checkpoint
     default_split_pick: str = "estimate"  # an edge split's pick: "estimate" (the paper) or "confirmed"
+    default_method: str = "ours"  # the method a run uses when none is asked for (``runs.methods.METHODS``)
 
 
 AGENTS: dict[str, Agent] = {
@@ -94,7 +95,9 @@ AGENTS: dict[str, Agent] = {
         # Centre goal points and stage 5 measured best on the Ant (docs/choices.md, "Presets").
         # A confirmed split pick passed lever 5's rule on the oracle grid (docs/ant_experiments.md, "lever 5").
         default_evaluation="adaptive", default_goal_points="centre", default_policy="ant_stage5",
-        default_split_pick="confirmed"),
+        # The corrector with the oracle passed lever 7's grid on the nine U-chains (docs/ant_experiments.md, "Issue 42,
+        # lever 7 on every U-chain").
+        default_split_pick="confirmed", default_method="ours-corrector-redraw"),
 }
 
 

@@ -16,6 +16,7 @@ class PaperSettings:
     goal_points: str = "sampled"  # a leg aims at a point drawn in its goal vertex's set, a new one per rollout
     evaluation: str = "fixed"  # every subtask estimate on `rollouts` rollouts (no adaptive racing)
     split_pick: str = "estimate"  # Algorithm 1 takes the candidate with the best estimate, from whatever round
+    method: str = "ours"  # the search of Algorithms 1-3, as the paper states it
 
 
 PAPER = PaperSettings()

@@ -102,7 +102,8 @@ class RunConfig:
     measured settings, and ``preset="paper"`` the paper's rules."""
 
     agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
-    method: str = option("ours", _methods_help, choices=_methods)
+    method: str | None = option(None, _methods_help, choices=_methods,
+                                shown="the preset's: best: ours for point, ours-corrector-redraw for ant; paper: ours")
     proposer: str = option("geometric", _proposers_help)
     spec: str | None = option(None, "the task as an expression over the maze's letters: a..z its subgoal regions, G "
                                     "the goal, S implicit; '->' sequence, '|' choice (binds tighter), parentheses; "
@@ -152,8 +153,8 @@ class RunConfig:
                                  "'Presets')", choices=lambda: PRESETS)
 
     def resolved(self) -> RunConfig:
-        """This configuration with what its preset decides filled in (``evaluation``, ``goal_points``, ``policy``,
-        ``split_pick``):
+        """This configuration with what its preset decides filled in (``method``, ``evaluation``, ``goal_points``,
+        ``policy``, ``split_pick``):
         the agent's ``default_*`` under ``best``, the paper's rules under ``paper`` (the policy is the agent's
         adopted one under either: the paper does not fix how its policy is trained)."""
         from ..core.agents import get_agent
@@ -163,7 +164,8 @@ class RunConfig:
             raise SpecrefineError(f"preset {self.preset!r}: use one of {', '.join(PRESETS)}")
         agent = get_agent(self.agent)
         best = self.preset == "best"
-        return replace(self, evaluation=self.evaluation or (agent.default_evaluation if best else PAPER.evaluation),
+        return replace(self, method=self.method or (agent.default_method if best else PAPER.method),
+                       evaluation=self.evaluation or (agent.default_evaluation if best else PAPER.evaluation),
                        goal_points=self.goal_points or (agent.default_goal_points if best else PAPER.goal_points),
                        policy=self.policy or agent.default_policy,
                        split_pick=self.split_pick or (agent.default_split_pick if best else PAPER.split_pick))

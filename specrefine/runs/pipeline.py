@@ -103,8 +103,8 @@ def refine_maze(maze_path, config: RunConfig | None = None, *, out=Path("runs/la
     config = replace(config or RunConfig(), **fields)
     maze = maze_path if isinstance(maze_path, Maze) else load_maze(maze_path)
     maze_task(maze.for_agent(config.agent), config.spec)  # a bad agent or spec fails before the folder is touched
-    proposer = config.proposer if get_method(config.method).asks_proposer else None
     config = config.resolved()
+    proposer = config.proposer if get_method(config.method).asks_proposer else None
     args = {"maze": maze.name, "maze_grid": list(maze.grid), "maze_spec": maze.spec, **config.record()}
     if config.evaluation not in EVALUATIONS:
         raise SpecrefineError(f"--evaluation must be one of {', '.join(EVALUATIONS)}, got {config.evaluation!r}")
