@@ -78,6 +78,10 @@ class SearchConfig:
     correct_min_failures: int = 1  # the correction asks the proposer about a leg only with this many fresh failures
     correct_lean: bool = False  # the correction judges by posterior means and offers every waypoint its bypass
     correct_passes: int = 1  # the correction again on a fresh draw, from the path it left: this many passes in all
+    correct_wide: int | None = None  # beyond the paper: after the passes, one more on a wide draw of this many x n
+    #                                  fresh rollouts per leg, the proposer asked only about a leg with at least
+    #                                  correct_wide_min_failures failures there (method ours-corrector-wide)
+    correct_wide_min_failures: int = 3
     correct_while_dead: bool = False  # beyond the paper: further passes while the corrected path has a leg that never
     #                                   succeeded on its fresh check, until the search's max_edge_splits are spent
     dead_budget: int | None = None  # beyond the paper: while the path still has such a dead leg, those passes go on
@@ -118,6 +122,10 @@ class SearchConfig:
             raise ValueError(f"evaluation must be one of {', '.join(EVALUATIONS)}, got {self.evaluation!r}")
         if self.correct_passes < 1:
             raise ValueError(f"correct_passes must be at least 1, got {self.correct_passes!r}")
+        if self.correct_wide is not None and (self.correct_wide < 1 or not self.correct_rollouts):
+            raise ValueError(f"correct_wide must be at least 1 and needs correct_rollouts, got {self.correct_wide!r}")
+        if self.correct_wide_min_failures < 1:
+            raise ValueError(f"correct_wide_min_failures must be at least 1, got {self.correct_wide_min_failures!r}")
         if self.empty_retries < 0:
             raise ValueError(f"empty_retries must be at least 0, got {self.empty_retries!r}")
         if self.dead_budget is not None and self.dead_budget < 1:
@@ -526,6 +534,9 @@ class RefinementSearch:
         for pass_ in range(self.cfg.correct_passes):
             path, check = self._correct_pass(path, pass_)
         pass_, limit = self.cfg.correct_passes, limit or self._dead_limit()
+        if self.cfg.correct_wide:
+            path, check = self._correct_pass(path, pass_, wide=True)
+            pass_ += 1
         while self.cfg.correct_while_dead and check.p <= 0.0 and self.splits_generated < limit:
             if self.splits_generated >= self.cfg.max_edge_splits and not self._extended:
                 self._extended = True
@@ -543,10 +554,16 @@ class RefinementSearch:
         """The Algorithm 1 calls the correction of a dead path may reach: ``dead_budget``, else the search's."""
         return self.cfg.max_edge_splits if self.cfg.dead_budget is None else self.cfg.dead_budget
 
-    def _correct_pass(self, path: list[str], pass_: int, budget: int | None = None) -> tuple[list[str], Check]:
+    def _correct_pass(self, path: list[str], pass_: int, budget: int | None = None,
+                      wide: bool = False) -> tuple[list[str], Check]:
         """One pass of the correction on its own fresh draw -> (the path, its fresh check). ``budget``: the Algorithm
-        1 calls the search may have made when the pass ends (None: the calls so far plus its share per leg)."""
+        1 calls the search may have made when the pass ends (None: the calls so far plus its share per leg);
+        ``wide``: the pass on ``correct_wide`` x n rollouts per leg, asking only about legs with
+        ``correct_wide_min_failures`` failures (a leg losing a per cent or two shows several there, one losing a
+        tenth of that mostly none)."""
         n = self.evaluator.n
+        rollouts, min_failures = ((self.cfg.correct_wide, self.cfg.correct_wide_min_failures) if wide
+                                  else (self.cfg.correct_rollouts, self.cfg.correct_min_failures))
         if budget is None:
             budget = self.splits_generated + math.ceil(self.cfg.correct_splits_per_leg * (len(path) - 1))
 
@@ -564,13 +581,14 @@ class RefinementSearch:
             return best
 
         reach = self.cfg.correct_reach or 0.0
-        log = self._log if self.cfg.correct_passes == 1 and not self.cfg.correct_while_dead else \
-            (lambda event, **detail: self._log(event, **detail, correct_pass=pass_ + 1))
-        self.graph, path, check = correct(self.graph, path, self.evaluator, rollouts=self.cfg.correct_rollouts * n,
+        single = self.cfg.correct_passes == 1 and not self.cfg.correct_while_dead and not self.cfg.correct_wide
+        tag = dict(correct_pass=pass_ + 1) | (dict(wide_rollouts=rollouts * n) if wide else {})
+        log = self._log if single else (lambda event, **detail: self._log(event, **detail, **tag))
+        self.graph, path, check = correct(self.graph, path, self.evaluator, rollouts=rollouts * n,
                                       seed=self.cfg.seed + CHECK_SEED_OFFSET + pass_ * PASS_SEED_STEP,
                                       split_leg=split_leg, may_split=lambda: self.splits_generated < budget,
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
-                                      min_failures=self.cfg.correct_min_failures, lean=self.cfg.correct_lean,
+                                      min_failures=min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,

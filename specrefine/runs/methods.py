@@ -353,11 +353,20 @@ register_method("ours-corrector-reaim", ours_variant(**CORRECTOR | dict(confirm_
                 colour="#e65100")
 #: ours-corrector-redraw: confirm, whose correction runs a second pass on a fresh draw (docs/corrector.md, "A second
 #: draw for the Ant")
-register_method("ours-corrector-redraw", ours_variant(**CORRECTOR | dict(confirm_pick=True, correct_passes=2)),
+REDRAW = CORRECTOR | dict(confirm_pick=True, correct_passes=2)
+register_method("ours-corrector-redraw", ours_variant(**REDRAW),
                 "beyond the paper: ours-corrector-confirm whose correction, when done, runs once more from the path "
                 "it left on a fresh draw of its own (new first states, a budget of one proposer split per leg), so "
                 "that a leg chosen on one draw's rollouts is judged again on rollouts that did not choose it",
                 colour="#3e2723")
+#: ours-corrector-wide: redraw, then one more pass on a wide draw (docs/ant_experiments.md, "Issue 42, lever 8")
+register_method("ours-corrector-wide",
+                ours_variant(**REDRAW | dict(correct_wide=16, correct_wide_min_failures=3)),
+                "beyond the paper: ours-corrector-redraw whose correction, when its two passes are done, runs once "
+                "more on a wide fresh draw (16x n rollouts per leg, 512 on the Ant) and asks the proposer only about "
+                "a leg with at least 3 failures there (other weak legs are offered their bypass only), so that a leg "
+                "losing a per cent or two, which 128 rollouts see about twice, is found and one losing a tenth of "
+                "that is not chased", colour="#5d4037")
 #: ours-corrector-crosscheck: confirm, whose correction takes an alternative only where it also wins on a second draw
 #: (docs/corrector.md, "Wins checked on a second draw")
 register_method("ours-corrector-crosscheck",
