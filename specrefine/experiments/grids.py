@@ -909,7 +909,7 @@ GRIDS = {g.name: g for g in (
         split_pick="confirmed", workers=1, code="2b6a4f7", table="data/results/ant/oracle_corrector_scaling.csv",
         out="runs/ant_oracle_corrector_scaling"),
     ExperimentGrid(
-        "ant-oracle-wide", "docs/ant_experiments.md, 'Issue 42, lever 8' (fixed 2026-12-05 01:05 UTC before its first "
+        "ant-oracle-wide", "docs/ant_experiments.md, 'Issue 42, lever 8' (fixed 2026-12-05 00:22 UTC before its first "
         "cell ran): lever 7's corrector with one more pass on a wide draw, on lever 7's six cells",
         "ant", parts=(Part(("ours-corrector-wide",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
         mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
