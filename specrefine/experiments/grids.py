@@ -916,6 +916,14 @@ GRIDS = {g.name: g for g in (
         goal_points="centre", split_pick="confirmed", workers=1, code="adda718",
         table="data/results/ant/oracle_wide.csv", out="runs/ant_oracle_wide"),
     ExperimentGrid(
+        "ant-oracle-wide-scaling", "docs/ant_experiments.md, 'Issue 42, lever 8 on every U-chain' (fixed 2026-12-05 "
+        "01:56 UTC before its first new cell ran): lever 8's corrector with the oracle on the nine U-chains; its six "
+        "U-chain 3 and 5 cells are lever 8's rows (the same code and cells), copied into its table, not run again",
+        "ant", parts=(Part(("ours-corrector-wide",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
+        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
+        split_pick="confirmed", workers=1, code="adda718", table="data/results/ant/oracle_wide_scaling.csv",
+        out="runs/ant_oracle_wide_scaling"),
+    ExperimentGrid(
         "ant-corrector-fresh", "docs/corrector.md, 'Fresh layouts for the Ant' (issue 39; fixed 2026-12-04 before it "
         "ran): ours-corrector-redraw and its control confirm on layouts and a mix no run had used, and the oracle",
         "ant", parts=(Part(("ours-corrector-redraw", "ours-corrector-confirm"), ANT_FRESH_MIXES, split="proposers"),
