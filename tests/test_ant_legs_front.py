@@ -304,3 +304,72 @@ def test_lever_7_legs_recompute_from_the_shipped_profiles():
     assert lever["turning"][0] == ours["turning"][0] == "84"  # "Both have 84 turning legs"
     assert (lever["straight"][0], ours["straight"][0]) == ("139", "91")
     assert "(139 against 91)" in docs and "Both have 84 turning legs" in docs
+
+
+def test_lever_8_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
+    """docs/ant_experiments.md's lever 8 outcome: the rule's command on the shipped tables, its verdict and interval."""
+    from specrefine.experiments import levers
+
+    ant = ROOT / "data" / "results" / "ant"
+    out = tmp_path / "check.md"
+    assert levers.main([str(ant / "oracle_wide.csv"), "--method", "ours-corrector-wide", "--baseline",
+                        str(ant / "oracle_corrector.csv"), "--baseline-method", "ours-corrector-redraw", "--mazes",
+                        "u_chain_3", "u_chain_5", "--seeds", "0", "1", "2", "--out", str(out)]) == 0
+    capsys.readouterr()
+    text = out.read_text()
+    assert text == (ant / "oracle_wide_check.md").read_text()
+    verdict, difference = re.search(r"6 of 6 cells: ([\w ]+)\.\*\*.*difference (\S+ \[\S+ \S+\])", text).groups()
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    outcome = " ".join(docs.split("**Outcome (complete 2026-12-05 01:55")[1].split("\n\n")[0].split())
+    assert verdict == "no difference shown" and "no difference shown.**" in outcome
+    assert f"**{difference}**" in outcome
+
+
+def test_front_oracle_wide_recomputes_from_its_table():
+    """README's lever 8 line: pooled success of both sides, the difference and the verdict; U-chain 5 pooled; cost."""
+    from specrefine.experiments import levers
+
+    ant = ROOT / "data" / "results" / "ant"
+    lever = levers._by_cell(ant / "oracle_wide.csv", "ours-corrector-wide", None)
+    base = levers._by_cell(ant / "oracle_corrector.csv", "ours-corrector-redraw", None)
+    cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
+    check = levers.lever_check(lever, base, cells)
+    (k1, n1), (k2, n2) = check["lever"], check["baseline"]
+    expected = (f"{k1 / n1:.3f} against {k2 / n2:.3f} over {check['cells']} cells, "
+                f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}")
+    assert front("oracle wide") == expected
+
+    def u5(rows):
+        return sum(float(rows[("u_chain_5", s)]["success_rate"]) for s in (0, 1, 2)) / 3
+
+    def ratio(column):
+        return sum(int(lever[c][column]) for c in cells) / sum(int(base[c][column]) for c in cells)
+
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    assert (f"U-chain 5 pooled {u5(lever):.3f} against {u5(base):.3f}, at {ratio('proposer_calls'):.2f}x lever 7's "
+            f"proposer calls and {ratio('sim_steps'):.2f}x its simulator steps") in readme
+
+
+def test_lever_8_legs_recompute_from_the_shipped_profiles():
+    """docs/ant_experiments.md's per-kind losses of lever 8's paths against lever 7's, from the shipped JSONs."""
+    from specrefine.experiments.legs import turn_table
+
+    ant = ROOT / "data" / "results" / "ant"
+
+    def kinds(name) -> dict[str, list[str]]:
+        rows = [line.strip("|").split("|") for line in
+                turn_table(json.loads((ant / name).read_text())).splitlines()[2:]]
+        return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
+
+    lever, before = kinds("oracle_wide_legs.json"), kinds("oracle_corrector_legs.json")
+
+    def said(kind: str, side: dict) -> str:
+        count, started, lost, rate = side[kind]
+        return f"{lost} of {started}, {rate}"
+
+    expected = (f"turning legs {said('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+                f"against lever 7's {said('turning', before)}; straight legs {said('straight', lever)}, against "
+                f"{said('straight', before)}")
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    found = re.search(r"<!-- lever 8 legs -->(.*?)<!-- /lever 8 legs -->", docs, flags=re.S)
+    assert found and " ".join(found.group(1).split()) == expected
