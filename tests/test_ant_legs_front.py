@@ -140,7 +140,11 @@ ORACLE_CHECKS = {"oracle spread": ("oracle_spread.csv", ["--baseline", "data/res
                  "oracle corrector scaling": ("oracle_corrector_scaling.csv",
                                               ["--method", "ours-corrector-redraw", "--baseline",
                                                "data/results/ant/oracle_confirm.csv", "--baseline-method",
-                                               "ours-confirm"])}
+                                               "ours-confirm"]),
+                 "oracle wide scaling": ("oracle_wide_scaling.csv",
+                                         ["--method", "ours-corrector-wide", "--baseline",
+                                          "data/results/ant/oracle_corrector_scaling.csv", "--baseline-method",
+                                          "ours-corrector-redraw"])}
 
 
 def test_the_oracle_checks_regenerate_and_readme_quotes_their_summaries(tmp_path, monkeypatch):
