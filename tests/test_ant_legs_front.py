@@ -243,37 +243,65 @@ def test_switching_scale_table_pairs_only_what_both_rules_finished(tmp_path):
     assert "1 (path, episode seed) pairs" in switching_scale_table.table(tmp_path)
 
 
-def test_lever_7_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
-    """docs/ant_experiments.md's lever 7 outcome: the rule's command on the shipped tables, its verdict and interval."""
+ANT = ROOT / "data" / "results" / "ant"
+LEVER_CELLS = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]  # levers 7 and 8 (U-chain 3 and 5)
+
+
+def lever_check_quoted(tmp_path, capsys, table, method, baseline, baseline_method, outcome_start):
+    """The rule's command on the shipped tables regenerates the shipped check -> (its verdict, its difference, the
+    docs outcome paragraph that starts with ``outcome_start``, whitespace collapsed)."""
     from specrefine.experiments import levers
 
-    ant = ROOT / "data" / "results" / "ant"
     out = tmp_path / "check.md"
-    assert levers.main([str(ant / "oracle_corrector.csv"), "--method", "ours-corrector-redraw", "--baseline",
-                        str(ant / "oracle_confirm.csv"), "--baseline-method", "ours-confirm", "--mazes", "u_chain_3",
-                        "u_chain_5", "--seeds", "0", "1", "2", "--out", str(out)]) == 0
+    assert levers.main([str(ANT / table), "--method", method, "--baseline", str(ANT / baseline), "--baseline-method",
+                        baseline_method, "--mazes", "u_chain_3", "u_chain_5", "--seeds", "0", "1", "2", "--out",
+                        str(out)]) == 0
     capsys.readouterr()
     text = out.read_text()
-    assert text == (ant / "oracle_corrector_check.md").read_text()
-    verdict, difference = re.search(r"6 of 6 cells: (\w+)\.\*\*.*difference (\S+ \[\S+ \S+\])", text).groups()
+    assert text == (ANT / table.replace(".csv", "_check.md")).read_text()
+    verdict, difference = re.search(r"6 of 6 cells: ([\w ]+)\.\*\*.*difference (\S+ \[\S+ \S+\])", text).groups()
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    outcome = " ".join(docs.split("**Outcome (complete 2026-12-04 21:40")[1].split("\n\n")[0].split())
+    return verdict, difference, " ".join(docs.split(outcome_start)[1].split("\n\n")[0].split())
+
+
+def lever_line(table, method, baseline, baseline_method) -> tuple[str, dict, dict]:
+    """What README's line for a lever says (pooled success of both sides, the difference, the verdict) -> (that text,
+    the lever's rows by cell, the baseline's)."""
+    from specrefine.experiments import levers
+
+    lever, base = levers._by_cell(ANT / table, method, None), levers._by_cell(ANT / baseline, baseline_method, None)
+    check = levers.lever_check(lever, base, LEVER_CELLS)
+    (k1, n1), (k2, n2) = check["lever"], check["baseline"]
+    return (f"{k1 / n1:.3f} against {k2 / n2:.3f} over {check['cells']} cells, "
+            f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}"), lever, base
+
+
+def leg_kinds(profiles) -> dict[str, list[str]]:
+    """experiments.legs.turn_table's rows: kind -> its count, episodes started, lost, rate."""
+    from specrefine.experiments.legs import turn_table
+
+    rows = [line.strip("|").split("|") for line in turn_table(profiles).splitlines()[2:]]
+    return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
+
+
+def lost_of(kind: str, side: dict) -> str:
+    count, started, lost, rate = side[kind]
+    return f"{lost} of {started}, {rate}"
+
+
+def test_lever_7_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
+    """docs/ant_experiments.md's lever 7 outcome: the rule's command on the shipped tables, its verdict and interval."""
+    verdict, difference, outcome = lever_check_quoted(tmp_path, capsys, "oracle_corrector.csv",
+                                                      "ours-corrector-redraw", "oracle_confirm.csv", "ours-confirm",
+                                                      "**Outcome (complete 2026-12-04 21:40")
     assert verdict == "helps" and "the correction helps the oracle" in outcome
     assert f"**{difference}**" in outcome
 
 
 def test_front_oracle_corrector_recomputes_from_its_table():
     """README's lever 7 line: pooled success of both sides, the difference and the verdict, and the per-maze means."""
-    from specrefine.experiments import levers
-
-    ant = ROOT / "data" / "results" / "ant"
-    lever = levers._by_cell(ant / "oracle_corrector.csv", "ours-corrector-redraw", None)
-    base = levers._by_cell(ant / "oracle_confirm.csv", "ours-confirm", None)
-    cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
-    check = levers.lever_check(lever, base, cells)
-    (k1, n1), (k2, n2) = check["lever"], check["baseline"]
-    expected = (f"{k1 / n1:.3f} against {k2 / n2:.3f} over {check['cells']} cells, "
-                f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}")
+    expected, lever, _ = lever_line("oracle_corrector.csv", "ours-corrector-redraw", "oracle_confirm.csv",
+                                    "ours-confirm")
     assert front("oracle corrector") == expected
     per_maze = [sum(float(lever[(m, s)]["success_rate"]) for s in (0, 1, 2)) / 3 for m in ("u_chain_3", "u_chain_5")]
     readme = " ".join((ROOT / "README.md").read_text().split())
@@ -282,26 +310,12 @@ def test_front_oracle_corrector_recomputes_from_its_table():
 
 def test_lever_7_legs_recompute_from_the_shipped_profiles():
     """docs/ant_experiments.md's per-kind losses of lever 7's paths and of ours's on the same cells, from the JSONs."""
-    from specrefine.experiments.legs import turn_table
-
-    ant = ROOT / "data" / "results" / "ant"
-
-    def kinds(profiles) -> dict[str, list[str]]:
-        rows = [line.strip("|").split("|") for line in turn_table(profiles).splitlines()[2:]]
-        return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
-
-    lever = kinds(json.loads((ant / "oracle_corrector_legs.json").read_text()))
-    cells = {("u_chain_3", s) for s in (0, 1, 2)} | {("u_chain_5", s) for s in (0, 1, 2)}
-    ours = kinds([p for p in json.loads((ant / "scaling_centre" / "leg_profiles.json").read_text())
-                  if (p["maze"], p["seed"]) in cells])
-
-    def said(kind: str, side: dict) -> str:
-        count, started, lost, rate = side[kind]
-        return f"{lost} of {started}, {rate}"
-
-    expected = (f"turning legs {said('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
-                f"against {said('turning', ours)}; straight legs {said('straight', lever)}, against "
-                f"{said('straight', ours)}")
+    lever = leg_kinds(json.loads((ANT / "oracle_corrector_legs.json").read_text()))
+    ours = leg_kinds([p for p in json.loads((ANT / "scaling_centre" / "leg_profiles.json").read_text())
+                      if (p["maze"], p["seed"]) in set(LEVER_CELLS)])
+    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+                f"against {lost_of('turning', ours)}; straight legs {lost_of('straight', lever)}, against "
+                f"{lost_of('straight', ours)}")
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
     found = re.search(r"<!-- lever 7 legs -->(.*?)<!-- /lever 7 legs -->", docs, flags=re.S)
     assert found and " ".join(found.group(1).split()) == expected
@@ -312,42 +326,24 @@ def test_lever_7_legs_recompute_from_the_shipped_profiles():
 
 def test_lever_8_check_regenerates_and_its_outcome_quotes_it(tmp_path, capsys):
     """docs/ant_experiments.md's lever 8 outcome: the rule's command on the shipped tables, its verdict and interval."""
-    from specrefine.experiments import levers
-
-    ant = ROOT / "data" / "results" / "ant"
-    out = tmp_path / "check.md"
-    assert levers.main([str(ant / "oracle_wide.csv"), "--method", "ours-corrector-wide", "--baseline",
-                        str(ant / "oracle_corrector.csv"), "--baseline-method", "ours-corrector-redraw", "--mazes",
-                        "u_chain_3", "u_chain_5", "--seeds", "0", "1", "2", "--out", str(out)]) == 0
-    capsys.readouterr()
-    text = out.read_text()
-    assert text == (ant / "oracle_wide_check.md").read_text()
-    verdict, difference = re.search(r"6 of 6 cells: ([\w ]+)\.\*\*.*difference (\S+ \[\S+ \S+\])", text).groups()
-    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    outcome = " ".join(docs.split("**Outcome (complete 2026-12-05 01:55")[1].split("\n\n")[0].split())
+    verdict, difference, outcome = lever_check_quoted(tmp_path, capsys, "oracle_wide.csv", "ours-corrector-wide",
+                                                      "oracle_corrector.csv", "ours-corrector-redraw",
+                                                      "**Outcome (complete 2026-12-05 01:55")
     assert verdict == "no difference shown" and "no difference shown.**" in outcome
     assert f"**{difference}**" in outcome
 
 
 def test_front_oracle_wide_recomputes_from_its_table():
     """README's lever 8 line: pooled success of both sides, the difference and the verdict; U-chain 5 pooled; cost."""
-    from specrefine.experiments import levers
-
-    ant = ROOT / "data" / "results" / "ant"
-    lever = levers._by_cell(ant / "oracle_wide.csv", "ours-corrector-wide", None)
-    base = levers._by_cell(ant / "oracle_corrector.csv", "ours-corrector-redraw", None)
-    cells = [(m, s) for m in ("u_chain_3", "u_chain_5") for s in (0, 1, 2)]
-    check = levers.lever_check(lever, base, cells)
-    (k1, n1), (k2, n2) = check["lever"], check["baseline"]
-    expected = (f"{k1 / n1:.3f} against {k2 / n2:.3f} over {check['cells']} cells, "
-                f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}")
+    expected, lever, base = lever_line("oracle_wide.csv", "ours-corrector-wide", "oracle_corrector.csv",
+                                       "ours-corrector-redraw")
     assert front("oracle wide") == expected
 
     def u5(rows):
         return sum(float(rows[("u_chain_5", s)]["success_rate"]) for s in (0, 1, 2)) / 3
 
     def ratio(column):
-        return sum(int(lever[c][column]) for c in cells) / sum(int(base[c][column]) for c in cells)
+        return sum(int(lever[c][column]) for c in LEVER_CELLS) / sum(int(base[c][column]) for c in LEVER_CELLS)
 
     readme = " ".join((ROOT / "README.md").read_text().split())
     assert (f"U-chain 5 pooled {u5(lever):.3f} against {u5(base):.3f}, at {ratio('proposer_calls'):.2f}x lever 7's "
@@ -356,24 +352,11 @@ def test_front_oracle_wide_recomputes_from_its_table():
 
 def test_lever_8_legs_recompute_from_the_shipped_profiles():
     """docs/ant_experiments.md's per-kind losses of lever 8's paths against lever 7's, from the shipped JSONs."""
-    from specrefine.experiments.legs import turn_table
-
-    ant = ROOT / "data" / "results" / "ant"
-
-    def kinds(name) -> dict[str, list[str]]:
-        rows = [line.strip("|").split("|") for line in
-                turn_table(json.loads((ant / name).read_text())).splitlines()[2:]]
-        return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
-
-    lever, before = kinds("oracle_wide_legs.json"), kinds("oracle_corrector_legs.json")
-
-    def said(kind: str, side: dict) -> str:
-        count, started, lost, rate = side[kind]
-        return f"{lost} of {started}, {rate}"
-
-    expected = (f"turning legs {said('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
-                f"against lever 7's {said('turning', before)}; straight legs {said('straight', lever)}, against "
-                f"{said('straight', before)}")
+    lever, before = (leg_kinds(json.loads((ANT / name).read_text()))
+                     for name in ("oracle_wide_legs.json", "oracle_corrector_legs.json"))
+    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+                f"against lever 7's {lost_of('turning', before)}; straight legs {lost_of('straight', lever)}, against "
+                f"{lost_of('straight', before)}")
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
     found = re.search(r"<!-- lever 8 legs -->(.*?)<!-- /lever 8 legs -->", docs, flags=re.S)
     assert found and " ".join(found.group(1).split()) == expected

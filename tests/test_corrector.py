@@ -6,6 +6,7 @@ what the stub's proposer answers decides what each lever can do.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,6 +63,17 @@ def run(evaluator, proposer, **cfg):
     result = RefinementSearch(g, evaluator, proposer=proposer, config=config,
                               query_for=lambda graph, u, v, r: _Query(graph, u, v)).run()
     return g, result
+
+
+def point_run(tmp_path, method: str) -> tuple[dict, list[dict]]:
+    """``method`` end to end on the point's U-chain 2 (imperfect:moderate, seed 1, centre goal points, a small run)
+    -> (its result.json, its steps log)."""
+    from specrefine.runs.pipeline import refine_maze
+
+    out = tmp_path / "run"
+    result = refine_maze("u_chain_2", method=method, proposer="imperfect:moderate", out=out, agent="point",
+                         rollouts=8, episodes=20, seed=1, goal_points="centre").data
+    return result, [json.loads(line) for line in (out / "steps.jsonl").read_text().splitlines()]
 
 
 def xs(result):
@@ -137,8 +149,6 @@ def test_the_correction_spends_at_most_one_split_per_leg_of_the_found_path():
 
 
 def test_ours_corrector_runs_end_to_end_and_logs_its_correction(tmp_path):
-    import json
-
     from specrefine.runs.pipeline import refine_maze
 
     out = tmp_path / "run"
@@ -262,8 +272,6 @@ def test_posterior_mean_of_a_leg_nothing_reached_is_zero():
 
 
 def test_ours_corrector_lean_runs_end_to_end_and_logs_its_pruning(tmp_path):
-    import json
-
     from specrefine.runs.pipeline import refine_maze
 
     out = tmp_path / "run"

@@ -3,10 +3,8 @@ draw replaces the path only if it also beats it on a second draw of its own."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
-from test_corrector import FAR_DEAD, LUCKY, ONWARD, AnswerBook, EdgeQueue, LegTable, run, xs
+from test_corrector import FAR_DEAD, LUCKY, ONWARD, AnswerBook, EdgeQueue, LegTable, point_run, run, xs
 
 from specrefine.core.graph import check_refines
 from specrefine.refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET
@@ -49,12 +47,7 @@ def test_without_it_the_first_draws_win_is_taken():
 
 
 def test_ours_corrector_crosscheck_runs_end_to_end_and_logs_both_draws(tmp_path):
-    from specrefine.runs.pipeline import refine_maze
-
-    out = tmp_path / "run"
-    result = refine_maze("u_chain_2", method="ours-corrector-crosscheck", proposer="imperfect:moderate", out=out,
-                         agent="point", rollouts=8, episodes=20, seed=1, goal_points="centre").data
-    steps = [json.loads(line) for line in (out / "steps.jsonl").read_text().splitlines()]
+    result, steps = point_run(tmp_path, "ours-corrector-crosscheck")
     assert steps[-1]["event"] == "done" and result["refines_input"] is True
     done = next(s for s in steps if s["event"] == "correct-done")
     assert 0.0 <= done["p_second"] <= 1.0

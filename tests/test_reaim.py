@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 import pytest
-from test_corrector import LUCKY, AnswerBook, LegTable, run, xs
+from test_corrector import LUCKY, AnswerBook, LegTable, point_run, run, xs
 from test_refine_search import _Arrive
 
 from specrefine.core.graph import check_refines
@@ -58,13 +58,9 @@ def test_a_reaim_that_gains_nothing_is_not_taken():
 
 
 def test_ours_corrector_reaim_runs_end_to_end_and_its_policy_aims_where_it_chose(tmp_path):
-    from specrefine.runs.pipeline import refine_maze
-
-    out = tmp_path / "run"
-    result = refine_maze("u_chain_2", method="ours-corrector-reaim", proposer="imperfect:moderate", out=out,
-                         agent="point", rollouts=8, episodes=20, seed=1, goal_points="centre").data
-    events = [json.loads(line)["event"] for line in (out / "steps.jsonl").read_text().splitlines()]
+    result, steps = point_run(tmp_path, "ours-corrector-reaim")
+    events = [step["event"] for step in steps]
     assert events[-1] == "done" and "correct-done" in events
     assert result["method"] == "ours-corrector-reaim" and result["refines_input"] is True
-    saved = [leg["point"] for leg in json.loads((out / "policy.json").read_text())["legs"]]
+    saved = [leg["point"] for leg in json.loads((tmp_path / "run" / "policy.json").read_text())["legs"]]
     assert len(saved) == len(result["path"]) - 1 and all(p is not None for p in saved)  # centre or re-aimed

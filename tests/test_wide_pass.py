@@ -3,10 +3,8 @@ asks the proposer only about legs with several failures there."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
-from test_corrector import LUCKY, AnswerBook, LegTable, run, xs
+from test_corrector import LUCKY, AnswerBook, LegTable, point_run, run, xs
 
 from specrefine.core.graph import check_refines
 from specrefine.refine import SearchConfig
@@ -59,12 +57,7 @@ def test_bad_settings_are_refused(bad):
 
 
 def test_ours_corrector_wide_runs_end_to_end_and_logs_its_wide_pass(tmp_path):
-    from specrefine.runs.pipeline import refine_maze
-
-    out = tmp_path / "run"
-    result = refine_maze("u_chain_2", method="ours-corrector-wide", proposer="imperfect:moderate", out=out,
-                         agent="point", rollouts=8, episodes=20, seed=1, goal_points="centre").data
-    steps = [json.loads(line) for line in (out / "steps.jsonl").read_text().splitlines()]
+    result, steps = point_run(tmp_path, "ours-corrector-wide")
     assert steps[-1]["event"] == "done" and result["refines_input"] is True
     checks = [s for s in steps if s["event"] == "correct-check"]
     assert [s["correct_pass"] for s in checks] == [1, 2, 3] and checks[-1]["wide_rollouts"] == 16 * 8

@@ -534,12 +534,13 @@ def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str
                           table=f"data/results/corrector/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
 
 
-def ant_oracle_grid(name: str, source: str, method: str, stem: str, code: str) -> ExperimentGrid:
-    """``method`` x the oracle on the Ant (issue 42): the U-chains, seeds 0-2 seed by seed, stage 5, adaptive
-    evaluation, centre goal points, into data/results/ant/STEM.csv."""
+def ant_oracle_grid(name: str, source: str, method: str, stem: str, code: str, mazes: tuple = SCALING_MAZES,
+                    split_pick: str | None = None) -> ExperimentGrid:
+    """``method`` x the oracle on the Ant (issue 42): ``mazes`` (the U-chains), seeds 0-2 seed by seed, stage 5,
+    adaptive evaluation, centre goal points, into data/results/ant/STEM.csv. ``split_pick``: as ant_corrector_grid's."""
     return ExperimentGrid(name, source, "ant", parts=(Part((method,), (GEOMETRIC_48,), split="seeds"),),
-                          seeds=(0, 1, 2), mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt",
-                          evaluation="adaptive", goal_points="centre", workers=1, code=code,
+                          seeds=(0, 1, 2), mazes=mazes, policy="data/policies/ant_stage5.pt",
+                          evaluation="adaptive", goal_points="centre", split_pick=split_pick, workers=1, code=code,
                           table=f"data/results/ant/{stem}.csv", out=f"runs/{name.replace('-', '_')}")
 
 
@@ -892,37 +893,24 @@ GRIDS = {g.name: g for g in (
                        "2026-12-02 08:30 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with a second correction pass on a fresh draw", "ant_redraw",
                        code="96e357e", method="ours-corrector-redraw", split_pick="confirmed"),
-    ExperimentGrid(
-        "ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC before its "
-        "first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5", "ant",
-        parts=(Part(("ours-corrector-redraw",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", split_pick="confirmed", workers=1, code="2b6a4f7",
-        table="data/results/ant/oracle_corrector.csv", out="runs/ant_oracle_corrector"),
-    ExperimentGrid(
-        "ant-oracle-corrector-scaling", "docs/ant_experiments.md, 'Issue 42, lever 7 on every U-chain' (fixed "
-        "2026-12-04 21:50 UTC before its first new cell ran): lever 7's corrector with the oracle on the nine "
-        "U-chains; its six U-chain 3 and 5 cells are lever 7's rows (the same code and cells), copied into its table, "
-        "not run again",
-        "ant", parts=(Part(("ours-corrector-redraw",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
-        split_pick="confirmed", workers=1, code="2b6a4f7", table="data/results/ant/oracle_corrector_scaling.csv",
-        out="runs/ant_oracle_corrector_scaling"),
-    ExperimentGrid(
-        "ant-oracle-wide", "docs/ant_experiments.md, 'Issue 42, lever 8' (fixed 2026-12-05 00:22 UTC before its first "
-        "cell ran): lever 7's corrector with one more pass on a wide draw, on lever 7's six cells",
-        "ant", parts=(Part(("ours-corrector-wide",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=("u_chain_3", "u_chain_5"), policy="data/policies/ant_stage5.pt", evaluation="adaptive",
-        goal_points="centre", split_pick="confirmed", workers=1, code="adda718",
-        table="data/results/ant/oracle_wide.csv", out="runs/ant_oracle_wide"),
-    ExperimentGrid(
-        "ant-oracle-wide-scaling", "docs/ant_experiments.md, 'Issue 42, lever 8 on every U-chain' (fixed 2026-12-05 "
-        "01:56 UTC before its first new cell ran): lever 8's corrector with the oracle on the nine U-chains; its six "
-        "U-chain 3 and 5 cells are lever 8's rows (the same code and cells), copied into its table, not run again",
-        "ant", parts=(Part(("ours-corrector-wide",), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2),
-        mazes=SCALING_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre",
-        split_pick="confirmed", workers=1, code="adda718", table="data/results/ant/oracle_wide_scaling.csv",
-        out="runs/ant_oracle_wide_scaling"),
+    ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
+                    "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
+                    "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),
+                    split_pick="confirmed"),
+    ant_oracle_grid("ant-oracle-corrector-scaling", "docs/ant_experiments.md, 'Issue 42, lever 7 on every U-chain' "
+                    "(fixed 2026-12-04 21:50 UTC before its first new cell ran): lever 7's corrector with the oracle "
+                    "on the nine U-chains; its six U-chain 3 and 5 cells are lever 7's rows (the same code and cells), "
+                    "copied into its table, not run again",
+                    "ours-corrector-redraw", "oracle_corrector_scaling", code="2b6a4f7", split_pick="confirmed"),
+    ant_oracle_grid("ant-oracle-wide", "docs/ant_experiments.md, 'Issue 42, lever 8' (fixed 2026-12-05 00:22 UTC "
+                    "before its first cell ran): lever 7's corrector with one more pass on a wide draw, on lever 7's "
+                    "six cells", "ours-corrector-wide", "oracle_wide", code="adda718",
+                    mazes=("u_chain_3", "u_chain_5"), split_pick="confirmed"),
+    ant_oracle_grid("ant-oracle-wide-scaling", "docs/ant_experiments.md, 'Issue 42, lever 8 on every U-chain' (fixed "
+                    "2026-12-05 01:56 UTC before its first new cell ran): lever 8's corrector with the oracle on the "
+                    "nine U-chains; its six U-chain 3 and 5 cells are lever 8's rows (the same code and cells), copied "
+                    "into its table, not run again", "ours-corrector-wide", "oracle_wide_scaling", code="adda718",
+                    split_pick="confirmed"),
     ExperimentGrid(
         "ant-corrector-fresh", "docs/corrector.md, 'Fresh layouts for the Ant' (issue 39; fixed 2026-12-04 before it "
         "ran): ours-corrector-redraw and its control confirm on layouts and a mix no run had used, and the oracle",
