@@ -359,6 +359,14 @@ register_method("ours-corrector-redraw", ours_variant(**REDRAW),
                 "it left on a fresh draw of its own (new first states, a budget of one proposer split per leg), so "
                 "that a leg chosen on one draw's rollouts is judged again on rollouts that did not choose it",
                 colour="#3e2723")
+#: ours-corrector-sparing: redraw, whose two passes ask the proposer only about a leg with at least 3 fresh failures
+#: (docs/corrector.md, "A gate for the Ant's corrector")
+SPARING = REDRAW | dict(correct_min_failures=3)
+register_method("ours-corrector-sparing", ours_variant(**SPARING),
+                "beyond the paper: ours-corrector-redraw whose correction, on both passes, asks the proposer about a "
+                "leg only where at least 3 of its 4n fresh rollouts failed (128 at n = 32); a leg with one or two "
+                "failures is offered its bypass only, which asks nothing, so that the proposer is not asked about a "
+                "leg whose loss the draw cannot tell from none", colour="#a1887f")
 #: ours-corrector-wide: redraw, then one more pass on a wide draw (docs/ant_experiments.md, "Issue 42, lever 8")
 register_method("ours-corrector-wide",
                 ours_variant(**REDRAW | dict(correct_wide=16, correct_wide_min_failures=3)),
