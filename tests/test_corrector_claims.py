@@ -301,7 +301,7 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
                                  f"no cell in both yet. {cc.ANT_REAIM} ({cc.REAIM}): no cell yet; {cc.REAIM} - "
                                  f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet. {cc.ANT_REDRAW} "
                                  f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
-                                 "no cell in both yet")
+                                 f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -364,6 +364,35 @@ def test_where_both_candidates_hold_the_one_with_the_higher_pooled_success_is_re
              if v["rule"].startswith("Ant: ours-corrector-re") and " above 0 " in v["rule"]}
     assert rules == {f"Ant: {cc.REAIM}": f"holds; {cc.REDRAW} read (higher pooled success)",
                      f"Ant: {cc.REDRAW}": "adopted"}
+
+
+@pytest.mark.parametrize("rate, calls, verdict", [
+    (0.9, 5, "adopted"), (0.9, 8, "not adopted (cheaper missed)"), (0.86, 5, "not adopted (no worse missed)"),
+    (0.84, 5, "not adopted (floor, no worse missed)")])
+def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of_its_rule_holds(tmp_path, rate, calls,
+                                                                                                verdict):
+    """ant-corrector-sparing's rule (docs/corrector.md, 'A gate for the Ant's corrector'): over the 27 cells paired
+    with redraw, at least 0.85 on every maze, the difference's interval above -0.02 and at most 0.75x redraw's mean
+    proposer calls; undecided until every cell ran."""
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
+    lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)  # adopted over confirm
+    lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls, drop=1)
+    ant = cc.ant_study(tmp_path)
+    assert (ant["grid"], ant["method"]) == (cc.ANT_REDRAW, cc.REDRAW)
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(f"Ant: {cc.SPARING} in place"))
+    assert rule["verdict"] == "undecided (26 of 27 cells)"
+    lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls)
+    ant = cc.ant_study(tmp_path)
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(f"Ant: {cc.SPARING} in place"))
+    assert rule["verdict"] == verdict and rule["value"].endswith(f"; proposer calls {calls / 10:.2f}x")
+    adopted = verdict == "adopted"
+    assert (ant["grid"], ant["method"]) == ((cc.ANT_SPARING, cc.SPARING) if adopted else (cc.ANT_REDRAW, cc.REDRAW))
+    floor = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
+    assert floor["rule"].startswith(f"Ant ({cc.SPARING if adopted else cc.REDRAW})")
+    assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc._ant_text(ant)) is adopted
+    md = cc.markdown(cc.point_study(tmp_path), ant)
+    assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
 
 
 def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):
@@ -851,12 +880,13 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     lines = table.strip().splitlines()
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 4  # + the two held-out mixes + the Ant's four rules
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5  # + the two held-out mixes + the Ant's five rules
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
-    assert rules[-4].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-3].startswith(f"Ant: {cc.ANT_METHOD}")
-    assert rules[-2].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
-    assert rules[-1].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
+    assert rules[-5].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-4].startswith(f"Ant: {cc.ANT_METHOD}")
+    assert rules[-3].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
+    assert rules[-2].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
+    assert rules[-1].startswith(f"Ant: {cc.SPARING} in place of {cc.REDRAW}")
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
 

@@ -157,6 +157,13 @@ ANT_FIRST = "ant-corrector"  # ours-corrector before spread start states (stoppe
 ANT_REAIM, REAIM = "ant-corrector-reaim", "ours-corrector-reaim"
 ANT_REDRAW, REDRAW = "ant-corrector-redraw", "ours-corrector-redraw"
 ANT_CANDIDATES = {ANT_REAIM: REAIM, ANT_REDRAW: REDRAW}
+#: the same cells with a cheaper corrector (docs/corrector.md, "A gate for the Ant's corrector"): the Ant's rules read
+#: it in place of the corrector it spares (while that one is read) once every paired cell ran, it holds ANT_FLOOR on
+#: every maze, it - that corrector has a 95 % interval whose lower end is at least -NON_INFERIORITY, and its mean
+#: proposer calls are at most SAVER_CALLS of that corrector's
+ANT_SPARING, SPARING = "ant-corrector-sparing", "ours-corrector-sparing"
+ANT_SAVERS = {ANT_SPARING: (SPARING, ANT_REDRAW)}
+SAVER_CALLS = 0.75
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
@@ -291,8 +298,13 @@ def ant_study(root: Path = ROOT) -> dict | None:
     adopted = max((c for c in candidates if c["adopted"]), key=lambda c: c["pooled"], default=None)
     now, grid, method = (studies[adopted["grid"]], adopted["grid"], adopted["method"]) if adopted else \
         (confirm, ANT_GRID, ANT_METHOD)
+    savers = [_ant_saver(saver, spared, root) for saver, (_, spared) in ANT_SAVERS.items()]
+    for saver in savers:
+        if saver["adopted"] and saver["spares"] == grid:
+            now, grid, method = saver["study"], saver["grid"], saver["method"]
     return now | {"grid": grid, "method": method, "confirm": confirm["per_maze"], "before": before["per_maze"],
-                  "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates}
+                  "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates,
+                  "savers": savers}
 
 
 def ant_fresh_study(root: Path = ROOT) -> dict | None:
@@ -310,6 +322,22 @@ def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
             "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan,
             "cost_vs_confirm": costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, ANT_METHOD),
             "cost_vs_ours": study["costs"]}
+
+
+def _ant_saver(grid: str, spared: str, root: Path) -> dict:
+    """A cheaper corrector on the cells of the ``spared`` grid's: its cells per maze, its paired difference from the
+    spared corrector, its cost over that corrector's, and whether its rule (ANT_SAVERS) holds."""
+    method, base = ANT_SAVERS[grid][0], ANT_CANDIDATES[spared]
+    study = _ant_grid_study(grid, method, root)
+    rows = load(GRIDS[grid].tables + GRIDS[spared].tables, root)
+    paired = _ant_paired_rows(rows, method, base)
+    cost = costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, base)
+    parts = {"floor": all(e["episodes"] and e["success"] >= ANT_FLOOR for e in study["per_maze"]),
+             "no worse": bool(paired["cells"]) and paired["ci"][0] >= -NON_INFERIORITY,
+             "cheaper": cost["proposer_calls_ratio"] <= SAVER_CALLS}
+    return {"grid": grid, "method": method, "spares": spared, "spared_method": base, "study": study,
+            "per_maze": study["per_maze"], "paired": paired, "parts": parts, "cost_vs_spared": cost,
+            "cost_vs_ours": study["costs"], "adopted": paired["complete"] and all(parts.values())}
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
@@ -779,7 +807,22 @@ def _ant_verdicts(ant: dict) -> list[dict]:
                 "verdict": _verdict(not low, complete)},
                {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                 "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
-    return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]]
+    return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]] + \
+        [_saver_verdict(saver) for saver in ant["savers"]]
+
+
+def _saver_verdict(saver: dict) -> dict:
+    """A cheaper corrector's rule: "adopted" when every part holds over every paired cell, else the parts missed."""
+    e, calls = saver["paired"], saver["cost_vs_spared"]["proposer_calls_ratio"]
+    if not e["complete"]:
+        verdict = f"undecided ({e['cells']} of {e['expected']} cells)"
+    else:
+        missed = [part for part, held in saver["parts"].items() if not held]
+        verdict = "adopted" if saver["adopted"] else f"not adopted ({', '.join(missed)} missed)"
+    value = _ant_paired_text(e) + ("" if math.isnan(calls) else f"; proposer calls {calls:.2f}x")
+    return {"rule": f"Ant: {saver['method']} in place of {saver['spared_method']}: at least {ANT_FLOOR} on every maze, "
+                    f"the difference's 95 % interval above -{NON_INFERIORITY} (every paired cell), at most "
+                    f"{SAVER_CALLS}x its proposer calls", "value": value, "verdict": verdict}
 
 
 def _candidate_verdict(candidate: dict, read: str) -> dict:
@@ -901,7 +944,19 @@ def ant_markdown(ant: dict) -> list[str]:
               f"| {c['method']} | {_cost_cells(c['cost_vs_confirm'])} | {_cost_cells(c['cost_vs_ours'])} |"
               for c in candidates] + [
               "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
-    return lines + [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+    lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
+    return lines + [line for saver in ant["savers"] for line in saver_markdown(saver)]
+
+
+def saver_markdown(saver: dict) -> list[str]:
+    """A cheaper corrector's cells per maze beside the one it spares, their difference and its cost."""
+    return ["", f"`{saver['grid']}` ({saver['method']}, in place of {saver['spared_method']} if its rule holds; "
+            "docs/corrector.md, 'A gate for the Ant's corrector'), pooled per maze (Wilson 95 %):", "",
+            "| maze | runs | success [95 % CI] |", "|---|---|---|"] + [
+            f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} |" for e in saver["per_maze"]] + [
+            "", f"{saver['method']} - {saver['spared_method']} on the cells both ran: "
+            f"{_ant_paired_text(saver['paired'])}. Its mean cost over {saver['spared_method']}'s: "
+            f"{_cost_text(saver['cost_vs_spared'])}; over ours's: {_cost_text(saver['cost_vs_ours'])}."]
 
 
 def _cost_cells(c: dict) -> str:
@@ -1299,7 +1354,13 @@ def _ant_text(ant: dict) -> str:
             + ". ".join(f"{c['grid']} ({c['method']}): {cells(c['per_maze'])}; {c['method']} - {ANT_METHOD} on the "
                         f"cells both ran: {_ant_paired_text(c['paired'])}"
                         + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
-                        for c in ant["candidates"]))
+                        for c in ant["candidates"])
+            + "".join(f". {c['grid']} ({c['method']}): {cells(c['per_maze'])}" + (
+                          f"; {c['method']} - {c['spared_method']} on the cells both ran: "
+                          f"{_ant_paired_text(c['paired'])}; its mean cost over {c['spared_method']}'s: "
+                          f"{_cost_text(c['cost_vs_spared'])}" if c["paired"]["cells"] else "")
+                      + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
+                      for c in ant["savers"]))
 
 
 def _ant_paired_text(e: dict) -> str:

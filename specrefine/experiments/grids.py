@@ -893,6 +893,10 @@ GRIDS = {g.name: g for g in (
                        "2026-12-02 08:30 UTC before its first cell ran; one confirm cell's pilot informed it): "
                        "ant-corrector-confirm's cells with a second correction pass on a fresh draw", "ant_redraw",
                        code="96e357e", method="ours-corrector-redraw", split_pick="confirmed"),
+    ant_corrector_grid("ant-corrector-sparing", "docs/corrector.md, 'A gate for the Ant's corrector' (issue 39; fixed "
+                       "2026-12-05 03:30 UTC before its first cell ran; two of redraw's step logs informed it): "
+                       "ant-corrector-redraw's cells with the correction's proposer gated at 3 fresh failures",
+                       "ant_sparing", code="d0214b6", method="ours-corrector-sparing", split_pick="confirmed"),
     ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
                     "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
                     "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),
