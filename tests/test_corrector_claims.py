@@ -374,17 +374,18 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     """ant-corrector-sparing's rule (docs/corrector.md, 'A gate for the Ant's corrector'): over the 27 cells paired
     with redraw, at least 0.85 on every maze, the difference's interval above -0.02 and at most 0.75x redraw's mean
     proposer calls; undecided until every cell ran."""
+    saver_rule = f"Ant: {cc.SPARING} in place of {cc.REDRAW}"
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
     lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)  # adopted over confirm
     lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls, drop=1)
     ant = cc.ant_study(tmp_path)
     assert (ant["grid"], ant["method"]) == (cc.ANT_REDRAW, cc.REDRAW)
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(f"Ant: {cc.SPARING} in place"))
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(saver_rule))
     assert rule["verdict"] == "undecided (26 of 27 cells)"
     lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls)
     ant = cc.ant_study(tmp_path)
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(f"Ant: {cc.SPARING} in place"))
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(saver_rule))
     assert rule["verdict"] == verdict and rule["value"].endswith(f"; proposer calls {calls / 10:.2f}x")
     adopted = verdict == "adopted"
     assert (ant["grid"], ant["method"]) == ((cc.ANT_SPARING, cc.SPARING) if adopted else (cc.ANT_REDRAW, cc.REDRAW))
