@@ -374,18 +374,18 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     """ant-corrector-sparing's rule (docs/corrector.md, 'A gate for the Ant's corrector'): over the 27 cells paired
     with redraw, at least 0.85 on every maze, the difference's interval above -0.02 and at most 0.75x redraw's mean
     proposer calls; undecided until every cell ran."""
-    saver_rule = f"Ant: {cc.SPARING} in place of {cc.REDRAW}"
+    successor_rule = f"Ant: {cc.SPARING} in place of {cc.REDRAW}"
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
     lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)  # adopted over confirm
     lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls, drop=1)
     ant = cc.ant_study(tmp_path)
     assert (ant["grid"], ant["method"]) == (cc.ANT_REDRAW, cc.REDRAW)
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(saver_rule))
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(successor_rule))
     assert rule["verdict"] == "undecided (26 of 27 cells)"
     lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: rate, calls_of=lambda m: calls)
     ant = cc.ant_study(tmp_path)
-    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(saver_rule))
+    rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(successor_rule))
     assert rule["verdict"] == verdict and rule["value"].endswith(f"; proposer calls {calls / 10:.2f}x")
     adopted = verdict == "adopted"
     assert (ant["grid"], ant["method"]) == ((cc.ANT_SPARING, cc.SPARING) if adopted else (cc.ANT_REDRAW, cc.REDRAW))
@@ -394,6 +394,38 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc._ant_text(ant)) is adopted
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
+
+
+def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path, monkeypatch):
+    """A successor with margin None (its difference's interval not wholly below 0, no cost part), beside sparing: where
+    both hold, the one with the higher pooled success is read and the other's row says so."""
+    from specrefine.experiments.grids import ant_corrector_grid
+
+    grid = ant_corrector_grid("ant-corrector-successor-test", "a test", "successor_test", code="d0214b6",
+                              method="ours-corrector-wide", split_pick="confirmed")
+    monkeypatch.setitem(GRIDS, grid.name, grid)
+    monkeypatch.setitem(cc.ANT_SUCCESSORS, grid.name, cc.Successor("ours-corrector-wide", cc.ANT_REDRAW, "a test",
+                                                                   margin=None))
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
+    lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)
+    lay_grid(tmp_path, grid.name, lambda maze, m, p: 0.895, calls_of=lambda m: 30)  # below redraw, not wholly
+    rules = {v["rule"].split(":")[1].strip(): v for v in cc.verdicts(cc.point_study(tmp_path), cc.ant_study(tmp_path))
+             if " in place of " in v["rule"]}
+    wide_rule = f"Ant: ours-corrector-wide in place of {cc.REDRAW}"
+    wide = rules[wide_rule.removeprefix("Ant: ")]
+    assert wide["verdict"] == "adopted" and "not wholly below 0" in wide["rule"] and "at most" not in wide["rule"]
+    lay_grid(tmp_path, grid.name, lambda maze, m, p: 0.85, calls_of=lambda m: 30)  # wholly below redraw
+    ant = cc.ant_study(tmp_path)
+    verdict = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(wide_rule))
+    assert verdict["verdict"] == "not adopted (not below missed)" and ant["method"] == cc.REDRAW
+    lay_grid(tmp_path, grid.name, lambda maze, m, p: 0.93, calls_of=lambda m: 30)
+    lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: 0.9, calls_of=lambda m: 5)
+    ant = cc.ant_study(tmp_path)
+    verdicts = {v["rule"].split(" in place")[0]: v["verdict"] for v in cc.verdicts(cc.point_study(tmp_path), ant)
+                if " in place of " in v["rule"]}
+    assert ant["method"] == "ours-corrector-wide"
+    assert verdicts == {"Ant: ours-corrector-wide": "adopted", f"Ant: {cc.SPARING}": "holds; ours-corrector-wide read"}
 
 
 def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):

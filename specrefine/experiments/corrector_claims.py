@@ -22,6 +22,7 @@ import json
 import math
 import re
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -157,13 +158,30 @@ ANT_FIRST = "ant-corrector"  # ours-corrector before spread start states (stoppe
 ANT_REAIM, REAIM = "ant-corrector-reaim", "ours-corrector-reaim"
 ANT_REDRAW, REDRAW = "ant-corrector-redraw", "ours-corrector-redraw"
 ANT_CANDIDATES = {ANT_REAIM: REAIM, ANT_REDRAW: REDRAW}
-#: the same cells with a cheaper corrector (docs/corrector.md, "A gate for the Ant's corrector"): the Ant's rules read
-#: it in place of the corrector it spares (while that one is read) once every paired cell ran, it holds ANT_FLOOR on
-#: every maze, it - that corrector has a 95 % interval whose lower end is at least -NON_INFERIORITY, and its mean
-#: proposer calls are at most SAVER_CALLS of that corrector's
+
+
+@dataclass(frozen=True)
+class Successor:
+    """A corrector run on the cells of the one the Ant's rules read (``follows``, a grid of ANT_CANDIDATES), read in
+    its place (while that one is read) once every paired cell ran and its rule holds: at least ANT_FLOOR on every maze;
+    its difference from that corrector with a 95 % interval whose lower end is at least -``margin`` (None: whose upper
+    end is at least 0, not wholly below); at most ``calls`` times that corrector's mean proposer calls (None: any)."""
+
+    method: str
+    follows: str
+    section: str
+    margin: float | None = NON_INFERIORITY
+    calls: float | None = None
+
+    def rule(self) -> str:
+        bound = (f"above -{self.margin}" if self.margin is not None else "not wholly below 0")
+        return (f"at least {ANT_FLOOR} on every maze, the difference's 95 % interval {bound} (every paired cell)"
+                + (f", at most {self.calls}x its proposer calls" if self.calls is not None else ""))
+
+
 ANT_SPARING, SPARING = "ant-corrector-sparing", "ours-corrector-sparing"
-ANT_SAVERS = {ANT_SPARING: (SPARING, ANT_REDRAW)}
-SAVER_CALLS = 0.75
+#: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector")
+ANT_SUCCESSORS = {ANT_SPARING: Successor(SPARING, ANT_REDRAW, "A gate for the Ant's corrector", calls=0.75)}
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 HELD_OUT_SEEDS = GRIDS["corrector-held-out"].seeds
 MIX_NAMES = dict(zip(HELD_OUT_MIXES, ("A", "B")))
@@ -298,13 +316,14 @@ def ant_study(root: Path = ROOT) -> dict | None:
     adopted = max((c for c in candidates if c["adopted"]), key=lambda c: c["pooled"], default=None)
     now, grid, method = (studies[adopted["grid"]], adopted["grid"], adopted["method"]) if adopted else \
         (confirm, ANT_GRID, ANT_METHOD)
-    savers = [_ant_saver(saver, spared, root) for saver, (_, spared) in ANT_SAVERS.items()]
-    for saver in savers:
-        if saver["adopted"] and saver["spares"] == grid:
-            now, grid, method = saver["study"], saver["grid"], saver["method"]
+    successors = [_ant_successor(name, root) for name in ANT_SUCCESSORS]
+    following = [s for s in successors if s["adopted"] and s["follows"] == grid]
+    if following:  # where several hold, the one with the higher pooled success
+        best = max(following, key=lambda s: s["pooled"])
+        now, grid, method = best["study"], best["grid"], best["method"]
     return now | {"grid": grid, "method": method, "confirm": confirm["per_maze"], "before": before["per_maze"],
                   "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates,
-                  "savers": savers}
+                  "successors": successors}
 
 
 def ant_fresh_study(root: Path = ROOT) -> dict | None:
@@ -324,20 +343,25 @@ def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
             "cost_vs_ours": study["costs"]}
 
 
-def _ant_saver(grid: str, spared: str, root: Path) -> dict:
-    """A cheaper corrector on the cells of the ``spared`` grid's: its cells per maze, its paired difference from the
-    spared corrector, its cost over that corrector's, and whether its rule (ANT_SAVERS) holds."""
-    method, base = ANT_SAVERS[grid][0], ANT_CANDIDATES[spared]
-    study = _ant_grid_study(grid, method, root)
-    rows = load(GRIDS[grid].tables + GRIDS[spared].tables, root)
-    paired = _ant_paired_rows(rows, method, base)
-    cost = costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, base)
+def _ant_successor(grid: str, root: Path) -> dict:
+    """A successor (ANT_SUCCESSORS) on the cells of the grid it follows: its cells per maze, its paired difference from
+    that corrector, its cost over that corrector's, each part of its rule and whether all hold over every cell."""
+    s = ANT_SUCCESSORS[grid]
+    base = ANT_CANDIDATES[s.follows]
+    study = _ant_grid_study(grid, s.method, root)
+    rows = load(GRIDS[grid].tables + GRIDS[s.follows].tables, root)
+    paired = _ant_paired_rows(rows, s.method, base)
+    cost = costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, s.method, base)
+    bounded = bool(paired["cells"]) and (paired["ci"][0] >= -s.margin if s.margin is not None else paired["ci"][1] >= 0)
     parts = {"floor": all(e["episodes"] and e["success"] >= ANT_FLOOR for e in study["per_maze"]),
-             "no worse": bool(paired["cells"]) and paired["ci"][0] >= -NON_INFERIORITY,
-             "cheaper": cost["proposer_calls_ratio"] <= SAVER_CALLS}
-    return {"grid": grid, "method": method, "spares": spared, "spared_method": base, "study": study,
-            "per_maze": study["per_maze"], "paired": paired, "parts": parts, "cost_vs_spared": cost,
-            "cost_vs_ours": study["costs"], "adopted": paired["complete"] and all(parts.values())}
+             "no worse" if s.margin is not None else "not below": bounded}
+    if s.calls is not None:
+        parts["cheaper"] = cost["proposer_calls_ratio"] <= s.calls
+    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
+    return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
+            "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
+            "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": k / n if n else math.nan,
+            "adopted": paired["complete"] and all(parts.values())}
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
@@ -808,21 +832,21 @@ def _ant_verdicts(ant: dict) -> list[dict]:
                {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
                 "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
     return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]] + \
-        [_saver_verdict(saver) for saver in ant["savers"]]
+        [_successor_verdict(s, ant["method"]) for s in ant["successors"]]
 
 
-def _saver_verdict(saver: dict) -> dict:
-    """A cheaper corrector's rule: "adopted" when every part holds over every paired cell, else the parts missed."""
-    e, calls = saver["paired"], saver["cost_vs_spared"]["proposer_calls_ratio"]
+def _successor_verdict(s: dict, read: str) -> dict:
+    """A successor's rule: "adopted" when the Ant's rules read it, the parts missed where its rule does not hold."""
+    e, calls = s["paired"], s["cost_vs_followed"]["proposer_calls_ratio"]
     if not e["complete"]:
         verdict = f"undecided ({e['cells']} of {e['expected']} cells)"
+    elif not s["adopted"]:
+        verdict = f"not adopted ({', '.join(part for part, held in s['parts'].items() if not held)} missed)"
     else:
-        missed = [part for part, held in saver["parts"].items() if not held]
-        verdict = "adopted" if saver["adopted"] else f"not adopted ({', '.join(missed)} missed)"
+        verdict = "adopted" if s["method"] == read else f"holds; {read} read"
     value = _ant_paired_text(e) + ("" if math.isnan(calls) else f"; proposer calls {calls:.2f}x")
-    return {"rule": f"Ant: {saver['method']} in place of {saver['spared_method']}: at least {ANT_FLOOR} on every maze, "
-                    f"the difference's 95 % interval above -{NON_INFERIORITY} (every paired cell), at most "
-                    f"{SAVER_CALLS}x its proposer calls", "value": value, "verdict": verdict}
+    return {"rule": f"Ant: {s['method']} in place of {s['followed_method']}: {s['rule']}", "value": value,
+            "verdict": verdict}
 
 
 def _candidate_verdict(candidate: dict, read: str) -> dict:
@@ -945,18 +969,18 @@ def ant_markdown(ant: dict) -> list[str]:
               for c in candidates] + [
               "", "| ratio | estimate [95 % CI] | verdict |", "|---|---|---|"]
     lines += [f"| {e['method']} | {cmp._interval_text(e)} | {e['verdict']} |" for e in ant["ratio"]]
-    return lines + [line for saver in ant["savers"] for line in saver_markdown(saver)]
+    return lines + [line for s in ant["successors"] for line in successor_markdown(s)]
 
 
-def saver_markdown(saver: dict) -> list[str]:
-    """A cheaper corrector's cells per maze beside the one it spares, their difference and its cost."""
-    return ["", f"`{saver['grid']}` ({saver['method']}, in place of {saver['spared_method']} if its rule holds; "
-            "docs/corrector.md, 'A gate for the Ant's corrector'), pooled per maze (Wilson 95 %):", "",
+def successor_markdown(s: dict) -> list[str]:
+    """A successor's cells per maze, its difference from the corrector it follows and its cost."""
+    return ["", f"`{s['grid']}` ({s['method']}, in place of {s['followed_method']} if its rule holds; "
+            f"docs/corrector.md, '{s['section']}'), pooled per maze (Wilson 95 %):", "",
             "| maze | runs | success [95 % CI] |", "|---|---|---|"] + [
-            f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} |" for e in saver["per_maze"]] + [
-            "", f"{saver['method']} - {saver['spared_method']} on the cells both ran: "
-            f"{_ant_paired_text(saver['paired'])}. Its mean cost over {saver['spared_method']}'s: "
-            f"{_cost_text(saver['cost_vs_spared'])}; over ours's: {_cost_text(saver['cost_vs_ours'])}."]
+            f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} |" for e in s["per_maze"]] + [
+            "", f"{s['method']} - {s['followed_method']} on the cells both ran: "
+            f"{_ant_paired_text(s['paired'])}. Its mean cost over {s['followed_method']}'s: "
+            f"{_cost_text(s['cost_vs_followed'])}; over ours's: {_cost_text(s['cost_vs_ours'])}."]
 
 
 def _cost_cells(c: dict) -> str:
@@ -1356,11 +1380,11 @@ def _ant_text(ant: dict) -> str:
                         + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
                         for c in ant["candidates"])
             + "".join(f". {c['grid']} ({c['method']}): {cells(c['per_maze'])}" + (
-                          f"; {c['method']} - {c['spared_method']} on the cells both ran: "
-                          f"{_ant_paired_text(c['paired'])}; its mean cost over {c['spared_method']}'s: "
-                          f"{_cost_text(c['cost_vs_spared'])}" if c["paired"]["cells"] else "")
+                          f"; {c['method']} - {c['followed_method']} on the cells both ran: "
+                          f"{_ant_paired_text(c['paired'])}; its mean cost over {c['followed_method']}'s: "
+                          f"{_cost_text(c['cost_vs_followed'])}" if c["paired"]["cells"] else "")
                       + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
-                      for c in ant["savers"]))
+                      for c in ant["successors"]))
 
 
 def _ant_paired_text(e: dict) -> str:
