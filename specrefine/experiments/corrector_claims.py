@@ -336,9 +336,8 @@ def _ant_candidate(grid: str, method: str, study: dict, root: Path) -> dict:
     rule holds (every paired cell ran, the 95 % interval above 0) and its pooled success."""
     rows = load(GRIDS[grid].tables + GRIDS[ANT_GRID].tables, root)
     paired = _ant_paired_rows(rows, method, ANT_METHOD)
-    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
     return {"grid": grid, "method": method, "per_maze": study["per_maze"], "paired": paired,
-            "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": k / n if n else math.nan,
+            "adopted": paired["complete"] and paired["ci"][0] > 0, "pooled": _pooled_success(study["per_maze"]),
             "cost_vs_confirm": costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, method, ANT_METHOD),
             "cost_vs_ours": study["costs"]}
 
@@ -357,11 +356,16 @@ def _ant_successor(grid: str, root: Path) -> dict:
              "no worse" if s.margin is not None else "not below": bounded}
     if s.calls is not None:
         parts["cheaper"] = cost["proposer_calls_ratio"] <= s.calls
-    k, n = (sum(e[key] for e in study["per_maze"]) for key in ("successes", "episodes"))
     return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
             "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
-            "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": k / n if n else math.nan,
+            "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": _pooled_success(study["per_maze"]),
             "adopted": paired["complete"] and all(parts.values())}
+
+
+def _pooled_success(per_maze: list[dict]) -> float:
+    """Success pooled over a grid's mazes (their episodes together); NaN before any cell."""
+    k, n = (sum(e[key] for e in per_maze) for key in ("successes", "episodes"))
+    return k / n if n else math.nan
 
 
 def _ant_grid_study(grid: str, method: str, root: Path) -> dict:
