@@ -229,8 +229,10 @@ register_method("ours-corrector-recheck", ours_variant(**CORRECTOR | dict(correc
                                                                           correct_passes=2)),
                 "beyond the paper: ours-corrector-precise with its correction run again on a fresh draw, so that a "
                 "leg chosen on one draw's rollouts is judged on rollouts that did not choose it", colour="#1b5e20")
-register_method("ours-corrector-frugal", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3,
-                                                                        correct_first_win=True, correct_rounds=1)),
+#: frugal asking: a weak leg's alternatives cheapest first, the first win taken, each split in one proposer round
+FRUGAL = dict(correct_first_win=True, correct_rounds=1)
+register_method("ours-corrector-frugal", ours_variant(**CORRECTOR | dict(correct_rollouts=16, correct_min_failures=3)
+                                                      | FRUGAL),
                 "beyond the paper: ours-corrector-precise asking the proposer less in its correction: a weak leg's "
                 "alternatives cheapest first (bypass, split, split over the next waypoint), stopping at the first "
                 "that wins, and each of its splits in one proposer round (the leg's failure picture already in it)",
@@ -367,6 +369,13 @@ register_method("ours-corrector-sparing", ours_variant(**SPARING),
                 "leg only where at least 3 of its 4n fresh rollouts failed (128 at n = 32); a leg with one or two "
                 "failures is offered its bypass only, which asks nothing, so that the proposer is not asked about a "
                 "leg whose loss the draw cannot tell from none", colour="#a1887f")
+#: ours-corrector-sparing-frugal: sparing, asking as frugal does (docs/corrector.md, "Sparing and frugal: the Ant")
+SPARING_FRUGAL = SPARING | FRUGAL
+register_method("ours-corrector-sparing-frugal", ours_variant(**SPARING_FRUGAL),
+                "beyond the paper: ours-corrector-sparing asking the proposer as ours-corrector-frugal does: a weak "
+                "leg's alternatives cheapest first (bypass, split, split over the next waypoint), the first that "
+                "wins taken, and each of the correction's splits in one proposer round (the leg's failure picture "
+                "already in it)", colour="#6d4c41")
 #: ours-corrector-wide: redraw, then one more pass on a wide draw (docs/ant_experiments.md, "Issue 42, lever 8")
 register_method("ours-corrector-wide",
                 ours_variant(**REDRAW | dict(correct_wide=16, correct_wide_min_failures=3)),
