@@ -897,6 +897,11 @@ GRIDS = {g.name: g for g in (
                        "2026-12-05 03:30 UTC before its first cell ran; two of redraw's step logs informed it): "
                        "ant-corrector-redraw's cells with the correction's proposer gated at 3 fresh failures",
                        "ant_sparing", code="d0214b6", method="ours-corrector-sparing", split_pick="confirmed"),
+    ant_corrector_grid("ant-corrector-sparing-frugal", "docs/corrector.md, 'Sparing and frugal: the Ant' (issue 39; "
+                       "fixed 2026-12-05 07:20 UTC before its first cell ran; the same two step logs informed it): "
+                       "ant-corrector-redraw's cells with sparing's gate and frugal's asking",
+                       "ant_sparing_frugal", code="08bb143", method="ours-corrector-sparing-frugal",
+                       split_pick="confirmed"),
     ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
                     "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
                     "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),
