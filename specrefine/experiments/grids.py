@@ -898,7 +898,7 @@ GRIDS = {g.name: g for g in (
                        "ant-corrector-redraw's cells with the correction's proposer gated at 3 fresh failures",
                        "ant_sparing", code="d0214b6", method="ours-corrector-sparing", split_pick="confirmed"),
     ant_corrector_grid("ant-corrector-sparing-frugal", "docs/corrector.md, 'Sparing and frugal: the Ant' (issue 39; "
-                       "fixed 2026-12-05 07:20 UTC before its first cell ran; the same two step logs informed it): "
+                       "fixed 2026-12-05 06:23 UTC before its first cell ran; the same two step logs informed it): "
                        "ant-corrector-redraw's cells with sparing's gate and frugal's asking",
                        "ant_sparing_frugal", code="08bb143", method="ours-corrector-sparing-frugal",
                        split_pick="confirmed"),
