@@ -404,8 +404,8 @@ def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_t
     grid = ant_corrector_grid("ant-corrector-successor-test", "a test", "successor_test", code="d0214b6",
                               method="ours-corrector-wide", split_pick="confirmed")
     monkeypatch.setitem(GRIDS, grid.name, grid)
-    monkeypatch.setitem(cc.ANT_SUCCESSORS, grid.name, cc.Successor("ours-corrector-wide", cc.ANT_REDRAW, "a test",
-                                                                   margin=None))
+    monkeypatch.setitem(cc.ant.ANT_SUCCESSORS, grid.name,  # the table ant_study reads (corrector_claims/ant.py)
+                        cc.Successor("ours-corrector-wide", cc.ANT_REDRAW, "a test", margin=None))
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
     lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)

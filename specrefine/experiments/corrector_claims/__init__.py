@@ -1,0 +1,121 @@
+"""The corrector grids' claims (docs/corrector.md, "The rules"), decided as fixed there.
+
+    specrefine corrector-claims --out data/results/corrector
+
+Reads the shipped tables of the grids ``taxonomy`` (ours, ours-repair and the oracle), ``corrector`` (ours-corrector
+and the one-shot), ``corrector-held-out`` (described, no rule) and, where present, ``corrector-levers`` (each lever
+alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corrector-spread`` and
+``ant-corrector-reaim`` and ``ant-corrector-redraw`` beside it; one of them read instead once its adoption rule holds)
+with the
+Ant scaling grid's one-shot;
+writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
+rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
+marked partial. ``--fill FILE ...`` also rewrites the ``<!-- front corrector NAME -->`` passages of those files
+(README.md, docs/corrector.md) from the same studies::
+
+    specrefine corrector-claims --out data/results/corrector --fill README.md docs/corrector.md
+"""
+
+from __future__ import annotations
+
+# what the command and the tests read here (as from the single module this package was); the rest from its module:
+# common (names, constants, shared helpers), point, ant, layouts, variants (the studies), formats, rules (verdicts),
+# report (claims.md), frontpage (README's passages, fill), figure (rooms.png), cli (the command)
+from ...core.errors import SpecrefineError
+from ..grids import (
+    ADVANCE_CHECK_MIXES,
+    ADVANCE_MIXES,
+    CHECK_MIXES,
+    DEEP_MIXES,
+    EXTEND_MIXES,
+    FALLBACK_MIXES,
+    FRESH_MAZES,
+    FRESH_MIXES,
+    KEEP_MIXES,
+    MEMORY_MIXES,
+    NEW_MAZES,
+    PROBE_MIXES,
+    ROADMAP_CHECK_MIXES,
+    ROADMAP_MIXES,
+    SNAP_MIXES,
+    SOUND_MIXES,
+)
+from .ant import (
+    ANT_BEFORE,
+    ANT_CANDIDATES,
+    ANT_FLOOR,
+    ANT_GRID,
+    ANT_METHOD,
+    ANT_REAIM,
+    ANT_REDRAW,
+    ANT_SPARING,
+    ANT_SUCCESSORS,
+    REAIM,
+    REDRAW,
+    SPARING,
+    Successor,
+    ant_fresh_study,
+    ant_study,
+)
+from .cli import add_arguments, main, run
+from .common import (
+    ADOPTABLE,
+    ADVANCE,
+    CENTRE,
+    DEEP,
+    EXTEND,
+    FALLBACK,
+    GATED,
+    KEEP,
+    LEAN,
+    MEMORY,
+    METHOD,
+    PERSIST,
+    POINT_SEEDS,
+    POLISH,
+    PRECISE,
+    PROBE,
+    RECHECK,
+    ROADMAP,
+    SNAP,
+    SOUND,
+    SPREAD,
+    TRIM,
+    VARIANT_GRIDS,
+    VARIANTS,
+    load,
+    reference_of,
+    table_name,
+)
+from .frontpage import (
+    _adoption_text,
+    _ant_text,
+    _fresh_text,
+    _gated_text,
+    _new_text,
+    _unseen_text,
+    _variant_text,
+    fill,
+    front,
+    reported,
+    rules_table,
+)
+from .layouts import INFORMED_PARTS, fresh_study, new_study, unseen
+from .point import held_out_study, levers_study, point_study
+from .report import levers_markdown, markdown, variant_markdown
+from .rules import _helps, variant_verdicts, verdicts
+from .variants import variant_studies, variant_study
+
+__all__ = [
+    "ADOPTABLE", "ADVANCE", "ADVANCE_CHECK_MIXES", "ADVANCE_MIXES", "ANT_BEFORE", "ANT_CANDIDATES", "ANT_FLOOR",
+    "ANT_GRID", "ANT_METHOD", "ANT_REAIM", "ANT_REDRAW", "ANT_SPARING", "ANT_SUCCESSORS", "CENTRE", "CHECK_MIXES",
+    "DEEP", "DEEP_MIXES", "EXTEND", "EXTEND_MIXES", "FALLBACK", "FALLBACK_MIXES", "FRESH_MAZES", "FRESH_MIXES", "GATED",
+    "INFORMED_PARTS", "KEEP", "KEEP_MIXES", "LEAN", "MEMORY", "MEMORY_MIXES", "METHOD", "NEW_MAZES", "PERSIST",
+    "POINT_SEEDS", "POLISH", "PRECISE", "PROBE", "PROBE_MIXES", "REAIM", "RECHECK", "REDRAW", "ROADMAP",
+    "ROADMAP_CHECK_MIXES", "ROADMAP_MIXES", "SNAP", "SNAP_MIXES", "SOUND", "SOUND_MIXES", "SPARING", "SPREAD",
+    "SpecrefineError", "Successor", "TRIM", "VARIANTS", "VARIANT_GRIDS", "add_arguments", "ant_fresh_study",
+    "ant_study", "fill", "fresh_study", "front", "held_out_study", "levers_markdown", "levers_study", "load", "main",
+    "markdown", "new_study", "point_study", "reference_of", "reported", "rules_table", "run", "table_name", "unseen",
+    "variant_markdown", "variant_studies", "variant_study", "variant_verdicts", "verdicts", "_adoption_text",
+    "_ant_text", "_fresh_text", "_gated_text", "_helps", "_new_text", "_unseen_text", "_variant_text",
+]

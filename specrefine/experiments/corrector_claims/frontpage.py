@@ -1,0 +1,304 @@
+"""The ``<!-- front corrector NAME -->`` passages of README.md and docs/corrector.md: their texts from the studies
+(``front``, ``rules_table``) and the rewrite of a file's markers (``fill``)."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from ...core.errors import SpecrefineError
+from ...core.runfolder import locked, write_atomic
+from .. import ant_fresh
+from .. import comparison as cmp
+from ..grids import GRIDS, ROOT
+from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD
+from .common import (
+    ADOPTABLE,
+    COST_CAP,
+    GATED,
+    HELD_OUT_SEEDS,
+    METHOD,
+    MIX_NAMES,
+    NON_INFERIORITY,
+    REPORTED,
+    TOLERANCE,
+    VARIANT_GRIDS,
+    VARIANT_SUITE,
+    VARIANTS,
+    _below_ours,
+    _known,
+)
+from .formats import _ant_paired_text, _cost_text, _num, _paired_text, _partial, _signed
+from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
+from .rules import (
+    _adoption_rows,
+    _cost_verdict,
+    _helps,
+    _mazes_run,
+    _verdict,
+    variant_verdicts,
+    verdicts,
+    versus_corrector,
+)
+
+MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
+
+
+def fill(path: Path, texts: dict[str, str]) -> None:
+    """Rewrite every ``<!-- front corrector NAME -->`` passage of ``path`` with ``texts[NAME]`` (whole file, atomic;
+    a marker with no text is an error, and nothing is written). A text of several lines keeps the indentation of its
+    marker's line, so that a table stays inside its list item."""
+    source = path.read_text()
+    unknown = sorted({m.group(2) for m in MARKER.finditer(source)} - set(texts))
+    if unknown:
+        raise SpecrefineError(f"{path}: no text for the marker(s) {', '.join(unknown)}")
+
+    def text(m: re.Match) -> str:
+        line = source[source.rfind("\n", 0, m.start()) + 1:m.start()]
+        indent = line if not line.strip() else ""
+        body = re.sub(r"\n[ \t]+(?=\n)", "\n", texts[m.group(2)].replace("\n", "\n" + indent))
+        return m.group(1) + body + m.group(4)
+
+    with locked(path.parent):
+        write_atomic(path, MARKER.sub(text, source))
+
+
+def rules_table(variant: dict | None, point: dict, ant: dict | None) -> str:
+    """Issue 39's rules for the reported variant, the held-out cells it is described on, and the Ant's rules, as one
+    markdown table (README's front page)."""
+    if not variant:
+        return "not run yet"
+    method = variant["method"]
+    rows = [dict(v, rule=v["rule"].removeprefix(f"{method}, ")) for v in variant_verdicts(variant)]
+    order = [v for v in rows if "cost at most" not in v["rule"] and not v["rule"].startswith(method)]
+    order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
+    order += [row for mix in MIX_NAMES.values() if (row := _held_out_row(variant, mix))]
+    order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
+    table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
+    table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
+    return "\n" + "\n".join(table) + "\n\n"  # the markers on lines of their own, around the table
+
+
+def _held_out_row(variant: dict, mix: str) -> dict | None:
+    """The variant's held-out cells of one error mix as a described row: success per layout, cost over ours."""
+    method = variant["method"]
+    held = [e for e in variant["held_out"] if e["runs"] and e["mix"] == mix]
+    cost = next((c for c in variant.get("held_out_costs", []) if c["method"] == method
+                 and c["proposer"] == f"mix {mix}" and c["pairs"]), None)
+    if not (held and cost):
+        return None
+    return {"rule": f"held out, mix {mix} ({len(held)} layouts, seeds {list(HELD_OUT_SEEDS)}): success per layout; "
+                    "proposer calls, evaluations over ours",
+            "value": f"{min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f}; "
+                     f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, {_num(cost['evaluations_ratio'], '{:.2f}x')} "
+                     f"over {cost['pairs']} pairs",
+            "verdict": "described" + (f" (over {COST_CAP}x)" if _cost_verdict(cost) != "holds" else "")}
+
+
+def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
+    """(cells done in the shipped tables, cells) of grid ``name``."""
+    from ..grids import status
+
+    done = [(d, total) for _, d, total, _ in status(GRIDS[name], root)]
+    return sum(d for d, _ in done), sum(t for _, t in done)
+
+
+def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
+          ant: dict | None = None, fresh: dict | None = None, **variants: dict | None) -> dict[str, str]:
+    """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
+    their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s)."""
+    _known(variants)
+    grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
+             *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
+             ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES)
+    counts = {name: progress(name, root) for name in grids}
+    out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
+                     + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
+    for proposer in ("imperfect:mild", "imperfect:moderate", "imperfect:severe"):
+        level = proposer.split(":")[1]
+        mazes = [e for e in point["per_maze"] + point["severe"] if e["proposer"] == proposer]
+        ran = [e for e in mazes if e["runs"]]
+        if not ran:
+            out[level] = "not run yet"
+            continue
+        within = sum(1 for e in ran if e["success"] >= e["reference_success"] - TOLERANCE)
+        rooms = next((e for e in point["rooms"] if e["proposer"] == proposer and e["method"] == METHOD), None)
+        zero = next(z for z in point["zero"] if z["proposer"] == proposer)
+        curve = [f"{k / n:.3f}" for k, n, _ in point["curves"][proposer]["/".join((METHOD, "*"))] if n]
+        text = (f"1-5 rooms {', '.join(curve)}; within {TOLERANCE} of the oracle on {within} of {len(ran)} "
+                f"U-chains" + ("" if len(ran) == len(mazes) else f" run so far (of {len(mazes)})"))
+        if rooms is not None:
+            text += f", {cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)})"
+        text += (f"; runs at 0: {zero[METHOD][0]} of {zero[METHOD][1]} (ours {zero['ours'][0]} of "
+                 f"{zero['ours'][1]}, ours-repair {zero['ours-repair'][0]} of {zero['ours-repair'][1]})")
+        out[level] = text
+    ratios = [e for e in point["ratio"] if e["method"].startswith(METHOD)]
+    out["ratio"] = "; ".join(f"{e['proposer'].split(':')[1]} {cmp._interval_text(e)} ({e['verdict']}{_partial(e)})"
+                             for e in ratios)
+    out["cost"] = "; ".join(_cost_text(c) for c in point["costs"] if c["pairs"])
+    out["levers"] = _levers_text(levers) if levers else "not run yet"
+    for name in VARIANTS:
+        study = variants.get(name)
+        out[name] = ((_gated_text if name == "gated" else _variant_text)(study)) if study else "not run yet"
+        if study:
+            v = study["versus_corrector"]
+            out[f"{name}-paired"] = f"{_signed(v)} over {v['n_cells']} paired U-chain cells"
+        if study and "oracle_versus_paper" in study:
+            out[f"{name}-oracle"] = _paired_text(study["oracle_versus_paper"])
+            out[f"{name}-runs"] = "; ".join(f"{p.split(':')[1]} {k} of {n}" for p, (k, n) in
+                                            study["every_episode"].items())
+            out[f"{name}-fresh"] = _fresh_text(study["fresh"]) if study.get("fresh") else "not run yet"
+            if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
+                k, n = study["severe_zero"][study["method"]]
+                out[f"{name}-severe-zero"] = f"{k} of {n}"
+        if VARIANTS[name] in NEW_STUDIES:
+            out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
+            out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
+        for part in INFORMED_PARTS.get(VARIANTS[name], ()):
+            out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
+    out["ant"] = _ant_text(ant) if ant else "not run yet"
+    out["unseen"] = _unseen_text(unseen(root))
+    out["table"] = rules_table(variants.get(reported(variants)), point, ant)
+    out["reported"] = f"`{VARIANTS[reported(variants)]}`"
+    if held_out:
+        done = [e for e in held_out["per_maze"] if e["runs"]]
+        lo = min(e["success"] for e in done)
+        hi = max(e["success"] for e in done)
+        lo_o, hi_o = min(e["reference_success"] for e in done), max(e["reference_success"] for e in done)
+        out["held-out"] = (f"ours-corrector {lo:.3f}-{hi:.3f} per layout and mix where ours gives {lo_o:.3f}-"
+                           f"{hi_o:.3f}; runs at 0: {held_out['zero'][METHOD]} of {held_out['runs']} against "
+                           f"{held_out['zero']['ours']} of {held_out['runs']}")
+    out["ant-fresh"] = ant_fresh.front_text(fresh)
+    return out
+
+
+def _unseen_text(sets: list[dict]) -> str:
+    if not sets:
+        return "not run yet"
+    return "; ".join(f"{e['mixes']} {e['zero']} of {e['runs']}" for e in sets) + " (the oracle at least " + \
+        f"{min(e['oracle_min'] for e in sets):.3f} on every one of those runs' cells)"
+
+
+def reported(variants: dict) -> str:
+    """The variant README's rules table reads: the latest of ``ADOPTABLE`` adopted by its rule, else ``REPORTED``."""
+    return next((name for name in ADOPTABLE if (variants.get(name) or {}).get("adoption", {}).get("adopted")),
+                REPORTED)
+
+
+def _ant_text(ant: dict) -> str:
+    """The Ant's cells per maze in ANT_GRID, ANT_BEFORE and each of ANT_CANDIDATES, with their pooled differences
+    from ANT_GRID."""
+    def cells(per_maze):
+        ran = [e for e in per_maze if e["runs"]]
+        low = sum(e["success"] < ANT_FLOOR for e in ran)
+        return (", ".join(f"{e['maze']} {e['success']:.3f} ({e['runs']} run{'s' * (e['runs'] > 1)})" for e in ran)
+                + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
+    return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['confirm'])}. {ANT_BEFORE} (ours-corrector, stopped): "
+            f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}. "
+            + ". ".join(f"{c['grid']} ({c['method']}): {cells(c['per_maze'])}; {c['method']} - {ANT_METHOD} on the "
+                        f"cells both ran: {_ant_paired_text(c['paired'])}"
+                        + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
+                        for c in ant["candidates"])
+            + "".join(f". {c['grid']} ({c['method']}): {cells(c['per_maze'])}" + (
+                          f"; {c['method']} - {c['followed_method']} on the cells both ran: "
+                          f"{_ant_paired_text(c['paired'])}; its mean cost over {c['followed_method']}'s: "
+                          f"{_cost_text(c['cost_vs_followed'])}" if c["paired"]["cells"] else "")
+                      + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
+                      for c in ant["successors"]))
+
+
+def _levers_text(lv: dict) -> str:
+    parts = []
+    for proposer in dict.fromkeys(e["proposer"] for e in lv["entries"]):
+        here = [e for e in lv["entries"] if e["proposer"] == proposer and e["runs"]]
+        parts.append(f"{proposer.split(':')[1]}: " + ("; ".join(
+            f"{e['lever']} {_num(e['success'])} ({_signed(e['versus']['ours'])} over ours, "
+            f"{_helps(e['versus']['ours'])}; {_signed(e['versus'][METHOD])} against {METHOD}, {_proposer_calls(e)})"
+            for e in here) or "not run yet"))
+    return ". ".join(parts)
+
+
+def _proposer_calls(e: dict) -> str:
+    return f"{_num(e['costs']['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
+
+
+def _gated_text(gs: dict) -> str:
+    v = gs["versus_corrector"]
+    costs = "; ".join(f"{c['proposer'].split(':')[1]} {_num(c['proposer_calls_ratio'], '{:.1f}x')} ({c['pairs']} pairs)"
+                      for c in gs["costs"])
+    ok = not math.isnan(v["estimate"]) and v["ci_low"] >= -NON_INFERIORITY
+    return (f"proposer calls over ours: {costs}; {GATED} - {METHOD} {_signed(v)} over {v['n_cells']} of "
+            f"{v['n_expected']} paired cells (no worse by -{NON_INFERIORITY}: {_verdict(ok, v['complete'])})")
+
+
+def _variant_text(vs: dict) -> str:
+    """A variant against its reference, its change over rooms per preset and its proposer calls."""
+    _, verdict = versus_corrector(vs)
+    v, ref = vs["versus_corrector"], vs["reference"]
+    parts = [f"{vs['method']} - {ref} {_signed(v)} over {v['n_cells']} of {v['n_expected']} paired cells "
+             f"({verdict})"]
+    for rooms, c, zero in zip(vs["rooms"], vs["costs"], vs["zero"]):
+        level = rooms["proposer"].split(":")[1]
+        mazes = [e for e in vs["per_maze"] if e["proposer"] == rooms["proposer"] and e["runs"]]
+        within = sum(1 for e in mazes if e["success"] >= e["reference_success"] - TOLERANCE)
+        parts.append(f"{level}: within {TOLERANCE} of the oracle on {within} of {len(mazes)} U-chains, "
+                     f"{cmp._interval_text(rooms)} ({rooms['verdict']}{_partial(rooms)}), runs at 0: "
+                     f"{zero['runs'][0]} of {zero['runs'][1]}, "
+                     f"{_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
+                     + "".join(f", one-shot {cmp._interval_text(r)} ({r['verdict']}{_partial(r)})"
+                               for r in vs.get("ratio", []) if r["proposer"] == rooms["proposer"]))
+    if "severe_zero" in vs and vs["severe_zero"][vs["method"]][1]:
+        zero = vs["severe_zero"]
+        parts.append(f"severe: runs at 0 {zero[vs['method']][0]} of {zero[vs['method']][1]} ({ref} "
+                     f"{zero[ref][0]} of {zero[ref][1]}), - {ref} {_signed(vs['severe_vs_corrector'])}, - "
+                     f"ours-repair {_signed(vs['severe_vs_repair'])}{_partial(vs['severe_vs_repair'])}")
+    if vs.get("versus_ours"):
+        below = {level: _below_ours(vs["versus_ours"], f"imperfect:{level}") for level in ("mild", "moderate")}
+        parts.append("every suite maze: below ours on " + ", ".join(
+            f"{len(m)} of {_mazes_run(vs['versus_ours'], f'imperfect:{level}')} at {level}"
+            + (f" ({', '.join(m)})" if m else "") for level, m in below.items()))
+    held = [e for e in vs["held_out"] if e["runs"]]
+    if held:
+        both = [e for e in held if e["reference_runs"]]
+        beside = (f"{ref} {min(e['reference_success'] for e in both):.3f}-"
+                  f"{max(e['reference_success'] for e in both):.3f}; higher on "
+                  f"{sum(e['success'] > e['reference_success'] for e in both)}, lower on "
+                  f"{sum(e['success'] < e['reference_success'] for e in both)} of {len(both)}"
+                  + ("" if len(both) == len(held) else " run by both") if both else f"{ref} not run there")
+        parts.append(f"held out: {min(e['success'] for e in held):.3f}-{max(e['success'] for e in held):.3f} per "
+                     f"layout and mix ({beside})")
+        mine = [c for c in vs.get("held_out_costs", []) if c["method"] == vs["method"] and c["pairs"]]
+        if mine:
+            parts[-1] += ", " + ", ".join(f"{c['proposer']} {_num(c['proposer_calls_ratio'], '{:.1f}x')}"
+                                          for c in mine) + " the proposer calls of ours"
+    return "; ".join(parts)
+
+
+def _new_text(new: dict) -> str:
+    short = lambda m: m.removeprefix(f"{METHOD}-")  # noqa: E731
+    mine, ref = short(new["method"]), short(new["reference"])
+    return _layouts_text(new, f"{mine} ", f", {ref} ", f"; {mine} - {ref} ")
+
+
+def _layouts_text(study: dict, first: str, second: str, paired: str) -> str:
+    """A new-layout or fresh study in one line: the first method's range per layout and mix, the second's, their
+    paired difference and the runs at 0 (``first``, ``second``, ``paired``: the words before each)."""
+    done = [e for e in study["per_maze"] if e["runs"]]
+    both = [e for e in done if e["reference_runs"]]
+    text = (f"{first}{min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per layout and mix "
+            f"over {study['runs']} runs ({len(done)} of {len(study['per_maze'])} layouts and mixes run)")
+    if both:
+        text += (f"{second}{min(e['reference_success'] for e in both):.3f}-"
+                 f"{max(e['reference_success'] for e in both):.3f}{paired}{_paired_text(study['paired'])}")
+    return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in study["zero"].items())
+
+
+def _adoption_text(study: dict) -> str:
+    rows = _adoption_rows(study)
+    return (f"(1) no worse on the U-chains, {rows[0]['value']} ({rows[0]['verdict']}); (2) {rows[1]['value']} "
+            f"({rows[1]['verdict']}): **{rows[2]['verdict']}**")
+
+
+def _fresh_text(fresh: dict) -> str:
+    return _layouts_text(fresh, "", "; at sampled points ", "; centre - sampled ")
