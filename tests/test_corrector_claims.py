@@ -301,7 +301,8 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
                                  f"no cell in both yet. {cc.ANT_REAIM} ({cc.REAIM}): no cell yet; {cc.REAIM} - "
                                  f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet. {cc.ANT_REDRAW} "
                                  f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
-                                 f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet")
+                                 f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet. "
+                                 f"{cc.ANT_SPARING_FRUGAL} ({cc.SPARING_FRUGAL}): no cell yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -425,7 +426,28 @@ def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_t
     verdicts = {v["rule"].split(" in place")[0]: v["verdict"] for v in cc.verdicts(cc.point_study(tmp_path), ant)
                 if " in place of " in v["rule"]}
     assert ant["method"] == "ours-corrector-wide"
-    assert verdicts == {"Ant: ours-corrector-wide": "adopted", f"Ant: {cc.SPARING}": "holds; ours-corrector-wide read"}
+    assert verdicts == {"Ant: ours-corrector-wide": "adopted", f"Ant: {cc.SPARING}": "holds; ours-corrector-wide read",
+                        f"Ant: {cc.SPARING_FRUGAL}": "undecided (0 of 27 cells)"}
+
+
+@pytest.mark.parametrize("calls, verdict", [(4, "adopted"), (6, "not adopted (cheaper missed)")])
+def test_sparing_frugal_needs_half_of_redraws_calls_and_shows_its_one_change_against_sparing(tmp_path, calls, verdict):
+    """ant-corrector-sparing-frugal's rule (docs/corrector.md, 'Sparing and frugal: the Ant'): sparing's, with at most
+    0.5x redraw's mean proposer calls; its difference from sparing (the one change) is described in the claims."""
+    rule = f"Ant: {cc.SPARING_FRUGAL} in place of {cc.REDRAW}"
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
+    lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)
+    lay_grid(tmp_path, cc.ANT_SPARING_FRUGAL, lambda maze, m, p: 0.9, calls_of=lambda m: calls)
+    ant = cc.ant_study(tmp_path)
+    found = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith(rule))
+    assert "at most 0.5x its proposer calls" in found["rule"] and found["verdict"] == verdict
+    assert ant["method"] == (cc.SPARING_FRUGAL if verdict == "adopted" else cc.REDRAW)
+    one_change = f"{cc.SPARING_FRUGAL} - {cc.SPARING} (the one change, described) on the cells both ran: "
+    assert f"{one_change}no cell in both yet" in cc.markdown(cc.point_study(tmp_path), ant)
+    lay_grid(tmp_path, cc.ANT_SPARING, lambda maze, m, p: 0.95, calls_of=lambda m: 7)
+    md = cc.markdown(cc.point_study(tmp_path), cc.ant_study(tmp_path))
+    assert f"{one_change}-0.050 [" in md and "over 27 cells" in md.split(one_change)[1].split("\n")[0]
 
 
 def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_before_it(tmp_path):
@@ -913,13 +935,15 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     lines = table.strip().splitlines()
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5  # + the two held-out mixes + the Ant's five rules
+    # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its two candidates and each successor
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 4 + len(cc.ANT_SUCCESSORS)
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
-    assert rules[-5].startswith(f"Ant ({cc.ANT_METHOD})") and rules[-4].startswith(f"Ant: {cc.ANT_METHOD}")
-    assert rules[-3].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
-    assert rules[-2].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
-    assert rules[-1].startswith(f"Ant: {cc.SPARING} in place of {cc.REDRAW}")
+    ant = rules[-4 - len(cc.ANT_SUCCESSORS):]
+    assert ant[0].startswith(f"Ant ({cc.ANT_METHOD})") and ant[1].startswith(f"Ant: {cc.ANT_METHOD}")
+    assert ant[2].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
+    assert ant[3].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
+    assert [r.split(" in place of ")[0] for r in ant[4:]] == [f"Ant: {cc.SPARING}", f"Ant: {cc.SPARING_FRUGAL}"]
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
 

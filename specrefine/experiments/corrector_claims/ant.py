@@ -33,13 +33,15 @@ class Successor:
     """A corrector run on the cells of the one the Ant's rules read (``follows``, a grid of ANT_CANDIDATES), read in
     its place (while that one is read) once every paired cell ran and its rule holds: at least ANT_FLOOR on every maze;
     its difference from that corrector with a 95 % interval whose lower end is at least -``margin`` (None: whose upper
-    end is at least 0, not wholly below); at most ``calls`` times that corrector's mean proposer calls (None: any)."""
+    end is at least 0, not wholly below); at most ``calls`` times that corrector's mean proposer calls (None: any).
+    ``control``: another successor's grid that differs from it by one change; their paired difference is described."""
 
     method: str
     follows: str
     section: str
     margin: float | None = NON_INFERIORITY
     calls: float | None = None
+    control: str | None = None
 
     def rule(self) -> str:
         bound = (f"above -{self.margin}" if self.margin is not None else "not wholly below 0")
@@ -48,8 +50,12 @@ class Successor:
 
 
 ANT_SPARING, SPARING = "ant-corrector-sparing", "ours-corrector-sparing"
-#: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector")
-ANT_SUCCESSORS = {ANT_SPARING: Successor(SPARING, ANT_REDRAW, "A gate for the Ant's corrector", calls=0.75)}
+ANT_SPARING_FRUGAL, SPARING_FRUGAL = "ant-corrector-sparing-frugal", "ours-corrector-sparing-frugal"
+#: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector", "Sparing and frugal: the Ant")
+ANT_SUCCESSORS = {
+    ANT_SPARING: Successor(SPARING, ANT_REDRAW, "A gate for the Ant's corrector", calls=0.75),
+    ANT_SPARING_FRUGAL: Successor(SPARING_FRUGAL, ANT_REDRAW, "Sparing and frugal: the Ant", calls=0.5,
+                                  control=ANT_SPARING)}
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
 ANT_ORACLE = "data/results/ant/scaling/ours_centre.csv"
@@ -108,7 +114,11 @@ def _ant_successor(grid: str, root: Path) -> dict:
              "no worse" if s.margin is not None else "not below": bounded}
     if s.calls is not None:
         parts["cheaper"] = cost["proposer_calls_ratio"] <= s.calls
+    control = (ANT_SUCCESSORS[s.control].method, _ant_paired((grid, s.method), (s.control,
+                                                                             ANT_SUCCESSORS[s.control].method), root)
+               ) if s.control else None
     return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
+            "control": control,
             "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
             "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": _pooled_success(study["per_maze"]),
             "adopted": paired["complete"] and all(parts.values())}

@@ -112,7 +112,9 @@ def successor_markdown(s: dict) -> list[str]:
             f"| {e['maze']} | {e['runs']} | {_rate_ci(e)} |" for e in s["per_maze"]] + [
             "", f"{s['method']} - {s['followed_method']} on the cells both ran: "
             f"{_ant_paired_text(s['paired'])}. Its mean cost over {s['followed_method']}'s: "
-            f"{_cost_text(s['cost_vs_followed'])}; over ours's: {_cost_text(s['cost_vs_ours'])}."]
+            f"{_cost_text(s['cost_vs_followed'])}; over ours's: {_cost_text(s['cost_vs_ours'])}."] + (
+            [f"{s['method']} - {s['control'][0]} (the one change, described) on the cells both ran: "
+             f"{_ant_paired_text(s['control'][1])}."] if s["control"] else [])
 
 
 def _cost_cells(c: dict) -> str:
