@@ -302,7 +302,8 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
                                  f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet. {cc.ANT_REDRAW} "
                                  f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
                                  f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet. "
-                                 f"{cc.ANT_SPARING_FRUGAL} ({cc.SPARING_FRUGAL}): no cell yet")
+                                 f"{cc.ANT_SPARING_FRUGAL} ({cc.SPARING_FRUGAL}): no cell yet. "
+                                 f"{cc.ANT_WIDE} ({cc.WIDE}): no cell yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -397,16 +398,10 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
 
 
-def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path, monkeypatch):
+def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path):
     """A successor with margin None (its difference's interval not wholly below 0, no cost part), beside sparing: where
     both hold, the one with the higher pooled success is read and the other's row says so."""
-    from specrefine.experiments.grids import ant_corrector_grid
-
-    grid = ant_corrector_grid("ant-corrector-successor-test", "a test", "successor_test", code="d0214b6",
-                              method="ours-corrector-wide", split_pick="confirmed")
-    monkeypatch.setitem(GRIDS, grid.name, grid)
-    monkeypatch.setitem(cc.ant.ANT_SUCCESSORS, grid.name,  # the table ant_study reads (corrector_claims/ant.py)
-                        cc.Successor("ours-corrector-wide", cc.ANT_REDRAW, "a test", margin=None))
+    grid = GRIDS[cc.ANT_WIDE]  # ant-corrector-wide: margin None, no cost part
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.84)
     lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)
@@ -428,6 +423,7 @@ def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_t
     assert ant["method"] == "ours-corrector-wide"
     assert verdicts == {"Ant: ours-corrector-wide": "adopted", f"Ant: {cc.SPARING}": "holds; ours-corrector-wide read",
                         f"Ant: {cc.SPARING_FRUGAL}": "undecided (0 of 27 cells)"}
+    assert cc.ANT_SUCCESSORS[cc.ANT_WIDE].method == cc.WIDE == "ours-corrector-wide"
 
 
 @pytest.mark.parametrize("calls, verdict", [(4, "adopted"), (6, "not adopted (cheaper missed)")])
@@ -943,7 +939,8 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     assert ant[0].startswith(f"Ant ({cc.ANT_METHOD})") and ant[1].startswith(f"Ant: {cc.ANT_METHOD}")
     assert ant[2].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
     assert ant[3].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
-    assert [r.split(" in place of ")[0] for r in ant[4:]] == [f"Ant: {cc.SPARING}", f"Ant: {cc.SPARING_FRUGAL}"]
+    assert [r.split(" in place of ")[0] for r in ant[4:]] == [f"Ant: {m}" for m in (cc.SPARING, cc.SPARING_FRUGAL,
+                                                                                   cc.WIDE)]
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
 

@@ -902,6 +902,10 @@ GRIDS = {g.name: g for g in (
                        "ant-corrector-redraw's cells with sparing's gate and frugal's asking",
                        "ant_sparing_frugal", code="08bb143", method="ours-corrector-sparing-frugal",
                        split_pick="confirmed"),
+    ant_corrector_grid("ant-corrector-wide", "docs/corrector.md, 'The wide pass with an erring proposer' (issues 39 "
+                       "and 42; fixed 2026-12-05 06:48 UTC when ant-oracle-wide-scaling's rule 2 held, before its "
+                       "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
+                       code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
     ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
                     "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
                     "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),

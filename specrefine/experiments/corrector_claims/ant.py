@@ -51,11 +51,14 @@ class Successor:
 
 ANT_SPARING, SPARING = "ant-corrector-sparing", "ours-corrector-sparing"
 ANT_SPARING_FRUGAL, SPARING_FRUGAL = "ant-corrector-sparing-frugal", "ours-corrector-sparing-frugal"
-#: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector", "Sparing and frugal: the Ant")
+ANT_WIDE, WIDE = "ant-corrector-wide", "ours-corrector-wide"
+#: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector", "Sparing and frugal: the Ant",
+#: "The wide pass with an erring proposer")
 ANT_SUCCESSORS = {
     ANT_SPARING: Successor(SPARING, ANT_REDRAW, "A gate for the Ant's corrector", calls=0.75),
     ANT_SPARING_FRUGAL: Successor(SPARING_FRUGAL, ANT_REDRAW, "Sparing and frugal: the Ant", calls=0.5,
-                                  control=ANT_SPARING)}
+                                  control=ANT_SPARING),
+    ANT_WIDE: Successor(WIDE, ANT_REDRAW, "The wide pass with an erring proposer", margin=None)}
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
 ANT_ORACLE = "data/results/ant/scaling/ours_centre.csv"
