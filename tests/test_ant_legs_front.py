@@ -360,3 +360,35 @@ def test_lever_8_legs_recompute_from_the_shipped_profiles():
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
     found = re.search(r"<!-- lever 8 legs -->(.*?)<!-- /lever 8 legs -->", docs, flags=re.S)
     assert found and " ".join(found.group(1).split()) == expected
+
+
+def test_lever_8_scaling_legs_recompute_from_the_shipped_profiles():
+    """docs/ant_experiments.md's per-kind losses over the 27 cells of lever 8's and lever 7's scaling grids, and the
+    lost episodes by outcome, from the shipped JSONs."""
+    profiles = {name: json.loads((ANT / f"{name}_legs.json").read_text())
+                for name in ("oracle_wide_scaling", "oracle_corrector_scaling")}
+    lever, before = (leg_kinds(p) for p in profiles.values())
+    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+                f"against lever 7's {lost_of('turning', before)}; straight legs {lost_of('straight', lever)}, against "
+                f"{lost_of('straight', before)}")
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    found = re.search(r"<!-- lever 8 scaling legs -->(.*?)<!-- /lever 8 scaling legs -->", docs, flags=re.S)
+    assert found and " ".join(found.group(1).split()) == expected
+    assert all(len({(p["maze"], p["seed"]) for p in side}) == 27 for side in profiles.values())
+    lost = {name: {k: sum(p["episode_outcomes"].get(k, 0) for p in side) for k in ("flipped", "avoid", "timeout")}
+            for name, side in profiles.items()}
+    wide, redraw = lost["oracle_wide_scaling"], lost["oracle_corrector_scaling"]
+    assert (f"The {sum(wide.values())} episodes lost on lever 8's paths: {wide['flipped']} flipped, {wide['avoid']} "
+            f"touched a wall, none timed out (lever 7's {sum(redraw.values())}: {redraw['flipped']}, "
+            f"{redraw['avoid']} and {redraw['timeout']})") in " ".join(docs.split())
+    assert wide["timeout"] == 0
+
+
+def test_front_oracle_wide_legs_quote_the_scaling_profiles():
+    """README's per-leg rates of lever 8 over its 27 cells (turning, then straight) and lever 7's beside them."""
+    lever, before = (leg_kinds(json.loads((ANT / f"{name}_legs.json").read_text()))
+                     for name in ("oracle_wide_scaling", "oracle_corrector_scaling"))
+    assert front("oracle wide legs") == f"{lever['turning'][3]} and {lever['straight'][3]}"
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    rate = {kind: before[kind][3].split()[0] for kind in ("turning", "straight")}
+    assert f"(lever 7: {rate['turning']} and {rate['straight']}), above issue 42's 0.0005 and 0.0003" in readme
