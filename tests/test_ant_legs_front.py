@@ -392,3 +392,18 @@ def test_front_oracle_wide_legs_quote_the_scaling_profiles():
     readme = " ".join((ROOT / "README.md").read_text().split())
     rate = {kind: before[kind][3].split()[0] for kind in ("turning", "straight")}
     assert f"(lever 7: {rate['turning']} and {rate['straight']}), above issue 42's 0.0005 and 0.0003" in readme
+
+
+def test_lever_8_scaling_switches_recompute_from_the_shipped_profiles():
+    """docs/ant_experiments.md's losses by the kind of the leg before, on lever 8's 27 cells (turn_table after=True)."""
+    from specrefine.experiments.legs import turn_table
+
+    profiles = json.loads((ANT / "oracle_wide_scaling_legs.json").read_text())
+    rows = {r.split(" | ")[0].removeprefix("| "): r.split(" | ")[-1].removesuffix(" |")
+            for r in turn_table(profiles, after=True).splitlines()[2:]}
+    expected = (f"the second leg, the first goal switch, {rows['straight after first leg']}; a straight leg after a "
+                f"straight one {rows['straight after straight']}, after a turn {rows['straight after turning']}; a "
+                f"turn after a straight leg {rows['turning after straight']}")
+    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
+    found = re.search(r"<!-- lever 8 scaling switches -->(.*?)<!-- /lever 8 scaling switches -->", docs, flags=re.S)
+    assert found and " ".join(found.group(1).split()) == expected

@@ -61,6 +61,20 @@ def test_legs_are_told_apart_by_their_turn_and_lost_episodes_pool_by_kind():
     assert table[2].startswith("| first leg | 2 | 400 | 0 | 0.0000 [")
     assert table[3].startswith("| straight | 2 | 400 | 4 | 0.0100 [")
     assert table[4].startswith("| turning | 2 | 396 | 20 | 0.0505 [")
+    after = legs.turn_table([profile, profile], after=True).splitlines()
+    assert [row.split(" | ")[0] for row in after[2:]] == ["| first leg", "| straight after first leg",
+                                                          "| turning after straight"]
+    assert after[3].startswith("| straight after first leg | 2 | 400 | 4 | 0.0100 [")
+    assert after[4].startswith("| turning after straight | 2 | 396 | 20 | 0.0505 [")
+
+
+def test_a_leg_is_pooled_with_the_kind_of_the_leg_before_it():
+    profile = {"maze": "u_chain_1", "seed": 0, "episodes": 100, "leg_failure": [0.0, 0.01, 0.0, 0.02],
+               "turn_degrees": [None, 90.0, 90.0, 0.0]}
+    rows = {row.split(" | ")[0].removeprefix("| "): row.split(" | ")[1:4]
+            for row in legs.turn_table([profile], after=True).splitlines()[2:]}
+    assert rows == {"first leg": ["1", "100", "0"], "turning after first leg": ["1", "100", "1"],
+                    "turning after turning": ["1", "99", "0"], "straight after turning": ["1", "99", "2"]}
 
 
 def test_a_profile_without_turns_is_refused_in_one_line(tmp_path, capsys):
@@ -72,6 +86,8 @@ def test_a_profile_without_turns_is_refused_in_one_line(tmp_path, capsys):
     path.write_text(json.dumps(_turning_result()))
     assert legs.main([str(path), "--profiles", "--turns"]) == 0
     assert "| turning | 1 | 198 | 10 |" in capsys.readouterr().out
+    assert legs.main([str(path), "--profiles", "--turns", "--after"]) == 0
+    assert "| turning after straight | 1 | 198 | 10 |" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         legs.main([str(path), "--turns"])  # --turns alone: argparse's usage line, exit 2
 

@@ -103,18 +103,27 @@ def turn_kind(turn: float | None, straight_below: float = 45.0) -> str:
 TURN_HEADER = ("| legs | count | episodes started | lost | failure per leg [95 % CI] |\n|---|---|---|---|---|")
 
 
-def turn_table(profiles) -> str:
-    """Lost episodes pooled by the kind of leg (first, straight, turning at 45 degrees or more)."""
+LEG_KINDS = ("first leg", "straight", "turning")
+
+
+def turn_table(profiles, after: bool = False) -> str:
+    """Lost episodes pooled by the kind of leg (first, straight, turning at 45 degrees or more); ``after``: by the
+    kind of the leg and of the leg before it ("straight after turning"), to tell a leg's own loss from what the
+    leg before it hands on."""
     pooled_by: dict[str, list[int]] = {}
     for p in profiles:
         if not p.get("turn_degrees") or p.get("episodes") is None:
             raise SpecrefineError(f"profile of {p.get('maze')} seed {p.get('seed')} has no turns or episodes: make "
                                   "it again with --profiles from the run's result.json")
-        for turn, (started, lost) in zip(p["turn_degrees"], leg_episodes(p), strict=True):
-            acc = pooled_by.setdefault(turn_kind(turn), [0, 0, 0])
+        kinds = [turn_kind(turn) for turn in p["turn_degrees"]]
+        for i, (kind, (started, lost)) in enumerate(zip(kinds, leg_episodes(p), strict=True)):
+            key = f"{kind} after {kinds[i - 1]}" if after and i else kind
+            acc = pooled_by.setdefault(key, [0, 0, 0])
             acc[0], acc[1], acc[2] = acc[0] + 1, acc[1] + started, acc[2] + lost
     lines = [TURN_HEADER]
-    for kind in ("first leg", "straight", "turning"):
+    order = [kind if not after or kind == LEG_KINDS[0] else f"{kind} after {before}"
+             for kind in LEG_KINDS for before in (LEG_KINDS if after and kind != LEG_KINDS[0] else (None,))]
+    for kind in order:
         if kind in pooled_by:
             count, started, lost = pooled_by[kind]
             lo, hi = wilson_ci(lost, started)
@@ -188,9 +197,13 @@ def main(argv=None) -> int:
                                                             "their lost episodes by kind of leg (kind_table)")
     ap.add_argument("--turns", action="store_true", help="with --profiles: also print the lost episodes pooled by "
                                                          "straight and turning legs")
+    ap.add_argument("--after", action="store_true", help="with --turns: pool by the kind of each leg and of the leg "
+                                                         "before it")
     args = ap.parse_args(argv)
     if args.turns and not args.profiles:
         ap.error("--turns needs --profiles")
+    if args.after and not args.turns:
+        ap.error("--after needs --turns")
     try:
         if args.out:
             output_file(args.out)  # before reading the inputs
@@ -210,7 +223,7 @@ def main(argv=None) -> int:
                 write_atomic(args.out, json.dumps(profiles, indent=1) + "\n")
             print(profile_table(profiles))
             if args.turns:
-                print("\n" + turn_table(profiles))
+                print("\n" + turn_table(profiles, after=args.after))
             return 0
         print(report(args.tables, args.method, args.proposer))
     except SpecrefineError as exc:  # a missing or malformed table: one line
