@@ -276,12 +276,27 @@ def lever_line(table, method, baseline, baseline_method) -> tuple[str, dict, dic
             f"{difference_text(k1, n1, k2, n2)}: {check['verdict']}"), lever, base
 
 
-def leg_kinds(profiles) -> dict[str, list[str]]:
+def leg_kinds(profiles, after: bool = False) -> dict[str, list[str]]:
     """experiments.legs.turn_table's rows: kind -> its count, episodes started, lost, rate."""
     from specrefine.experiments.legs import turn_table
 
-    rows = [line.strip("|").split("|") for line in turn_table(profiles).splitlines()[2:]]
+    rows = [line.strip("|").split("|") for line in turn_table(profiles, after=after).splitlines()[2:]]
     return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows}
+
+
+def kinds_line(lever: dict, before: dict, against: str = "") -> str:
+    """The docs' per-kind line of a lever's legs against ``before``'s (leg_kinds of each)."""
+    return (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
+            f"against {against}{lost_of('turning', before)}; straight legs {lost_of('straight', lever)}, against "
+            f"{lost_of('straight', before)}")
+
+
+def docs_marker(name: str) -> str:
+    """The text between docs/ant_experiments.md's ``<!-- name -->`` markers, on one line."""
+    found = re.search(rf"<!-- {name} -->(.*?)<!-- /{name} -->", (ROOT / "docs" / "ant_experiments.md").read_text(),
+                      flags=re.S)
+    assert found, name
+    return " ".join(found.group(1).split())
 
 
 def lost_of(kind: str, side: dict) -> str:
@@ -313,12 +328,8 @@ def test_lever_7_legs_recompute_from_the_shipped_profiles():
     lever = leg_kinds(json.loads((ANT / "oracle_corrector_legs.json").read_text()))
     ours = leg_kinds([p for p in json.loads((ANT / "scaling_centre" / "leg_profiles.json").read_text())
                       if (p["maze"], p["seed"]) in set(LEVER_CELLS)])
-    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
-                f"against {lost_of('turning', ours)}; straight legs {lost_of('straight', lever)}, against "
-                f"{lost_of('straight', ours)}")
+    assert docs_marker("lever 7 legs") == kinds_line(lever, ours)
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    found = re.search(r"<!-- lever 7 legs -->(.*?)<!-- /lever 7 legs -->", docs, flags=re.S)
-    assert found and " ".join(found.group(1).split()) == expected
     assert lever["turning"][0] == ours["turning"][0] == "84"  # "Both have 84 turning legs"
     assert (lever["straight"][0], ours["straight"][0]) == ("139", "91")
     assert "(139 against 91)" in docs and "Both have 84 turning legs" in docs
@@ -354,12 +365,7 @@ def test_lever_8_legs_recompute_from_the_shipped_profiles():
     """docs/ant_experiments.md's per-kind losses of lever 8's paths against lever 7's, from the shipped JSONs."""
     lever, before = (leg_kinds(json.loads((ANT / name).read_text()))
                      for name in ("oracle_wide_legs.json", "oracle_corrector_legs.json"))
-    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
-                f"against lever 7's {lost_of('turning', before)}; straight legs {lost_of('straight', lever)}, against "
-                f"{lost_of('straight', before)}")
-    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    found = re.search(r"<!-- lever 8 legs -->(.*?)<!-- /lever 8 legs -->", docs, flags=re.S)
-    assert found and " ".join(found.group(1).split()) == expected
+    assert docs_marker("lever 8 legs") == kinds_line(lever, before, against="lever 7's ")
 
 
 def test_lever_8_scaling_legs_recompute_from_the_shipped_profiles():
@@ -368,12 +374,8 @@ def test_lever_8_scaling_legs_recompute_from_the_shipped_profiles():
     profiles = {name: json.loads((ANT / f"{name}_legs.json").read_text())
                 for name in ("oracle_wide_scaling", "oracle_corrector_scaling")}
     lever, before = (leg_kinds(p) for p in profiles.values())
-    expected = (f"turning legs {lost_of('turning', lever).replace(', ', ' started episodes lost, ', 1)} per leg, "
-                f"against lever 7's {lost_of('turning', before)}; straight legs {lost_of('straight', lever)}, against "
-                f"{lost_of('straight', before)}")
+    assert docs_marker("lever 8 scaling legs") == kinds_line(lever, before, against="lever 7's ")
     docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    found = re.search(r"<!-- lever 8 scaling legs -->(.*?)<!-- /lever 8 scaling legs -->", docs, flags=re.S)
-    assert found and " ".join(found.group(1).split()) == expected
     assert all(len({(p["maze"], p["seed"]) for p in side}) == 27 for side in profiles.values())
     lost = {name: {k: sum(p["episode_outcomes"].get(k, 0) for p in side) for k in ("flipped", "avoid", "timeout")}
             for name, side in profiles.items()}
@@ -396,14 +398,9 @@ def test_front_oracle_wide_legs_quote_the_scaling_profiles():
 
 def test_lever_8_scaling_switches_recompute_from_the_shipped_profiles():
     """docs/ant_experiments.md's losses by the kind of the leg before, on lever 8's 27 cells (turn_table after=True)."""
-    from specrefine.experiments.legs import turn_table
-
-    profiles = json.loads((ANT / "oracle_wide_scaling_legs.json").read_text())
-    rows = {r.split(" | ")[0].removeprefix("| "): r.split(" | ")[-1].removesuffix(" |")
-            for r in turn_table(profiles, after=True).splitlines()[2:]}
-    expected = (f"the second leg, the first goal switch, {rows['straight after first leg']}; a straight leg after a "
-                f"straight one {rows['straight after straight']}, after a turn {rows['straight after turning']}; a "
-                f"turn after a straight leg {rows['turning after straight']}")
-    docs = (ROOT / "docs" / "ant_experiments.md").read_text()
-    found = re.search(r"<!-- lever 8 scaling switches -->(.*?)<!-- /lever 8 scaling switches -->", docs, flags=re.S)
-    assert found and " ".join(found.group(1).split()) == expected
+    kinds = leg_kinds(json.loads((ANT / "oracle_wide_scaling_legs.json").read_text()), after=True)
+    rate = {kind: row[3] for kind, row in kinds.items()}
+    assert docs_marker("lever 8 scaling switches") == (
+        f"the second leg, the first goal switch, {rate['straight after first leg']}; a straight leg after a straight "
+        f"one {rate['straight after straight']}, after a turn {rate['straight after turning']}; a turn after a "
+        f"straight leg {rate['turning after straight']}")
