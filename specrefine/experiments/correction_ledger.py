@@ -5,7 +5,8 @@
 Descriptive, no rule. For every finished run whose search corrected its path (``correct-check`` steps in its
 ``steps.jsonl``): its passes; the path's legs at the first check and at the end; the legs it tried to correct; the
 alternatives it took, by kind; the wins a second draw refuted (``ours-corrector-crosscheck``); and each pass's fresh
-estimate of the path at its end, beside the success measured in the run's fresh episodes. The last of those estimates
+estimate of the path at its end, beside the success measured in the run's fresh episodes; and where its proposer calls
+went, the search's (before the first check) and each pass's (issue 39's cost). The last of those estimates
 minus the measured success says how much the correction's own check flatters the path it chose (it chose the path on
 those rollouts). Writes ``ledger.csv``, ``ledger.md`` and ``ledger.png`` (each run's last check against its measured
 success, with the measured success's 95 % interval); without ``--out`` prints the summary.
@@ -26,9 +27,11 @@ from ..core.tables import csv_text
 from .corrector_diagnosis import events
 from .taxonomy import Run, read_runs
 
-COLUMNS = ("cell", "maze", "agent", "method", "proposer", "seed", "passes", "legs_at_check", "legs_at_end",
-           "legs_tried", "taken", "taken_by_kind", "refuted", "check_p", "pass_end_p", "last_p", "success_rate",
-           "episodes", "last_p_minus_success", "last_p_above_interval")
+CALLS = ("proposer_calls", "search_calls", "pass_calls")
+BEFORE_CALLS = ("cell", "maze", "agent", "method", "proposer", "seed", "passes", "legs_at_check", "legs_at_end",
+                "legs_tried", "taken", "taken_by_kind", "refuted", "check_p", "pass_end_p", "last_p", "success_rate",
+                "episodes", "last_p_minus_success", "last_p_above_interval")
+COLUMNS = BEFORE_CALLS + CALLS  # a ledger written before the calls were read has BEFORE_CALLS; its calls are unknown
 
 
 def refuted(step: dict) -> int:
@@ -39,6 +42,16 @@ def refuted(step: dict) -> int:
 def taken_kinds(row: dict) -> Counter:
     """A row's ``taken_by_kind`` ("split:2 bypass:1") as counts."""
     return Counter({kind: int(n) for kind, n in (entry.split(":") for entry in row["taken_by_kind"].split())})
+
+
+def calls_by_phase(run: Run, checks: list[dict]) -> dict:
+    """The run's proposer calls, the search's (up to the first check) and each pass's ("19;11"); "" where its log or
+    result predates the counts."""
+    marks = [c.get("proposer_calls") for c in checks] + [run.result.get("proposer_calls")]
+    if any(m is None for m in marks):
+        return dict.fromkeys(CALLS, "")
+    return {"proposer_calls": marks[-1], "search_calls": marks[0],
+            "pass_calls": ";".join(str(b - a) for a, b in zip(marks, marks[1:]))}
 
 
 def ledger_row(run: Run) -> dict | None:
@@ -58,7 +71,7 @@ def ledger_row(run: Run) -> dict | None:
             "refuted": sum(map(refuted, legs)), "check_p": float(checks[0]["p"]),
             "pass_end_p": ";".join(f"{d['p']:.4f}" for d in dones), "last_p": last,
             "success_rate": success, "episodes": episodes, "last_p_minus_success": last - success,
-            "last_p_above_interval": last > high}
+            "last_p_above_interval": last > high, **calls_by_phase(run, checks)}
 
 
 INTS = ("seed", "passes", "legs_at_check", "legs_at_end", "legs_tried", "taken", "refuted", "episodes")
@@ -83,13 +96,35 @@ def read_ledger(path: Path) -> list[dict]:
     try:
         with path.open(newline="") as fh:
             reader = csv.DictReader(fh)
-            if tuple(reader.fieldnames or ()) != COLUMNS:
+            if tuple(reader.fieldnames or ()) not in (COLUMNS, BEFORE_CALLS):
                 raise ValueError("its columns are not a ledger's")
-            return [{**row, **{c: int(row[c]) for c in INTS}, **{c: float(row[c]) for c in FLOATS},
+            return [{**dict.fromkeys(CALLS, ""), **row, **{c: int(row[c]) for c in INTS},
+                     **{c: float(row[c]) for c in FLOATS}, **_calls(row),
                      "last_p_above_interval": {"True": True, "False": False}[row["last_p_above_interval"]]}
                     for row in reader]
     except (ValueError, KeyError, TypeError, csv.Error, UnicodeDecodeError) as exc:
         raise SpecrefineError(f"--keep: {path} is not a ledger this command wrote ({exc})") from None
+
+
+def _calls(row: dict) -> dict:
+    return {c: int(row[c]) for c in CALLS[:2] if row.get(c, "") != ""}
+
+
+def calls_line(group: list[dict]) -> str:
+    """Mean proposer calls per run, the search's and each pass's, over the runs whose calls are known."""
+    known = [g for g in group if g["proposer_calls"] != ""]
+    if not known:
+        return "calls not logged"
+    passes = [[int(n) for n in g["pass_calls"].split(";")] for g in known]
+    per_pass = [np.mean([p[i] for p in passes if len(p) > i]) for i in range(max(map(len, passes)))]
+    runs = f"{len(known)} run{'' if len(known) == 1 else 's'}"
+    return (f"{np.mean([g['proposer_calls'] for g in known]):.1f} a run over {runs}: search "
+            f"{np.mean([g['search_calls'] for g in known]):.1f}, "
+            + ", ".join(f"pass {i + 1} {n:.1f}" for i, n in enumerate(per_pass)))
+
+
+def _run_calls(row: dict) -> str:
+    return "" if row["proposer_calls"] == "" else f"{row['search_calls']} + {row['pass_calls'].replace(';', ' + ')}"
 
 
 def markdown(rows: list[dict]) -> str:
@@ -110,12 +145,16 @@ def markdown(rows: list[dict]) -> str:
     lines += ["", "Does the last check flatter longer paths more? Least squares of last - measured on the legs at "
               "the end:", ""]
     lines += [f"- {method} ({proposer}): {length_trend(group)}" for (method, proposer), group in _groups(rows).items()]
-    lines += ["", "Per run (`pass_end_p`: each pass's fresh estimate of the path at its end):", "",
+    lines += ["", "Where the proposer calls go (the search's, before the first check, and each pass's):", ""]
+    lines += [f"- {method} ({proposer}): {calls_line(group)}" for (method, proposer), group in _groups(rows).items()]
+    lines += ["", "Per run (`pass_end_p`: each pass's fresh estimate of the path at its end; calls: the search's + "
+              "each pass's):", "",
               "| maze | method | seed | passes | legs at check | legs at end | tried | taken | refuted | check | "
-              "pass ends | measured |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "pass ends | measured | calls |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['maze']} | {r['method']} | {r['seed']} | {r['passes']} | {r['legs_at_check']} | "
               f"{r['legs_at_end']} | {r['legs_tried']} | {r['taken_by_kind'] or 'none'} | {r['refuted']} | "
-              f"{r['check_p']:.3f} | {r['pass_end_p'].replace(';', ', ')} | {r['success_rate']:.3f} |" for r in rows]
+              f"{r['check_p']:.3f} | {r['pass_end_p'].replace(';', ', ')} | {r['success_rate']:.3f} | "
+              f"{_run_calls(r)} |" for r in rows]
     return "\n".join(lines) + "\n"
 
 
