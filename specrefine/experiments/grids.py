@@ -906,6 +906,13 @@ GRIDS = {g.name: g for g in (
                        "and 42; fixed 2026-12-05 06:48 UTC when ant-oracle-wide-scaling's rule 2 held, before its "
                        "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
                        code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
+    # docs/corrector.md, "The point mass's default method: deep with the oracle" (fixed 2026-12-05 09:25 UTC)
+    ExperimentGrid("corrector-deep-oracle", "docs/corrector.md, 'The point mass's default method: deep with the "
+                   "oracle' (issue 39; fixed 2026-12-05 before it ran): ours-corrector-deep and ours with the oracle "
+                   "on the 17 suite mazes", "point",
+                   parts=(Part(("ours-corrector-deep", "ours"), ("geometric",), split="seeds"),),
+                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
+                   code=DEEP_CODE, table="data/results/corrector/deep_oracle.csv", out="runs/corrector_deep_oracle"),
     ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
                     "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
                     "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),
