@@ -991,3 +991,36 @@ def test_the_ants_fresh_layouts_are_described_cell_by_cell_with_the_paired_diffe
     no_oracle = {**fresh, "cells": [{**c, "oracle": float("nan")} for c in fresh["cells"]]}
     assert ant_fresh.front_text(no_oracle).endswith("runs at 0: redraw 0, confirm 2")  # before the oracle has run
     assert ant_fresh.front_text(None) == "no cell yet"
+
+
+def lay_default(root, deep_rate, seeds=None):
+    """Grid corrector-deep-oracle's table under ``root``: ours at 0.99 with the oracle, deep at deep_rate(maze)."""
+    g = GRIDS["corrector-deep-oracle"]
+    rows = [row(maze, m, 0.99 if m == "ours" else deep_rate(maze), s, "geometric")
+            | {"proposer_calls": 4 if m == "ours" else 6, "evaluations": 10 if m == "ours" else 30, "sim_steps": 100}
+            for maze in g.mazes for m in (cc.DEEP, "ours") for s in (seeds or g.seeds)]
+    (root / g.table).parent.mkdir(parents=True, exist_ok=True)
+    write_csv(root / g.table, rows)
+
+
+@pytest.mark.parametrize("far_maze, verdict", [(None, "adopted"),
+                                               ("x_maze", "not adopted (below on no maze missed)")])
+def test_deep_becomes_the_points_default_only_if_below_ours_with_the_oracle_on_no_suite_maze(tmp_path, far_maze,
+                                                                                            verdict):
+    from specrefine.experiments.corrector_claims.default import default_study, default_text, default_verdict
+
+    assert default_study(tmp_path) is None and default_text(None) == "not run yet"
+    lay_default(tmp_path, lambda maze: 0.9 if maze == far_maze else 0.99)
+    d = default_study(tmp_path)
+    assert d["paired"]["cells"] == 68 and d["below"] == ([far_maze] if far_maze else [])
+    assert default_verdict(d)["verdict"] == verdict and d["adopted"] == (far_maze is None)
+    assert d["costs"]["proposer_calls_ratio"] == pytest.approx(1.5)
+    assert d["costs"]["evaluations_ratio"] == pytest.approx(3.0)
+    assert default_text(d).endswith(f"1.50x the proposer calls and 3.00x the evaluations of ours: {verdict}")
+
+
+def test_the_points_default_is_undecided_until_every_paired_cell_ran(tmp_path):
+    from specrefine.experiments.corrector_claims.default import default_study, default_verdict
+
+    lay_default(tmp_path, lambda maze: 0.99, seeds=(0, 1))
+    assert default_verdict(default_study(tmp_path))["verdict"] == "undecided (34 of 68 cells)"

@@ -906,7 +906,7 @@ GRIDS = {g.name: g for g in (
                        "and 42; fixed 2026-12-05 06:48 UTC when ant-oracle-wide-scaling's rule 2 held, before its "
                        "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
                        code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
-    # docs/corrector.md, "The point mass's default method: deep with the oracle" (fixed 2026-12-05 09:25 UTC)
+    # docs/corrector.md, "The point mass's default method: deep with the oracle" (fixed 2026-12-05 09:22 UTC)
     ExperimentGrid("corrector-deep-oracle", "docs/corrector.md, 'The point mass's default method: deep with the "
                    "oracle' (issue 39; fixed 2026-12-05 before it ran): ours-corrector-deep and ours with the oracle "
                    "on the 17 suite mazes", "point",

@@ -29,6 +29,7 @@ from .common import (
     _below_ours,
     _known,
 )
+from .default import default_study, default_text, default_verdict
 from .formats import _ant_paired_text, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
@@ -64,9 +65,9 @@ def fill(path: Path, texts: dict[str, str]) -> None:
         write_atomic(path, MARKER.sub(text, source))
 
 
-def rules_table(variant: dict | None, point: dict, ant: dict | None) -> str:
-    """Issue 39's rules for the reported variant, the held-out cells it is described on, and the Ant's rules, as one
-    markdown table (README's front page)."""
+def rules_table(variant: dict | None, point: dict, ant: dict | None, default: dict | None = None) -> str:
+    """Issue 39's rules for the reported variant, the held-out cells it is described on, the point mass's default
+    method (``default_study``) and the Ant's rules, as one markdown table (README's front page)."""
     if not variant:
         return "not run yet"
     method = variant["method"]
@@ -74,6 +75,7 @@ def rules_table(variant: dict | None, point: dict, ant: dict | None) -> str:
     order = [v for v in rows if "cost at most" not in v["rule"] and not v["rule"].startswith(method)]
     order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
     order += [row for mix in MIX_NAMES.values() if (row := _held_out_row(variant, mix))]
+    order += [default_verdict(default)] if default else []
     order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
     table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
     table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
@@ -159,7 +161,9 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = _ant_text(ant) if ant else "not run yet"
     out["unseen"] = _unseen_text(unseen(root))
-    out["table"] = rules_table(variants.get(reported(variants)), point, ant)
+    default = default_study(root)
+    out["table"] = rules_table(variants.get(reported(variants)), point, ant, default)
+    out["point-default"] = default_text(default)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]

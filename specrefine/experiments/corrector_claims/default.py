@@ -1,0 +1,78 @@
+"""The point mass's default method (docs/corrector.md, "The point mass's default method: deep with the oracle"):
+ours-corrector-deep against ours with the oracle on the 17 suite mazes, and the rule that makes deep the point's
+``--preset best`` method."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .. import comparison as cmp
+from ..grids import GRIDS, ROOT
+from .common import DEEP, costs, load, per_maze, zero_runs
+from .formats import _ant_paired_text, _diff, _num
+
+GRID = "corrector-deep-oracle"
+PROPOSER = "geometric"
+MARGIN = 0.01  # the pooled difference's lower end at or above -MARGIN
+
+
+def default_study(root: Path = ROOT) -> dict | None:
+    """Deep and ours with the oracle per maze, pooled over the paired cells, runs at 0 and deep's cost over ours's;
+    None before the grid's first row."""
+    from ..levers import lever_check
+
+    g = GRIDS[GRID]
+    rows = load(g.tables, root)
+    if not rows:
+        return None
+    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m and r["proposer"] == PROPOSER
+              and cmp.is_done(r)} for m in (DEEP, "ours")}
+    paired = lever_check(by[DEEP], by["ours"], [(m, s) for m in g.mazes for s in g.seeds])
+    entries = per_maze(rows, PROPOSER, g.mazes, g.seeds, reference=("ours", "*"), method=DEEP)
+    below = [e["maze"] for e in entries if "ci_high" in e and e["ci_high"] < 0]
+    holds = {"below on no maze": not below, f"pooled lower end >= -{MARGIN}": paired["cells"] > 0
+             and paired["ci"][0] >= -MARGIN}
+    return {"grid": GRID, "method": DEEP, "per_maze": entries, "paired": paired, "below": below, "parts": holds,
+            "adopted": paired["complete"] and all(holds.values()),
+            "zero": {m: zero_runs(rows, m, PROPOSER, g.mazes) for m in (DEEP, "ours")},
+            "costs": costs(rows, PROPOSER, g.mazes, g.seeds, first=DEEP)}
+
+
+def default_verdict(d: dict) -> dict:
+    """The rule's row: "adopted" once every paired cell ran and both parts hold."""
+    e = d["paired"]
+    if not e["complete"]:
+        verdict = f"undecided ({e['cells']} of {e['expected']} cells)"
+    else:
+        verdict = "adopted" if d["adopted"] else \
+            f"not adopted ({', '.join(part for part, held in d['parts'].items() if not held)} missed)"
+    return {"rule": f"point, the oracle: {d['method']} as --preset best's method in place of ours: below ours on no "
+                    f"suite maze (Newcombe), the pooled difference's lower end at or above -{MARGIN}",
+            "value": f"below on {len(d['below'])} of {len(d['per_maze'])}"
+                     + (f" ({', '.join(d['below'])})" if d["below"] else "") + f"; {_ant_paired_text(e)}",
+            "verdict": verdict}
+
+
+def default_markdown(d: dict) -> list[str]:
+    c, z = d["costs"], d["zero"]
+    lines = ["", f"The point mass's default method (grid {d['grid']}, the oracle `{PROPOSER}`, centre points): "
+             f"{d['method']} - ours per suite maze, pooled over seeds (Newcombe 95 %). Runs at 0: "
+             + ", ".join(f"{m} {k} of {n}" for m, (k, n) in z.items())
+             + f". Cost of {d['method']} over ours ({c['pairs']} pairs): {_num(c['proposer_calls_ratio'], '{:.2f}x')} "
+             f"the proposer calls, {_num(c['evaluations_ratio'], '{:.2f}x')} the evaluations, "
+             f"{_num(c['sim_steps_ratio'], '{:.2f}x')} the simulator steps.", "",
+             f"| maze | runs (ours) | {d['method']} | ours | difference |", "|---|---|---|---|---|"]
+    lines += [f"| {e['maze']} | {e['runs']} ({e['reference_runs']}) | {_num(e['success'])} | "
+              f"{_num(e['reference_success'])} | {_diff(e)} |" for e in d["per_maze"]]
+    return lines
+
+
+def default_text(d: dict | None) -> str:
+    """README's passage on the point mass's default method (``<!-- front corrector point-default -->``)."""
+    if d is None:
+        return "not run yet"
+    c, z = d["costs"], d["zero"]
+    return (f"{d['method']} - ours with the oracle {_ant_paired_text(d['paired'])}; below ours on {len(d['below'])} of "
+            f"{len(d['per_maze'])} suite mazes; runs at 0: " + ", ".join(f"{m} {k}" for m, (k, _) in z.items())
+            + f"; {_num(c['proposer_calls_ratio'], '{:.2f}x')} the proposer calls and "
+              f"{_num(c['evaluations_ratio'], '{:.2f}x')} the evaluations of ours: {default_verdict(d)['verdict']}")
