@@ -54,8 +54,9 @@ def default_verdict(d: dict) -> dict:
 
 
 def default_markdown(d: dict) -> list[str]:
-    c, z = d["costs"], d["zero"]
-    lines = ["", f"The point mass's default method (grid {d['grid']}, the oracle `{PROPOSER}`, centre points): "
+    c, z, v = d["costs"], d["zero"], default_verdict(d)
+    lines = ["", f"Rule: {v['rule']}: {v['value']}: **{v['verdict']}**.", "",
+             f"The point mass's default method (grid {d['grid']}, the oracle `{PROPOSER}`, centre points): "
              f"{d['method']} - ours per suite maze, pooled over seeds (Newcombe 95 %). Runs at 0: "
              + ", ".join(f"{m} {k} of {n}" for m, (k, n) in z.items())
              + f". Cost of {d['method']} over ours ({c['pairs']} pairs): {_num(c['proposer_calls_ratio'], '{:.2f}x')} "
