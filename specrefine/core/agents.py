@@ -79,8 +79,10 @@ AGENTS: dict[str, Agent] = {
         reach_task=ReachTask(0.5, 3.0, 0.25, 60, 1.0, 1.0, 0.0, 0.02, arrive_speed=1.0, lateral_cost=2.0),
         train=dict(frames=200_000, num_envs=64, steps_per_env=32, epochs=4, minibatch=1024),
         planar=True, action_in_disc=True, max_speed=5.0, bench_room_cells=61,
-        # centre goal points passed their rule on the corrector's grids (docs/corrector.md, "Aimed at the centre")
-        default_goal_points="centre"),
+        # centre goal points passed their rule on the corrector's grids (docs/corrector.md, "Aimed at the centre");
+        # the corrector, adopted with erring proposers, passed its rule with the oracle (docs/corrector.md, "The point
+        # mass's default method")
+        default_goal_points="centre", default_method="ours-corrector-deep"),
     "ant": Agent(
         name="ant",
         description="the MuJoCo Ant, a four-legged walking robot (as in Gymnasium-Robotics AntMaze); it is slow to "
