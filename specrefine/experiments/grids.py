@@ -429,6 +429,21 @@ ANT_FRESH_MIXES = ("imperfect:moderate",
                    "p_drop_turn=0.3,p_false_opening=0.2,p_wrong_branch=0.3,p_mirror_y=0.05,p_uncapped=0.5,"
                    "p_unparseable=0.05,rho=0.5,alpha=0.1")
 
+#: Gymnasium-Robotics' own maps and two error mixes no run had used, for the point mass's default method
+#: (docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps", fixed 2026-12-05 before it ran): AJ
+#: (offsets rounded to half cells, regions pulled to corners, dropped turns, false openings, wrong branches, mirrored
+#: replies, uncapped legs, unparseable replies, a weak follow-up, errors growing with the turns a query spans) and AK
+#: (coordinates rounded to whole cells, small regions of spread sizes pulled hard to corners, many dropped turns, false
+#: openings and wrong branches often, uncapped legs, errors growing fast, a weak follow-up), beside two presets
+GR_MAZES = ("gr:U_MAZE", "gr:MEDIUM_MAZE", "gr:LARGE_MAZE")
+GR_MIXES = ("imperfect:moderate", "imperfect:severe",
+            "imperfect:position_sigma=0.4,coord_grid=0.5,radius=0.3,radius_log_sigma=0.5,corner_pull=0.35,"
+            "p_drop_turn=0.35,p_false_opening=0.3,p_wrong_branch=0.35,p_mirror_y=0.15,p_uncapped=0.6,"
+            "p_unparseable=0.1,alpha=0.35,rho=0.4",
+            "imperfect:position_sigma=0.25,coord_grid=1.0,radius=0.2,radius_log_sigma=0.7,corner_pull=0.5,"
+            "p_drop_turn=0.5,p_false_opening=0.4,p_wrong_branch=0.45,p_uncapped=0.7,p_unparseable=0.05,"
+            "alpha=0.5,rho=0.5")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -913,6 +928,16 @@ GRIDS = {g.name: g for g in (
                    parts=(Part(("ours-corrector-deep", "ours"), ("geometric",), split="seeds"),),
                    seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
                    code=DEEP_CODE, table="data/results/corrector/deep_oracle.csv", out="runs/corrector_deep_oracle"),
+    # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:55 UTC)
+    ExperimentGrid("corrector-deep-gr", "docs/corrector.md, 'The point mass's default on Gymnasium-Robotics' maps' "
+                   "(issue 39; fixed 2026-12-05 before it ran; described, no rule): the default, ours-corrector-deep, "
+                   "beside ours and the oracle on D4RL's three maps", "point",
+                   parts=(Part(("ours-corrector-deep", "ours"), GR_MIXES, split="proposers"),
+                          Part(("ours",), ("geometric",), table="data/results/corrector/deep_gr_oracle.csv",
+                               out="oracle")),
+                   seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1,
+                   code="ac2e7f4", table="data/results/corrector/deep_gr.csv",
+                   out="runs/corrector_deep_gr"),
     ant_oracle_grid("ant-oracle-corrector", "docs/ant_experiments.md, 'Issue 42, lever 7' (fixed 2026-12-04 20:40 UTC "
                     "before its first cell ran): the Ant's corrector on the oracle's paths, U-chain 3 and 5",
                     "ours-corrector-redraw", "oracle_corrector", code="2b6a4f7", mazes=("u_chain_3", "u_chain_5"),
