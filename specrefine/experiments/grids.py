@@ -928,7 +928,7 @@ GRIDS = {g.name: g for g in (
                    parts=(Part(("ours-corrector-deep", "ours"), ("geometric",), split="seeds"),),
                    seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
                    code=DEEP_CODE, table="data/results/corrector/deep_oracle.csv", out="runs/corrector_deep_oracle"),
-    # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:55 UTC)
+    # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:52 UTC)
     ExperimentGrid("corrector-deep-gr", "docs/corrector.md, 'The point mass's default on Gymnasium-Robotics' maps' "
                    "(issue 39; fixed 2026-12-05 before it ran; described, no rule): the default, ours-corrector-deep, "
                    "beside ours and the oracle on D4RL's three maps", "point",
