@@ -1024,3 +1024,30 @@ def test_the_points_default_is_undecided_until_every_paired_cell_ran(tmp_path):
 
     lay_default(tmp_path, lambda maze: 0.99, seeds=(0, 1))
     assert default_verdict(default_study(tmp_path))["verdict"] == "undecided (34 of 68 cells)"
+
+
+def test_the_points_default_on_gymnasium_robotics_maps_is_described_per_map_and_proposer(tmp_path):
+    from specrefine.experiments.corrector_claims.default import gr_markdown, gr_study, gr_text
+    from specrefine.experiments.grids import GR_MIXES
+
+    g = GRIDS["corrector-deep-gr"]
+    assert gr_study(tmp_path) is None and gr_text(None) == "not run yet"
+    ours_rate = {"imperfect:severe": 0.0}  # ours ends every severe run at 0, deep none
+    rows = [row(maze, m, 0.98 if m == cc.DEEP else ours_rate.get(p, 0.9), s, p)
+            | {"proposer_calls": 8 if m == cc.DEEP else 4, "evaluations": 50 if m == cc.DEEP else 10, "sim_steps": 1}
+            for maze in g.mazes for m in (cc.DEEP, "ours") for p in GR_MIXES for s in g.seeds]
+    oracle = [row(maze, "ours", 1.0, s, "geometric") for maze in g.mazes for s in g.seeds]
+    for path, content in ((g.table, rows), (g.part_table(1), oracle)):
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        write_csv(tmp_path / path, content)
+    d = gr_study(tmp_path)
+    assert d["runs"] == 48 and d["zero"] == {cc.DEEP: 0, "ours": 12} and d["paired"]["complete"]
+    assert [e["mix"] for e in d["per_maze"][::3]] == ["moderate", "severe", "AJ", "AK"]
+    assert all(e["oracle"] == 1.0 for e in d["per_maze"])
+    assert d["paired"]["difference"] == pytest.approx(0.98 - (0.9 * 3 + 0.0) / 4)
+    assert gr_text(d).startswith("deep 0.980-0.980 per map and proposer over 48 runs (12 of 12 maps and proposers "
+                                 "run), ours 0.000-0.900; deep - ours +0.305")
+    assert gr_text(d).endswith("runs at 0: ours-corrector-deep 0, ours 12")
+    assert "| severe | gr:LARGE_MAZE | 4 | 0.980 | 0.000 |" in "\n".join(gr_markdown(d))
+    assert {c["proposer"]: c["proposer_calls_ratio"] for c in d["costs"]} == dict.fromkeys(
+        ("moderate", "severe", "AJ", "AK"), pytest.approx(2.0))

@@ -4,11 +4,12 @@ ours-corrector-deep against ours with the oracle on the 17 suite mazes, and the 
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from .. import comparison as cmp
-from ..grids import GRIDS, ROOT
-from .common import DEEP, costs, load, per_maze, zero_runs
+from ..grids import GR_MIXES, GRIDS, ROOT
+from .common import DEEP, costs, episodes_of, load, per_maze, zero_runs
 from .formats import _ant_paired_text, _diff, _num
 
 GRID = "corrector-deep-oracle"
@@ -77,3 +78,59 @@ def default_text(d: dict | None) -> str:
             f"{len(d['per_maze'])} suite mazes; runs at 0: " + ", ".join(f"{m} {k}" for m, (k, _) in z.items())
             + f"; {_num(c['proposer_calls_ratio'], '{:.2f}x')} the proposer calls and "
               f"{_num(c['evaluations_ratio'], '{:.2f}x')} the evaluations of ours: {default_verdict(d)['verdict']}")
+
+
+GR_GRID = "corrector-deep-gr"
+GR_NAMES = ("moderate", "severe", "AJ", "AK")  # GR_MIXES by name: two presets, then the two mixes made for the grid
+
+
+def gr_study(root: Path = ROOT) -> dict | None:
+    """Described (docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps"): deep beside ours and
+    the oracle per map and proposer, runs at 0, deep - ours pooled over the cells both ran, deep's cost over ours's;
+    None before the grid's first row of deep."""
+    from ..levers import lever_check
+
+    g = GRIDS[GR_GRID]
+    rows = load(g.tables, root)
+    if not any(r["method"] == DEEP for r in rows):
+        return None
+    mixes = dict(zip(GR_MIXES, GR_NAMES))
+    entries = []
+    for mix, name in mixes.items():
+        for e in per_maze(rows, mix, g.mazes, g.seeds, reference=("ours", "*"), method=DEEP):
+            k, n, _ = episodes_of(rows, e["maze"], "ours", PROPOSER, g.seeds)
+            entries.append(e | {"mix": name, "oracle": k / n if n else math.nan})
+    by = {m: {(r["maze"], r["proposer"], int(r["seed"])): r for r in rows if r["method"] == m and cmp.is_done(r)}
+          for m in (DEEP, "ours")}
+    cells = [(m, p, s) for p in GR_MIXES for m in g.mazes for s in g.seeds]
+    return {"grid": GR_GRID, "per_maze": entries, "paired": lever_check(by[DEEP], by["ours"], cells),
+            "zero": {m: sum(zero_runs(rows, m, mix, g.mazes)[0] for mix in GR_MIXES) for m in (DEEP, "ours")},
+            "runs": sum(e["runs"] for e in entries),
+            "costs": [costs(rows, mix, g.mazes, g.seeds, first=DEEP) | {"proposer": name}
+                      for mix, name in mixes.items()]}
+
+
+def gr_text(d: dict | None) -> str:
+    """README's passage on the gr check (``<!-- front corrector point-default-gr -->``)."""
+    if d is None:
+        return "not run yet"
+    done = [e for e in d["per_maze"] if e["runs"]]
+    return (f"deep {min(e['success'] for e in done):.3f}-{max(e['success'] for e in done):.3f} per map and proposer "
+            f"over {d['runs']} runs ({len(done)} of {len(d['per_maze'])} maps and proposers run), ours "
+            f"{min(e['reference_success'] for e in done):.3f}-{max(e['reference_success'] for e in done):.3f}; deep - "
+            f"ours {_ant_paired_text(d['paired'])}; runs at 0: " + ", ".join(f"{m} {k}" for m, k in d["zero"].items()))
+
+
+def gr_markdown(d: dict) -> list[str]:
+    lines = ["", f"The point mass's default on Gymnasium-Robotics' maps (grid {d['grid']}, described, no rule): "
+             f"{DEEP} beside ours and the oracle, pooled over seeds; Newcombe 95 % interval of {DEEP} - ours. Runs at "
+             "0: " + ", ".join(f"{m} {k} of {d['runs']}" for m, k in d["zero"].items()) + f". Paired over the cells "
+             f"both ran: {_ant_paired_text(d['paired'])}.", "",
+             f"| proposer | map | runs | {DEEP} | ours | difference | oracle |", "|---|---|---|---|---|---|---|"]
+    lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
+              f"{_diff(e)} | {_num(e['oracle'])} |" for e in d["per_maze"]]
+    lines += ["", "| proposer | pairs | proposer calls | evaluations | simulator steps |", "|---|---|---|---|---|"]
+    lines += [f"| {c['proposer']} | {c['pairs']} | {_num(c['proposer_calls_ratio'], '{:.2f}x')} | "
+              f"{_num(c['evaluations_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"
+              for c in d["costs"]]
+    return lines

@@ -29,7 +29,7 @@ from .common import (
     _below_ours,
     _known,
 )
-from .default import default_study, default_text, default_verdict
+from .default import default_study, default_text, default_verdict, gr_study, gr_text
 from .formats import _ant_paired_text, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
@@ -164,6 +164,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     default = default_study(root)
     out["table"] = rules_table(variants.get(reported(variants)), point, ant, default)
     out["point-default"] = default_text(default)
+    out["point-default-gr"] = gr_text(gr_study(root))
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
