@@ -20,7 +20,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import DEEP, get_method
+from specrefine.runs.methods import DEEP, MEND, get_method
 
 
 class LegTable:
@@ -744,6 +744,49 @@ def test_a_roadmap_search_spends_the_evaluations_its_config_gives_it():
 def test_remembering_needs_the_roadmap():
     with pytest.raises(ValueError, match="roadmap_remember needs correct_roadmap"):
         SearchConfig(roadmap_remember=True)
+
+
+# --- weak legs mended on the roadmap (SearchConfig.roadmap_weak): method ours-corrector-mend ---------------------
+#: the search takes S -> 3 -> 6 -> G, where 3 -> 6 succeeds on half its rollouts. Its split (4.5) and its split over
+#: 6 (5, 8: 5 -> 8 dead) both lose; pooled, 5 lies between 3 and 6, and 3 -> 5 -> 6 lives
+WEAK_LEG = {(0.0, 10.0): 0.0, (3.0, 6.0): 0.5, (3.0, 4.5): 0.25, (4.5, 6.0): 0.25, (5.0, 8.0): 0.0}
+WEAK_REPLIES = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (3.0, 10.0): [5, 8]}
+MENDED = dict(correct_rollouts=4, correct_reach=3.5, correct_roadmap=True)
+
+
+@pytest.mark.parametrize("weak", [0.0, 0.9])
+def test_a_weak_leg_the_proposer_cannot_mend_is_offered_the_roadmaps_chain_only_below_the_level(weak):
+    book = AnswerBook(WEAK_REPLIES)
+    g, result = run(LegTable(WEAK_LEG, WEAK_LEG), book, roadmap_weak=weak, **MENDED)
+    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
+    kinds = [t["kind"] for t in legs[0]["tried"]]
+    assert kinds[:2] == ["split", "resplit"] and set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 10.0)}
+    if weak:  # the pooled 5 mends the leg: no proposer call more
+        assert kinds[-1] == "roadmap" and legs[0]["accepted"] == "roadmap"
+        assert xs(result) == [0.0, 3.0, 5.0, 6.0, 10.0] and check_refines(result.graph, g) == []
+        assert result.predicted_success == pytest.approx(1.0)
+    else:  # deep's correction: the roadmap is for dead legs of dead paths only
+        assert "roadmap" not in kinds and legs[0]["accepted"] is None
+        assert xs(result) == [0.0, 3.0, 6.0, 10.0] and not any(s["event"] == "roadmap" for s in result.steps)
+
+
+def test_a_weak_legs_chain_builds_on_sound_legs_only_and_leaves_the_roadmaps_memory_alone():
+    roadmap = Roadmap(reach=3.5, remember=True)
+    roadmap.add([Disc(1.5, 0, 0.5)])
+    ev, s, g = LegTable({(0.0, 3.0): 0.5}), box_at(0, 0), box_at(3, 0)  # the leg itself succeeds on half
+    mended = roadmap.chain(ev, s, s, g, WALLS, sound=0.9)
+    assert mended.reaches_goal and [float(r.centre()[0]) for r in mended.waypoints] == [1.5]
+    assert not roadmap.dead and not roadmap.trees  # 0 -> 3 lives: not dead, and no tree kept for this floor
+    plain = roadmap.chain(ev, s, s, g, WALLS)  # a dead leg's search: the leg itself reaches the goal
+    assert plain.reaches_goal and plain.waypoints == [] and roadmap.trees
+
+
+def test_mending_needs_the_roadmap_and_a_level_in_0_1():
+    with pytest.raises(ValueError, match="roadmap_weak needs correct_roadmap"):
+        SearchConfig(roadmap_weak=0.9)
+    with pytest.raises(ValueError, match="roadmap_weak must lie in"):
+        SearchConfig(roadmap_weak=1.5, correct_roadmap=True, correct_reach=3.0)
+    assert MEND == {"roadmap_weak": 0.9} and get_method("ours-corrector-mend").name == "ours-corrector-mend"
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

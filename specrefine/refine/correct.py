@@ -184,7 +184,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
-            crosscheck: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            crosscheck: bool = False, roadmap_weak: float = 0.0) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -197,7 +197,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     legs are tried (module doc); ``roadmap(a, b, start)`` -> a ``roadmap.Chain`` over the run's pooled waypoints,
     offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's); ``reaim(region)`` ->
     the point a re-aimed waypoint of that region aims at; ``crosscheck``: a win is taken only if it also wins on a
-    second draw (module doc)."""
+    second draw (module doc); ``roadmap_weak``: a live leg whose fresh success is below it is offered the roadmap's
+    chain to its end last, after the proposer's splits and whatever their budget left."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
     if crosscheck:
@@ -209,7 +210,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim)
+                               reaim, roadmap_weak)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -229,17 +230,29 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
                   may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
-                  roadmap: Callable | None = None, reaim: Callable | None = None):
+                  roadmap: Callable | None = None, reaim: Callable | None = None, roadmap_weak: float = 0.0):
     """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses and,
     given ``reaim``, its waypoints re-aimed (no proposer call), then, for a dead leg of a dead path given ``roadmap``,
     the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
-    Algorithm 1 each). Lazy: a split is asked for only when its group is reached."""
+    Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end. Lazy: a
+    split is asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
     if reaim is not None:
         yield [("reaim", *reaimed(graph, path, k, point)) for k, point in reaims(graph, path, leg, reaim)]
     if roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0:
         yield _roadmap_options(state, leg, roadmap)
+    yield from _splits(state, leg, evaluator, split_leg, may_split, min_failures)
+    if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
+        yield [option for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak)
+               if option[0] == "roadmap"]
+
+
+def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable, may_split: Callable[[], bool],
+            min_failures: int):
+    """The proposer's alternatives to ``leg`` (``_alternatives``): its split, then its split over the next waypoint,
+    while the budget allows; none for a leg with fewer than ``min_failures`` fresh failures."""
+    graph, path, check = state.graph, state.path, state.check
     if failures(check.results[leg]) < min_failures:
         return
     spans = [(leg, leg + 1)] + ([(leg, leg + 2)] if leg + 2 < len(path) and one_split(graph, path, leg) else [])
@@ -264,14 +277,14 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
             yield options
 
 
-def _roadmap_options(state: _State, leg: int, roadmap: Callable) -> list:
-    """The pooled waypoints' chain for the dead ``leg``: the whole leg ("roadmap") where it reaches the leg's end,
-    else its live part ("advance"); none where it reaches no waypoint."""
+def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None) -> list:
+    """The pooled waypoints' chain for ``leg`` (``sound``: on legs at least that sound only): the whole leg
+    ("roadmap") where it reaches the leg's end, else its live part ("advance"); none where it reaches no waypoint."""
     graph, path = state.graph, state.path
     start = state.start_of_leg(leg)
     if start is None:
         return []
-    found = roadmap(graph, path[leg], path[leg + 1], start)
+    found = roadmap(graph, path[leg], path[leg + 1], start, **({"sound": sound} if sound is not None else {}))
     if not found.waypoints:
         return []
     return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, leg, leg + 1, found.waypoints))]

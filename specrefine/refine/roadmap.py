@@ -87,12 +87,16 @@ class Roadmap:
                 self.points.append(region)
 
     def chain(self, evaluator: SubtaskEvaluator, start, origin: Region, goal: Region, avoid: Region,
-              goal_point=None) -> Chain:
+              goal_point=None, sound: float | None = None) -> Chain:
         """The best-first chain from ``start`` (the start states of the leg from ``origin``) toward ``goal`` over
-        the pooled waypoints: to ``goal`` if found, else to the node reached nearest ``goal`` (none: no waypoints)."""
+        the pooled waypoints: to ``goal`` if found, else to the node reached nearest ``goal`` (none: no waypoints).
+        ``sound``: this search builds only on legs at least that fraction of whose rollouts succeed (a weak leg's
+        mend: the leg itself must not count as reaching); a leg below it but not below the roadmap's own ``sound`` is
+        not remembered as dead, and the search neither starts from nor keeps a remembered tree."""
         first = np.asarray(origin.centre(), dtype=float)
+        floor, own_floor = max(self.sound, sound or 0.0), sound is None
         reached: dict[int, tuple] = {-1: (start, None)}  # node -> (its start states, the node before it)
-        if self.remember:
+        if self.remember and own_floor:
             reached.update(self.trees.get(self._key(first, first), {}))
         nodes, centres, to_goal = self._nodes(goal)
         queue, remembered, added = self._queue(first, reached, centres, to_goal), len(reached) - 1, 0
@@ -117,6 +121,7 @@ class Roadmap:
             for v, result in zip(near, results):
                 if result.successes == 0 or result.p < self.sound:
                     self.dead.add(self._key(here, centres[v]))
+                if result.successes == 0 or result.p < floor:
                     continue
                 reached[v] = (start_of(result), u)
                 heapq.heappush(queue, (float(to_goal[v]), v))
@@ -125,7 +130,7 @@ class Roadmap:
             if len(nodes) - 1 in reached:
                 best = len(nodes) - 1
                 break
-        if self.remember:
+        if self.remember and own_floor:
             self.trees[self._key(first, first)] = {v: r for v, r in reached.items() if 0 <= v < len(self.points)}
         order = []
         while best >= 0:

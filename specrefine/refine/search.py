@@ -114,6 +114,9 @@ class SearchConfig:
     #                             waypoints tried from it only (roadmap.py; method ours-corrector-probe)
     roadmap_evaluations: int = 120  # subtask evaluations one roadmap search may spend at most (roadmap.py; 360:
     #                                 method ours-corrector-deep)
+    roadmap_weak: float = 0.0  # beyond the paper: a live leg whose fresh success is below this is also offered the
+    #                            roadmap's chain, after the proposer's alternatives and whatever budget is left (0:
+    #                            dead legs of dead paths only; correct.py; method ours-corrector-mend)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -133,7 +136,7 @@ class SearchConfig:
         if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
             raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
                              "give 'policy', the agent's goal range)")
-        for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe"):
+        for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe", "roadmap_weak"):
             if getattr(self, name) and not self.correct_roadmap:
                 raise ValueError(f"{name} needs correct_roadmap (it changes the roadmap's searches)")
         for name in ("roadmap_explore", "roadmap_probe"):
@@ -142,8 +145,9 @@ class SearchConfig:
                 raise ValueError(f"{name} must lie in [0, 1] (a fraction of correct_reach), got {fraction!r}")
         if self.roadmap_evaluations < 1:
             raise ValueError(f"roadmap_evaluations must be at least 1, got {self.roadmap_evaluations!r}")
-        if not 0.0 <= self.roadmap_sound <= 1.0:
-            raise ValueError(f"roadmap_sound must lie in [0, 1], got {self.roadmap_sound!r}")
+        for name in ("roadmap_sound", "roadmap_weak"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise ValueError(f"{name} must lie in [0, 1], got {getattr(self, name)!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
 
@@ -591,16 +595,18 @@ class RefinementSearch:
                                       min_failures=min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
+                                      roadmap_weak=self.cfg.roadmap_weak,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
                                       crosscheck=self.cfg.correct_crosscheck)
         return path, check
 
-    def _roadmap_chain(self, graph, a, b, start):
-        """The pooled waypoints' chain for the dead leg a -> b (roadmap.py), logged."""
+    def _roadmap_chain(self, graph, a, b, start, sound: float | None = None):
+        """The pooled waypoints' chain for the leg a -> b (roadmap.py; ``sound``: a weak leg's floor), logged."""
         found = self.roadmap.chain(self.evaluator, start, graph.region(a), graph.region(b), graph.avoid(a, b),
-                                   graph.goal_point(b))
+                                   graph.goal_point(b), sound=sound)
         extra = dict(remembered=found.remembered) if self.roadmap.remember else {}
         extra |= dict(explored=found.explored) if self.roadmap.explore or self.roadmap.probe else {}
+        extra |= dict(sound=sound) if sound is not None else {}
         self._log("roadmap", edge=[a, b], pooled=len(self.roadmap.points), waypoints=len(found.waypoints),
                   reaches_end=found.reaches_goal, evaluations=found.evaluations, **extra)
         return found

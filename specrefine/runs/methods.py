@@ -342,6 +342,14 @@ register_method("ours-corrector-deep",
                 "beyond the paper: ours-corrector-probe whose roadmap searches may each spend 360 subtask "
                 "evaluations instead of 120, so that a search probing its way out of a pocket is not cut off and "
                 "started again after one more proposer call", colour="#6a1b9a")
+#: ours-corrector-mend: deep, a live leg below 0.9 on the fresh check also offered the roadmap's chain to its end,
+#: after the proposer's alternatives (docs/corrector.md, "Weak legs mended on the roadmap")
+MEND = dict(roadmap_weak=0.9)
+register_method("ours-corrector-mend",
+                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND),
+                "beyond the paper: ours-corrector-deep whose correction also offers a live leg that fails on more "
+                "than a tenth of its fresh rollouts the roadmap's chain to its end (the pooled waypoints and probes, "
+                "no proposer call), after the proposer's alternatives and whatever budget they left", colour="#7b1fa2")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
