@@ -444,11 +444,26 @@ GR_MIXES = ("imperfect:moderate", "imperfect:severe",
             "p_drop_turn=0.5,p_false_opening=0.4,p_wrong_branch=0.45,p_uncapped=0.7,p_unparseable=0.05,"
             "alpha=0.5,rho=0.5")
 
+#: layouts and error mixes no run had used before grid corrector-mend-new (docs/corrector.md, "Weak legs mended on the
+#: roadmap"), made after corrector-deep-gr had been looked at: four larger generated mazes (sizes chosen, seeds drawn by
+#: random.Random(20261205)), and two mixes: AL (offsets rounded to quarter cells, small regions pulled to corners,
+#: dropped turns, false openings, wrong branches often, mirrored replies, uncapped legs, unparseable replies, a weak
+#: follow-up, errors growing with the turns a query spans) and AM (coordinates rounded to half cells, regions of
+#: spread sizes, many dropped turns, false openings often, wrong branches, uncapped legs, errors growing fast)
+MEND_MAZES = ("random:12x11:1", "random:11x12:92", "random:13x10:52", "random:10x13:79")
+MEND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.25,radius=0.25,radius_log_sigma=0.5,corner_pull=0.45,"
+              "p_drop_turn=0.35,p_false_opening=0.3,p_wrong_branch=0.45,p_mirror_y=0.15,p_uncapped=0.65,"
+              "p_unparseable=0.1,alpha=0.4,rho=0.4",
+              "imperfect:position_sigma=0.35,coord_grid=0.5,radius=0.3,radius_log_sigma=0.7,corner_pull=0.3,"
+              "p_drop_turn=0.5,p_false_opening=0.4,p_wrong_branch=0.35,p_uncapped=0.7,p_unparseable=0.05,"
+              "alpha=0.5,rho=0.6")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
 PROBE_CODE = "fef6e19"  # the commit of ours-corrector-probe's code (Roadmap.probe)
 DEEP_CODE = "d788274"  # the commit of ours-corrector-deep's code (SearchConfig.roadmap_evaluations)
+MEND_CODE = "cc4f1d3"  # the commit of ours-corrector-mend's code (SearchConfig.roadmap_weak)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -928,6 +943,20 @@ GRIDS = {g.name: g for g in (
                    parts=(Part(("ours-corrector-deep", "ours"), ("geometric",), split="seeds"),),
                    seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
                    code=DEEP_CODE, table="data/results/corrector/deep_oracle.csv", out="runs/corrector_deep_oracle"),
+    # docs/corrector.md, "Weak legs mended on the roadmap" (fixed 2026-12-05 10:19 UTC, before its grids ran)
+    new_layouts_grid("corrector-mend-new", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
+                     "2026-12-05 before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
+                     MEND_MAZES, MEND_MIXES, "mend_new", code=MEND_CODE),
+    *centre_variant_grids("corrector-mend", "Weak legs mended on the roadmap", "ours-corrector-mend", "mend",
+                          code=MEND_CODE,
+                          informed=Part(("ours-corrector-mend",), GR_MIXES, mazes=GR_MAZES, split="proposers",
+                                        table="data/results/corrector/mend_gr.csv", out="gr"),
+                          fixed="2026-12-05"),
+    ExperimentGrid("corrector-mend-oracle", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
+                   "2026-12-05 before it ran): ours-corrector-mend and ours with the oracle on the 17 suite mazes",
+                   "point", parts=(Part(("ours-corrector-mend", "ours"), ("geometric",), split="seeds"),),
+                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
+                   code=MEND_CODE, table="data/results/corrector/mend_oracle.csv", out="runs/corrector_mend_oracle"),
     # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:52 UTC)
     ExperimentGrid("corrector-deep-gr", "docs/corrector.md, 'The point mass's default on Gymnasium-Robotics' maps' "
                    "(issue 39; fixed 2026-12-05 before it ran; described, no rule): the default, ours-corrector-deep, "
