@@ -1037,7 +1037,8 @@ def test_the_points_default_on_gymnasium_robotics_maps_is_described_per_map_and_
             | {"proposer_calls": 8 if m == cc.DEEP else 4, "evaluations": 50 if m == cc.DEEP else 10, "sim_steps": 1}
             for maze in g.mazes for m in (cc.DEEP, "ours") for p in GR_MIXES for s in g.seeds]
     oracle = [row(maze, "ours", 1.0, s, "geometric") for maze in g.mazes for s in g.seeds]
-    for path, content in ((g.table, rows), (g.part_table(1), oracle)):
+    mend = [row(maze, "ours-corrector-mend", 0.99, s, "imperfect:severe") for maze in g.mazes for s in g.seeds]
+    for path, content in ((g.table, rows), (g.part_table(1), oracle), (GRIDS["corrector-mend"].part_table(0), mend)):
         (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
         write_csv(tmp_path / path, content)
     d = gr_study(tmp_path)
@@ -1048,6 +1049,33 @@ def test_the_points_default_on_gymnasium_robotics_maps_is_described_per_map_and_
     assert gr_text(d).startswith("deep 0.980-0.980 per map and proposer over 48 runs (12 of 12 maps and proposers "
                                  "run), ours 0.000-0.900; deep - ours +0.305")
     assert gr_text(d).endswith("runs at 0: ours-corrector-deep 0, ours 12")
-    assert "| severe | gr:LARGE_MAZE | 4 | 0.980 | 0.000 |" in "\n".join(gr_markdown(d))
+    table = "\n".join(gr_markdown(d))  # mend beside deep where its grid ran the cell (severe only here)
+    assert "| severe | gr:LARGE_MAZE | 4 | 0.980 | 0.000 | +0.980 [+0.967, +0.988] | 1.000 | 0.990 (4) |" in table
+    assert "| AK | gr:LARGE_MAZE | 4 | 0.980 | 0.900 | " in table and table.count("| — (0) |") == 9
+    assert d["mend_runs"] == 12
     assert {c["proposer"]: c["proposer_calls_ratio"] for c in d["costs"]} == dict.fromkeys(
         ("moderate", "severe", "AJ", "AK"), pytest.approx(2.0))
+
+
+@pytest.mark.parametrize("weak_cell, adopted", [(False, True), (True, False)])
+def test_mend_holds_its_second_part_with_no_more_runs_below_0_9_than_deep_not_fewer(tmp_path, weak_cell, adopted):
+    """corrector-mend: deep its reference and control; deep ends no run below 0.9 on the severe and new cells, so
+    mend's second part asks for no more such runs (not fewer), with the paired difference >= 0."""
+    deep = later_rate(cc.DEEP, (cc.PROBE,), cc.DEEP_MIXES, ("random:12x9:7",), base=probe_rate())
+
+    def rate(maze, method, proposer):
+        if method == cc.MEND:
+            return 0.5 if weak_cell and proposer == cc.MEND_MIXES[0] and maze == "random:12x11:1" else 0.99
+        return 0.99 if method == cc.DEEP else deep(maze, method, proposer)
+
+    for name in (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite",
+                 "corrector-deep-new", "corrector-mend", "corrector-mend-suite", "corrector-mend-new"):
+        lay_all_parts(tmp_path, name, rate)
+    studies = cc.variant_studies(tmp_path)
+    vs, a = studies["mend"], studies["mend"]["adoption"]
+    assert vs["reference"] == cc.DEEP and vs["new"]["names"] == ["AL", "AM"] and a["complete"]
+    assert a["zero"] == {cc.MEND: 2 if weak_cell else 0, cc.DEEP: 0} and a["floor"] == 0.9
+    assert a["fewer_zero"] == adopted and a["no_worse"]  # 0 against 0 holds; 2 against 0 does not
+    assert a["adopted"] == (adopted and studies["deep"]["adoption"]["adopted"])  # only where deep is
+    second = next(v for v in cc.variant_verdicts(vs) if "adoption 2" in v["rule"])
+    assert second["rule"].startswith("ours-corrector-mend, adoption 2: no more runs below 0.9 than ours-corrector-deep")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .. import comparison as cmp
 from ..grids import GR_MIXES, GRIDS, ROOT
-from .common import DEEP, costs, episodes_of, load, per_maze, zero_runs
+from .common import DEEP, MEND, costs, episodes_of, load, per_maze, zero_runs
 from .formats import _ant_paired_text, _diff, _num
 
 GRID = "corrector-deep-oracle"
@@ -81,6 +81,7 @@ def default_text(d: dict | None) -> str:
 
 
 GR_GRID = "corrector-deep-gr"
+MEND_GRID = "corrector-mend"  # its first part runs ours-corrector-mend on GR_GRID's cells (they informed it)
 GR_NAMES = ("moderate", "severe", "AJ", "AK")  # GR_MIXES by name: two presets, then the two mixes made for the grid
 
 
@@ -91,7 +92,7 @@ def gr_study(root: Path = ROOT) -> dict | None:
     from ..levers import lever_check
 
     g = GRIDS[GR_GRID]
-    rows = load(g.tables, root)
+    rows = load(g.tables + (GRIDS[MEND_GRID].part_table(0),), root)  # mend on these cells: its grid's first part
     if not any(r["method"] == DEEP for r in rows):
         return None
     mixes = dict(zip(GR_MIXES, GR_NAMES))
@@ -99,12 +100,15 @@ def gr_study(root: Path = ROOT) -> dict | None:
     for mix, name in mixes.items():
         for e in per_maze(rows, mix, g.mazes, g.seeds, reference=("ours", "*"), method=DEEP):
             k, n, _ = episodes_of(rows, e["maze"], "ours", PROPOSER, g.seeds)
-            entries.append(e | {"mix": name, "oracle": k / n if n else math.nan})
+            km, nm, rm = episodes_of(rows, e["maze"], MEND, mix, g.seeds)
+            entries.append(e | {"mix": name, "oracle": k / n if n else math.nan,
+                                "mend": km / nm if nm else math.nan, "mend_runs": rm})
     by = {m: {(r["maze"], r["proposer"], int(r["seed"])): r for r in rows if r["method"] == m and cmp.is_done(r)}
           for m in (DEEP, "ours")}
     cells = [(m, p, s) for p in GR_MIXES for m in g.mazes for s in g.seeds]
     return {"grid": GR_GRID, "per_maze": entries, "paired": lever_check(by[DEEP], by["ours"], cells),
             "zero": {m: sum(zero_runs(rows, m, mix, g.mazes)[0] for mix in GR_MIXES) for m in (DEEP, "ours")},
+            "mend_runs": sum(e["mend_runs"] for e in entries),
             "runs": sum(e["runs"] for e in entries),
             "costs": [costs(rows, mix, g.mazes, g.seeds, first=DEEP) | {"proposer": name}
                       for mix, name in mixes.items()]}
@@ -126,9 +130,10 @@ def gr_markdown(d: dict) -> list[str]:
              f"{DEEP} beside ours and the oracle, pooled over seeds; Newcombe 95 % interval of {DEEP} - ours. Runs at "
              "0: " + ", ".join(f"{m} {k} of {d['runs']}" for m, k in d["zero"].items()) + f". Paired over the cells "
              f"both ran: {_ant_paired_text(d['paired'])}.", "",
-             f"| proposer | map | runs | {DEEP} | ours | difference | oracle |", "|---|---|---|---|---|---|---|"]
+             f"| proposer | map | runs | {DEEP} | ours | difference | oracle | {MEND} (runs; informed by this grid) |",
+             "|---|---|---|---|---|---|---|---|"]
     lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
-              f"{_diff(e)} | {_num(e['oracle'])} |" for e in d["per_maze"]]
+              f"{_diff(e)} | {_num(e['oracle'])} | {_num(e['mend'])} ({e['mend_runs']}) |" for e in d["per_maze"]]
     lines += ["", "| proposer | pairs | proposer calls | evaluations | simulator steps |", "|---|---|---|---|---|"]
     lines += [f"| {c['proposer']} | {c['pairs']} | {_num(c['proposer_calls_ratio'], '{:.2f}x')} | "
               f"{_num(c['evaluations_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"

@@ -29,6 +29,8 @@ from ..grids import (
     KEEP_MIXES,
     MEMORY_MAZES,
     MEMORY_MIXES,
+    MEND_MAZES,
+    MEND_MIXES,
     NEW_MAZES,
     NEW_MIXES,
     PROBE_MAZES,
@@ -51,6 +53,7 @@ from .common import (
     FALLBACK,
     KEEP,
     MEMORY,
+    MEND,
     ORACLE,
     PERSIST,
     POLISH,
@@ -86,7 +89,8 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                MEMORY: ("corrector-memory-new", MEMORY_MAZES, MEMORY_MIXES, ("AA", "AB")),
                PROBE: ("corrector-probe-new", PROBE_MAZES, PROBE_MIXES, ("AC", "AD")),
                DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF")),
-               "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH"))}  # as made
+               "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH")),
+               MEND: ("corrector-mend-new", MEND_MAZES, MEND_MIXES, ("AL", "AM"))}  # as made
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check"}

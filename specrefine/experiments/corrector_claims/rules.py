@@ -7,7 +7,7 @@ import math
 
 from .. import comparison as cmp
 from .ant import ANT_FLOOR, ANT_METHOD, ANT_SEEDS
-from .common import COST_CAP, GATED, METHOD, NON_INFERIORITY, POINT_SEEDS, TOLERANCE, _below_ours
+from .common import COST_CAP, GATED, METHOD, NO_MORE, NON_INFERIORITY, POINT_SEEDS, TOLERANCE, _below_ours
 from .formats import _ant_paired_text, _num, _paired_text
 
 
@@ -196,9 +196,9 @@ def _adoption_rows(vs: dict) -> list[dict]:
     return [{"rule": f"{method}, adoption 1: no worse than {ref} (U-chains, mild and moderate) and below ours on no "
                      "suite maze", "value": _paired_text(vs["versus_corrector"]) + below,
              "verdict": ("holds" if a["no_worse"] else "does not hold") + pending},
-            {"rule": f"{method}, adoption 2: fewer {runs} than {ref} over the severe and new cells, paired "
-                     "difference >= 0", "value": f"{runs}: {a['zero'][method]} against {a['zero'][ref]}; "
-                                                 f"{_paired_text(a['paired'])}",
+            {"rule": f"{method}, adoption 2: {'no more' if method in NO_MORE else 'fewer'} {runs} than {ref} over "
+                     "the severe and new cells, paired difference >= 0",
+             "value": f"{runs}: {a['zero'][method]} against {a['zero'][ref]}; {_paired_text(a['paired'])}",
              "verdict": ("holds" if a["fewer_zero"] else "does not hold") + pending},
             {"rule": f"{method}: adopted (README's rules table reads it)", "value": "both parts hold"
              if a["no_worse"] and a["fewer_zero"] else "not both parts",

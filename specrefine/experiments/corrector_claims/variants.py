@@ -15,6 +15,7 @@ from .common import (
     HELD_OUT_SEEDS,
     METHOD,
     MIX_NAMES,
+    NO_MORE,
     NON_INFERIORITY,
     ORACLE,
     PERSIST,
@@ -121,7 +122,8 @@ def adoption(study: dict, cells: dict, failed: set, root: Path = ROOT) -> dict:
     versus, suite = study["versus_corrector"], study.get("versus_ours", [])
     below = [e for p in ("imperfect:mild", "imperfect:moderate") for e in _below_ours(suite, p)]
     first = (not math.isnan(versus["estimate"]) and versus["ci_low"] >= -NON_INFERIORITY and not below)
-    second = zero[method] < zero[ref] and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
+    fewer = zero[method] <= zero[ref] if method in NO_MORE else zero[method] < zero[ref]
+    second = fewer and not math.isnan(paired["estimate"]) and paired["estimate"] >= 0
     suite_done = bool(suite) and all(e["runs"] == len(POINT_SEEDS) for e in suite)
     complete = versus["complete"] and paired["complete"] and suite_done
     return {"no_worse": first, "fewer_zero": second, "zero": zero, "floor": floor, "paired": paired,
