@@ -20,7 +20,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import DEEP, MEND, get_method
+from specrefine.runs.methods import DEEP, GUARD, MEND, get_method
 
 
 class LegTable:
@@ -787,6 +787,43 @@ def test_mending_needs_the_roadmap_and_a_level_in_0_1():
     with pytest.raises(ValueError, match="roadmap_weak must lie in"):
         SearchConfig(roadmap_weak=1.5, correct_roadmap=True, correct_reach=3.0)
     assert MEND == {"roadmap_weak": 0.9} and get_method("ours-corrector-mend").name == "ours-corrector-mend"
+
+
+# --- a window's win checked on the whole path (SearchConfig.correct_guard): method ours-corrector-guard ------------
+class Drift(LegTable):
+    """LegTable whose rollouts carry how they arrived: a leg into 3 from 1.5 arrives badly, the mark stays with the
+    states leg after leg, and 8 -> G from a bad arrival succeeds on a fifth."""
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None, n=None):
+        result = super().evaluate(start, goal, avoid, goal_point, seed, n)
+        x0, bad = (0.0, 0.0) if isinstance(start, Box) else start[1]
+        bad = 1.0 if bad or (x0, result.at[0]) == (1.5, 3.0) else 0.0
+        if bad and (x0, result.at[0]) == (8.0, 10.0):
+            result = _Arrive(0.2, n=result.n, at=result.at)
+        return _Arrive(result.p, n=result.n, at=(result.at[0], bad))
+
+
+#: the search takes S -> 3 -> 6 -> 8 -> G; fresh, S -> 3 succeeds on three quarters, and its split over 1.5 wins the
+#: window S .. 8 (1.0 against 0.75) while the leg 8 -> G beyond it falls to 0.2: the path from 0.75 to 0.2
+DOWNSTREAM = dict(table={(0.0, 10.0): 0.0}, fresh={(0.0, 3.0): 0.75})
+DOWNSTREAM_REPLIES = {(0.0, 10.0): [3, 6, 8], (0.0, 3.0): [1.5]}
+
+
+@pytest.mark.parametrize("guard", [False, True])
+def test_a_window_win_that_lowers_the_whole_path_is_reverted_only_with_the_guard(guard):
+    g, result = run(Drift(**DOWNSTREAM), AnswerBook(DOWNSTREAM_REPLIES), correct_rollouts=4, correct_guard=guard)
+    leg = next(s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["S", "x0"])
+    split = next(t for t in leg["tried"] if t["kind"] == "split")
+    assert split["p_window"] == pytest.approx(1.0) and leg["p_window"] == pytest.approx(0.75)
+    done = next(s for s in result.steps if s["event"] == "correct-done")
+    if guard:  # the path stays as it was, at 0.75 on the fresh check
+        assert leg["accepted"] is None and split["reverted"] and split["p_path"] == pytest.approx(0.2)
+        assert xs(result) == [0.0, 3.0, 6.0, 8.0, 10.0] and done["p"] == pytest.approx(0.75)
+    else:  # deep's correction takes the window's win, and the path ends at 0.2
+        assert leg["accepted"] == "split" and "reverted" not in split
+        assert xs(result) == [0.0, 1.5, 3.0, 6.0, 8.0, 10.0] and done["p"] == pytest.approx(0.2)
+    assert check_refines(result.graph, g) == []
+    assert GUARD == {"correct_guard": True} and get_method("ours-corrector-guard").name == "ours-corrector-guard"
 
 
 # --- snapped waypoints (SearchConfig.snap_waypoints): method ours-corrector-snap ----------------------------------

@@ -57,6 +57,17 @@ where the differences are a rollout or two (the Ant's legs lose a fraction of a 
 much as the policy does. On the second draw a strictly higher score suffices (a tie keeps the path). It costs
 evaluations, never a proposer call.
 
+``roadmap_weak`` (method ``ours-corrector-mend``): a live leg below that fraction on the fresh check is offered one more
+alternative, last: the roadmap's chain over the pooled waypoints and probes to the leg's end, built only on legs at
+least that sound, so that the weak leg itself does not count as reaching its end. Without it the roadmap serves only
+a dead leg of a dead path, and a live leg the proposer cannot mend stays as it is (docs/corrector.md, "Weak legs
+mended on the roadmap").
+
+``guard`` (method ``ours-corrector-guard``): a win on the window is kept only if the whole path, checked again from the
+window on, scores no lower than before. The window is the changed legs and the one after them, but the legs further on
+start from the new legs' end states: a split that wins its window can leave the next weak leg downstream worse, and
+the path lower than it was (docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps").
+
 Every alternative is a refinement of the same input edge (a longer or shorter chain of waypoints), so the refined
 graph still implies the input graph (Theorem 4.1, checked like every refinement). What the correction sees is what
 a real proposer's reply gives: waypoints, pictures and rollouts.
@@ -184,7 +195,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
-            crosscheck: bool = False, roadmap_weak: float = 0.0) -> tuple[TaskGraph, list[str], Check]:
+            crosscheck: bool = False, roadmap_weak: float = 0.0,
+            guard: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -198,9 +210,11 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's); ``reaim(region)`` ->
     the point a re-aimed waypoint of that region aims at; ``crosscheck``: a win is taken only if it also wins on a
     second draw (module doc); ``roadmap_weak``: a live leg whose fresh success is below it is offered the roadmap's
-    chain to its end last, after the proposer's splits and whatever their budget left."""
+    chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
+    kept only if the path checked again from the window on scores no lower than before (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
-                                           start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance)
+                                           start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
+                   guard=guard)
     if crosscheck:
         state.second = check_path(graph, path, evaluator, rollouts=rollouts, seed=state.second_seed,
                                   start=graph.region(path[0]))
@@ -309,6 +323,7 @@ class _State:
     lean: bool
     advance: bool = False
     second: Check | None = None  # ``crosscheck``: the path's check on the second draw
+    guard: bool = False  # a window's win kept only if the whole path, checked again, scores no lower
 
     @property
     def second_seed(self) -> int:
@@ -357,11 +372,17 @@ class _State:
             tried[next(i for i, option in enumerate(judged) if option is best)] |= {
                 "p_window_second": there, "p_current_second": here}
         if wins:
+            before = (self.graph, self.path, self.check, self.second)
             second_start = self.start_of_leg(s, self.second) if self.second is not None else None
             self.graph, self.path = best[1], best[2]
             self.check = self._checked_from(s, check, start, self.seed)
             if self.second is not None:
                 self.second = self._checked_from(s, self.second, second_start, self.second_seed)
+            if self.guard and self.score(self.check) < self.score(check):  # the path lost what its window won
+                tried[next(i for i, option in enumerate(judged) if option is best)] |= {
+                    "p_path": self.check.p, "p_path_before": check.p, "reverted": True}
+                self.graph, self.path, self.check, self.second = before
+                wins = False
         return Judged(current, tried), best[0] if wins else None
 
     def _checked_from(self, s: int, check: Check, start, seed: int) -> Check:

@@ -114,6 +114,8 @@ class SearchConfig:
     #                             waypoints tried from it only (roadmap.py; method ours-corrector-probe)
     roadmap_evaluations: int = 120  # subtask evaluations one roadmap search may spend at most (roadmap.py; 360:
     #                                 method ours-corrector-deep)
+    correct_guard: bool = False  # beyond the paper: a correction's win on its window is kept only if the whole path,
+    #                              checked again from the window on, scores no lower (correct.py; ours-corrector-guard)
     roadmap_weak: float = 0.0  # beyond the paper: a live leg whose fresh success is below this is also offered the
     #                            roadmap's chain, after the proposer's alternatives and whatever budget is left (0:
     #                            dead legs of dead paths only; correct.py; method ours-corrector-mend)
@@ -595,7 +597,7 @@ class RefinementSearch:
                                       min_failures=min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
-                                      roadmap_weak=self.cfg.roadmap_weak,
+                                      roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
                                       crosscheck=self.cfg.correct_crosscheck)
         return path, check

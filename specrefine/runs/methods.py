@@ -350,6 +350,15 @@ register_method("ours-corrector-mend",
                 "beyond the paper: ours-corrector-deep whose correction also offers a live leg that fails on more "
                 "than a tenth of its fresh rollouts the roadmap's chain to its end (the pooled waypoints and probes, "
                 "no proposer call), after the proposer's alternatives and whatever budget they left", colour="#7b1fa2")
+#: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
+#: lower (docs/corrector.md, "A window's win checked on the whole path")
+GUARD = dict(correct_guard=True)
+register_method("ours-corrector-guard",
+                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | GUARD),
+                "beyond the paper: ours-corrector-deep whose correction keeps an alternative that wins on its window "
+                "(the changed legs and the one after) only if the whole path, checked again from the window on, "
+                "scores no lower than before: a split can win its window and leave a weak leg downstream worse",
+                colour="#4527a0")
 register_method("ours-corrector-confirm", ours_variant(**CORRECTOR | dict(confirm_pick=True)),
                 "beyond the paper: ours-corrector whose edge splits (the search's and the correction's) keep a later "
                 "round's pick only if it beats the first round's best on the same fresh rollouts (ours-confirm's "
