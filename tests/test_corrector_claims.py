@@ -143,11 +143,11 @@ def test_each_lever_alone_is_compared_with_ours_ours_repair_and_the_corrector_on
     by = {(e["proposer"], e["lever"]): e for e in lv["entries"]}
     deep = by[("imperfect:mild", "ours-deeprepair")]
     assert deep["runs"] == 16 and deep["success"] == pytest.approx(0.8)
-    assert deep["versus"]["ours"]["estimate"] == pytest.approx(0.2) and cc._helps(deep["versus"]["ours"]) == "helps"
+    assert deep["versus"]["ours"]["estimate"] == pytest.approx(0.2) and cc.helps_word(deep["versus"]["ours"]) == "helps"
     assert deep["versus"]["ours-repair"]["estimate"] == pytest.approx(0.1)
     assert deep["versus"][cc.METHOD]["verdict"] == "lower"
     feasible = by[("imperfect:moderate", "ours-feasible")]
-    assert "ours-repair" not in feasible["versus"] and cc._helps(feasible["versus"]["ours"]) == "undecided"
+    assert "ours-repair" not in feasible["versus"] and cc.helps_word(feasible["versus"]["ours"]) == "undecided"
     checked = by[("imperfect:moderate", "ours-checked")]
     assert checked["versus"][cc.METHOD]["estimate"] == pytest.approx(0.0)
     assert checked["costs"]["proposer_calls_ratio"] == pytest.approx(1.0)  # 3 calls each, as ours
@@ -164,7 +164,7 @@ def test_a_lever_grid_cut_short_is_marked_partial(tmp_path):
     lay_grid(tmp_path, "corrector-levers", lambda maze, m, p: LEVER_RATES[m], drop=5)
     lv = cc.levers_study(tmp_path)
     last = lv["entries"][-1]
-    assert last["versus"]["ours"]["complete"] is False and "partial" in cc._helps(last["versus"]["ours"])
+    assert last["versus"]["ours"]["complete"] is False and "partial" in cc.helps_word(last["versus"]["ours"])
 
 
 @pytest.mark.parametrize("gated, verdict", [(0.96, "holds"), (0.9, "does not hold")])
@@ -183,7 +183,7 @@ def test_the_gated_corrector_is_judged_against_the_corrector_by_its_margin(tmp_p
     assert gs["held_out"] and not any(e["runs"] for e in gs["held_out"])  # its held-out part has not run
     assert [(c["proposer"], c["method"], c["pairs"]) for c in gs["held_out_costs"]] == [
         ("mix A", cc.GATED, 0), ("mix A", cc.METHOD, 0), ("mix B", cc.GATED, 0), ("mix B", cc.METHOD, 0)]
-    assert cc._gated_text(gs).startswith("proposer calls over ours: mild 1.7x (36 pairs); moderate 1.7x (36 pairs)")
+    assert cc.gated_text(gs).startswith("proposer calls over ours: mild 1.7x (36 pairs); moderate 1.7x (36 pairs)")
 
 
 def test_without_their_tables_the_levers_and_the_gate_are_not_run_yet(tmp_path):
@@ -243,7 +243,7 @@ def test_a_later_variant_helps_is_no_worse_or_is_worse_than_the_corrector(tmp_pa
     assert severe["verdict"] == "no worse" and "+" in severe["value"]  # every rate here is above ours-repair's
     assert [c["proposer"] for c in vs["costs"]] == [*LEVELS, "imperfect:severe"]
     assert all(e["runs"] == 2 for e in vs["held_out"])  # seeds 0-1 per layout and mix
-    text = cc._variant_text(vs)
+    text = cc.variant_text(vs)
     assert text.startswith(f"{method} - {cc.METHOD} ") and f"({verdict})" in text
     assert "1.7x the proposer calls of ours" in text and "one-shot ratio" in text
     assert "severe: runs at 0 0 of 36 (ours-corrector 0 of 36), - ours-corrector " in text
@@ -280,7 +280,7 @@ def test_trim_is_judged_against_precise_not_the_corrector(tmp_path, rate, verdic
                "worse if >= -0.02"]
     assert paired["verdict"] == verdict and "over 72 cells" in paired["value"]
     assert [c["proposer_calls_ratio"] for c in vs["corrector_costs"]] == pytest.approx([8 / 3] * 2)
-    text = cc._variant_text(vs)
+    text = cc.variant_text(vs)
     assert text.startswith(f"{cc.TRIM} - {cc.PRECISE} ") and f"({verdict})" in text
     assert f"({cc.PRECISE} 0 of 36), - {cc.PRECISE} " in text
     assert "per layout and mix (ours-corrector-precise 0.980-0.980;" in text
@@ -295,7 +295,7 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     ant = cc.ant_study(tmp_path)
     rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
     assert rule["verdict"] == "not run yet" and cc.ANT_GRID in rule["value"]
-    assert cc._ant_text(ant) == (f"{cc.ANT_GRID} ({cc.ANT_METHOD}): no cell yet. {cc.ANT_BEFORE} (ours-corrector, "
+    assert cc.ant_text(ant) == (f"{cc.ANT_GRID} ({cc.ANT_METHOD}): no cell yet. {cc.ANT_BEFORE} (ours-corrector, "
                                  "stopped): u_chain_1 0.800 (3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals "
                                  "0.800 (1 run); below 0.85 on 3 of 3 mazes run. Difference on the cells both ran: "
                                  f"no cell in both yet. {cc.ANT_REAIM} ({cc.REAIM}): no cell yet; {cc.REAIM} - "
@@ -315,7 +315,7 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_5 | 3 | 0.840 [" in md and "| 1 | 0.800 |" in md and "| 0 | — |" in md
     assert f"{cc.ANT_METHOD} - ours-corrector on the cells both ran: +0.100 [" in md
-    text = cc._ant_text(ant)
+    text = cc.ant_text(ant)
     assert "below 0.85 on 1 of 9 mazes run" in text and "over 7 cells (Newcombe 95 %, pooled). " in text
 
 
@@ -336,7 +336,7 @@ def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rule
     assert rules[0]["rule"].startswith(f"Ant ({cc.ANT_METHOD})")
     mine = next(v for v in rules if v["rule"].startswith(f"Ant: {method} - "))
     assert mine["verdict"] == "undecided (2 of 27 cells)"
-    assert f"{grid} ({method}): u_chain_1 {rate:.3f} (2 runs); below" in cc._ant_text(ant)
+    assert f"{grid} ({method}): u_chain_1 {rate:.3f} (2 runs); below" in cc.ant_text(ant)
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_1 | 3 | 0.900 [" in md and f"`{cc.ANT_BEFORE}`, ours-corrector" in md
     assert f"{method} - {cc.ANT_METHOD} on the cells both ran: +{rate - 0.9:.3f} [" in md
@@ -350,7 +350,7 @@ def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rule
     assert mine["verdict"] == ("adopted" if adopted else "not adopted")
     assert rules[0]["verdict"] == ("holds" if adopted else "does not hold")  # 0.99 everywhere; confirm 0.84
     assert rules[0]["rule"].startswith(f"Ant ({method if adopted else cc.ANT_METHOD})")
-    assert ("(adopted: the Ant's rules read" in cc._ant_text(ant)) is adopted
+    assert ("(adopted: the Ant's rules read" in cc.ant_text(ant)) is adopted
 
 
 def test_where_both_candidates_hold_the_one_with_the_higher_pooled_success_is_read(tmp_path):
@@ -393,7 +393,7 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     assert (ant["grid"], ant["method"]) == ((cc.ANT_SPARING, cc.SPARING) if adopted else (cc.ANT_REDRAW, cc.REDRAW))
     floor = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
     assert floor["rule"].startswith(f"Ant ({cc.SPARING if adopted else cc.REDRAW})")
-    assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc._ant_text(ant)) is adopted
+    assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc.ant_text(ant)) is adopted
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
 
@@ -458,7 +458,7 @@ def test_precise_at_the_fixed_code_is_named_apart_and_judged_against_precise_bef
     vs = cc.variant_study(cc.SPREAD, tmp_path)
     assert vs["reference"] == cc.PRECISE and vs["versus_corrector"]["estimate"] == pytest.approx(0.02)
     assert all(e["success"] == pytest.approx(0.98) for e in vs["per_maze"])
-    text = cc._variant_text(vs)
+    text = cc.variant_text(vs)
     assert text.startswith(f"{cc.SPREAD} - {cc.PRECISE} +0.020 ") and "(helps)" in text
     assert "per layout and mix (ours-corrector-precise 0.960-0.960; higher on 12, lower on 0 of 12)" in text
     assert cc.variant_study(cc.PRECISE, tmp_path)["versus_corrector"]["estimate"] == pytest.approx(-0.01)
@@ -470,7 +470,7 @@ def test_a_variant_whose_severe_part_did_not_run_says_so(tmp_path):
     vs = cc.variant_study(cc.TRIM, tmp_path)
     severe = next(v for v in cc.variant_verdicts(vs) if "imperfect:severe: no worse" in v["rule"])
     assert severe["verdict"] == "not run" and severe["value"] == "—"
-    assert "severe" not in cc._variant_text(vs) and "held out" not in cc._variant_text(vs)
+    assert "severe" not in cc.variant_text(vs) and "held out" not in cc.variant_text(vs)
 
 
 def test_recheck_is_judged_against_precise_at_the_fixed_code(tmp_path):
@@ -483,8 +483,8 @@ def test_recheck_is_judged_against_precise_at_the_fixed_code(tmp_path):
     lay_grid(tmp_path, "corrector-held-out", lambda maze, m, p: 0.97 if m == cc.METHOD else 0.5, part=1)
     vs = cc.variant_study(cc.RECHECK, tmp_path)
     assert vs["reference"] == cc.SPREAD and vs["versus_corrector"]["estimate"] == pytest.approx(0.02)
-    assert cc._variant_text(vs).startswith(f"{cc.RECHECK} - {cc.SPREAD} +0.020 ")
-    assert "(ours-corrector-precise (spread) 0.970-0.970;" in cc._variant_text(vs)
+    assert cc.variant_text(vs).startswith(f"{cc.RECHECK} - {cc.SPREAD} +0.020 ")
+    assert "(ours-corrector-precise (spread) 0.970-0.970;" in cc.variant_text(vs)
 
 
 def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_mazes(tmp_path):
@@ -504,7 +504,7 @@ def test_a_variant_with_a_suite_grid_is_judged_against_ours_on_all_17_suite_maze
     lay_grid(tmp_path, "corrector-precise", lambda maze, m, p: 0.97)
     assert "versus_ours" not in cc.variant_study(cc.PRECISE, tmp_path)  # no suite grid: no such rule
     assert f"every suite maze: below ours on 1 of 17 at mild ({below}), 1 of 17 at moderate ({below})" in \
-        cc._variant_text(vs)
+        cc.variant_text(vs)
 
 
 CENTRE_RATES = {"ours-corrector-polish": 0.99, "ours-repair": 0.7, "vlm-oneshot": 0.8}
@@ -554,7 +554,7 @@ def test_the_fresh_layouts_put_polish_at_centre_beside_polish_at_sampled_points(
     assert first["ours"] == 0.5 and first["oracle"] == 1.0 and first["oracle_sampled"] == pytest.approx(0.99)
     assert fresh["paired"]["n_cells"] == 16
     assert fresh["paired"]["estimate"] == pytest.approx((14 * 0.05 - 2 * 0.95) / 16)
-    assert "runs at 0: ours-corrector-polish (centre) 2" in cc._fresh_text(fresh)
+    assert "runs at 0: ours-corrector-polish (centre) 2" in cc.fresh_text(fresh)
 
 
 def persist_rate(maze, method, proposer):
@@ -622,7 +622,7 @@ def test_persist_is_judged_against_polish_at_centre_points_with_the_centre_grids
     assert a["paired"]["estimate"] == pytest.approx((4 * 0.98 + 32 * -0.01 + 4 * 0.99) / 52)
     rules = {r["rule"]: r["verdict"] for r in cc.variant_verdicts(vs)}
     assert rules[f"{cc.PERSIST}: adopted (README's rules table reads it)"] == "adopted"
-    assert "runs at 0: ours-corrector-persist 0" in cc._new_text(new)
+    assert "runs at 0: ours-corrector-persist 0" in cc.new_text(new)
     assert "Layouts and mixes no run had used" in "\n".join(cc.variant_markdown(vs))
 
 
@@ -695,8 +695,8 @@ def test_extend_is_judged_against_snap_on_its_new_layouts_and_the_check_cells_th
     assert a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
     assert a["adopted"] == a["reference_adopted"]
     assert cc.reported(studies) == ("extend" if a["adopted"] else cc.reported({**studies, "extend": None}))
-    assert cc._new_text(new).startswith("extend 0.990-0.990 per layout and mix over 16 runs")
-    assert "runs at 0: ours-corrector-extend 0, ours-corrector-snap 4" in cc._new_text(informed)
+    assert cc.new_text(new).startswith("extend 0.990-0.990 per layout and mix over 16 runs")
+    assert "runs at 0: ours-corrector-extend 0, ours-corrector-snap 4" in cc.new_text(informed)
     assert cc.INFORMED_PARTS[cc.EXTEND] == ("informed",)  # README's marker extend-informed
 
 
@@ -717,7 +717,7 @@ def test_keep_is_judged_against_snap_on_its_new_layouts_and_extends_cells_that_i
     a = vs["adoption"]
     assert a["zero"] == {cc.KEEP: 0, cc.SNAP: 4} and a["fewer_zero"] and a["no_worse"] and a["complete"]
     assert a["adopted"] == a["reference_adopted"] == studies["snap"]["adoption"]["adopted"]
-    assert "runs at 0: ours-corrector-keep 0, ours-corrector-snap 4" in cc._new_text(informed)
+    assert "runs at 0: ours-corrector-keep 0, ours-corrector-snap 4" in cc.new_text(informed)
 
 
 def test_advance_is_judged_against_snap_on_its_new_layouts_and_fallbacks_cells_that_informed_it(tmp_path):
@@ -802,7 +802,7 @@ def test_sound_is_judged_against_roadmap_by_its_runs_below_half_on_its_new_layou
     assert a["floor"] == 0.5 and a["zero"] == {cc.SOUND: 0, cc.ROADMAP: 4}
     assert a["fewer_zero"] and a["no_worse"] and a["complete"] and a["paired"]["estimate"] > 0
     assert a["adopted"] == a["reference_adopted"] == studies["roadmap"]["adoption"]["adopted"]
-    assert "runs below 0.5: 0 against 4" in cc._adoption_text(vs)
+    assert "runs below 0.5: 0 against 4" in cc.adoption_text(vs)
     assert cc.reported(studies) == ("sound" if a["adopted"] else cc.reported({**studies, "sound": None}))
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["W/X", "Y/Z"]  # in the order made
 
@@ -857,7 +857,7 @@ def test_memory_is_judged_against_roadmap_on_its_new_layouts_and_sounds_cells_th
         tmp_path, "memory", rate, laid,
         (["Y", "Z"], "corrector-sound-new", {cc.MEMORY: 0, cc.ROADMAP: 4, cc.SOUND: 4, "ours": 0}),
         "corrector-memory-new", (["AA", "AB"], {cc.MEMORY: 0, cc.ROADMAP: 4, "ours": 0}), {cc.MEMORY: 0, cc.ROADMAP: 4})
-    assert "runs at 0: 0 against 4" in cc._adoption_text(vs)
+    assert "runs at 0: 0 against 4" in cc.adoption_text(vs)
     assert [e["mixes"] for e in cc.unseen(tmp_path, cc.ROADMAP)][-2:] == ["Y/Z", "AA/AB"]  # in the order made
 
 
@@ -896,13 +896,13 @@ def test_deep_is_judged_against_probe_its_control_and_probes_cells_that_informed
 
 
 def test_the_reported_corrector_on_every_unseen_set_counts_its_runs_at_0_in_the_order_the_sets_were_made(tmp_path):
-    assert cc._unseen_text(cc.unseen(tmp_path)) == "not run yet"
+    assert cc.unseen_text(cc.unseen(tmp_path)) == "not run yet"
     lay_all_parts(tmp_path, "corrector-keep-new", lambda maze, m, p: 0.0 if m == cc.SNAP and
                   cc.table_name(maze) == "random:8x6:3" else 1.0)
     lay_all_parts(tmp_path, "corrector-snap-new", lambda maze, m, p: 0.995 if p == "geometric" else 1.0)
     sets = cc.unseen(tmp_path)
     assert [(e["mixes"], e["zero"], e["runs"]) for e in sets] == [("G/H", 0, 16), ("M/N", 4, 16)]
-    assert cc._unseen_text(sets) == "G/H 0 of 16; M/N 4 of 16 (the oracle at least 0.995 on every one of those " \
+    assert cc.unseen_text(sets) == "G/H 0 of 16; M/N 4 of 16 (the oracle at least 0.995 on every one of those " \
         "runs' cells)"
 
 

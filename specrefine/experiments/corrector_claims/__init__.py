@@ -94,22 +94,22 @@ from .common import (
     table_name,
 )
 from .frontpage import (
-    _adoption_text,
-    _ant_text,
-    _fresh_text,
-    _gated_text,
-    _new_text,
-    _unseen_text,
-    _variant_text,
+    adoption_text,
+    ant_text,
     fill,
+    fresh_text,
     front,
+    gated_text,
+    new_text,
     reported,
     rules_table,
+    unseen_text,
+    variant_text,
 )
 from .layouts import INFORMED_PARTS, fresh_study, new_study, unseen
 from .point import held_out_study, levers_study, point_study
 from .report import levers_markdown, markdown, variant_markdown
-from .rules import _helps, variant_verdicts, verdicts
+from .rules import helps_word, variant_verdicts, verdicts
 from .variants import variant_studies, variant_study
 
 __all__ = [
@@ -124,6 +124,6 @@ __all__ = [
     "TRIM", "VARIANTS", "VARIANT_GRIDS", "WIDE", "add_arguments", "ant_fresh_study", "ant_study", "fill",
     "fresh_study", "front", "held_out_study", "levers_markdown", "levers_study", "load", "main", "markdown",
     "new_study", "point_study", "reference_of", "reported", "rules_table", "run", "table_name", "unseen",
-    "variant_markdown", "variant_studies", "variant_study", "variant_verdicts", "verdicts", "_adoption_text",
-    "_ant_text", "_fresh_text", "_gated_text", "_helps", "_new_text", "_unseen_text", "_variant_text",
+    "variant_markdown", "variant_studies", "variant_study", "variant_verdicts", "verdicts", "adoption_text",
+    "ant_text", "fresh_text", "gated_text", "helps_word", "new_text", "unseen_text", "variant_text",
 ]

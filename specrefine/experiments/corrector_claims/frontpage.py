@@ -35,9 +35,9 @@ from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
     _adoption_rows,
     _cost_verdict,
-    _helps,
     _mazes_run,
     _verdict,
+    helps_word,
     variant_verdicts,
     verdicts,
     versus_corrector,
@@ -142,7 +142,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["levers"] = _levers_text(levers) if levers else "not run yet"
     for name in VARIANTS:
         study = variants.get(name)
-        out[name] = ((_gated_text if name == "gated" else _variant_text)(study)) if study else "not run yet"
+        out[name] = ((gated_text if name == "gated" else variant_text)(study)) if study else "not run yet"
         if study:
             v = study["versus_corrector"]
             out[f"{name}-paired"] = f"{_signed(v)} over {v['n_cells']} paired U-chain cells"
@@ -150,17 +150,17 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             out[f"{name}-oracle"] = _paired_text(study["oracle_versus_paper"])
             out[f"{name}-runs"] = "; ".join(f"{p.split(':')[1]} {k} of {n}" for p, (k, n) in
                                             study["every_episode"].items())
-            out[f"{name}-fresh"] = _fresh_text(study["fresh"]) if study.get("fresh") else "not run yet"
+            out[f"{name}-fresh"] = fresh_text(study["fresh"]) if study.get("fresh") else "not run yet"
             if study.get("severe_zero", {}).get(study["method"], (0, 0))[1]:
                 k, n = study["severe_zero"][study["method"]]
                 out[f"{name}-severe-zero"] = f"{k} of {n}"
         if VARIANTS[name] in NEW_STUDIES:
-            out[f"{name}-new"] = _new_text(study["new"]) if study and study.get("new") else "not run yet"
-            out[f"{name}-adoption"] = _adoption_text(study) if study else "not run yet"
+            out[f"{name}-new"] = new_text(study["new"]) if study and study.get("new") else "not run yet"
+            out[f"{name}-adoption"] = adoption_text(study) if study else "not run yet"
         for part in INFORMED_PARTS.get(VARIANTS[name], ()):
-            out[f"{name}-{part}"] = _new_text(study[part]) if study and study.get(part) else "not run yet"
-    out["ant"] = _ant_text(ant) if ant else "not run yet"
-    out["unseen"] = _unseen_text(unseen(root))
+            out[f"{name}-{part}"] = new_text(study[part]) if study and study.get(part) else "not run yet"
+    out["ant"] = ant_text(ant) if ant else "not run yet"
+    out["unseen"] = unseen_text(unseen(root))
     default = default_study(root)
     out["table"] = rules_table(variants.get(reported(variants)), point, ant, default)
     out["point-default"] = default_text(default)
@@ -178,7 +178,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     return out
 
 
-def _unseen_text(sets: list[dict]) -> str:
+def unseen_text(sets: list[dict]) -> str:
     if not sets:
         return "not run yet"
     return "; ".join(f"{e['mixes']} {e['zero']} of {e['runs']}" for e in sets) + " (the oracle at least " + \
@@ -191,7 +191,7 @@ def reported(variants: dict) -> str:
                 REPORTED)
 
 
-def _ant_text(ant: dict) -> str:
+def ant_text(ant: dict) -> str:
     """The Ant's cells per maze in ANT_GRID, ANT_BEFORE and each of ANT_CANDIDATES, with their pooled differences
     from ANT_GRID."""
     def cells(per_maze):
@@ -219,7 +219,7 @@ def _levers_text(lv: dict) -> str:
         here = [e for e in lv["entries"] if e["proposer"] == proposer and e["runs"]]
         parts.append(f"{proposer.split(':')[1]}: " + ("; ".join(
             f"{e['lever']} {_num(e['success'])} ({_signed(e['versus']['ours'])} over ours, "
-            f"{_helps(e['versus']['ours'])}; {_signed(e['versus'][METHOD])} against {METHOD}, {_proposer_calls(e)})"
+            f"{helps_word(e['versus']['ours'])}; {_signed(e['versus'][METHOD])} against {METHOD}, {_proposer_calls(e)})"
             for e in here) or "not run yet"))
     return ". ".join(parts)
 
@@ -228,7 +228,7 @@ def _proposer_calls(e: dict) -> str:
     return f"{_num(e['costs']['proposer_calls_ratio'], '{:.1f}x')} the proposer calls of ours"
 
 
-def _gated_text(gs: dict) -> str:
+def gated_text(gs: dict) -> str:
     v = gs["versus_corrector"]
     costs = "; ".join(f"{c['proposer'].split(':')[1]} {_num(c['proposer_calls_ratio'], '{:.1f}x')} ({c['pairs']} pairs)"
                       for c in gs["costs"])
@@ -237,7 +237,7 @@ def _gated_text(gs: dict) -> str:
             f"{v['n_expected']} paired cells (no worse by -{NON_INFERIORITY}: {_verdict(ok, v['complete'])})")
 
 
-def _variant_text(vs: dict) -> str:
+def variant_text(vs: dict) -> str:
     """A variant against its reference, its change over rooms per preset and its proposer calls."""
     _, verdict = versus_corrector(vs)
     v, ref = vs["versus_corrector"], vs["reference"]
@@ -280,7 +280,7 @@ def _variant_text(vs: dict) -> str:
     return "; ".join(parts)
 
 
-def _new_text(new: dict) -> str:
+def new_text(new: dict) -> str:
     short = lambda m: m.removeprefix(f"{METHOD}-")  # noqa: E731
     mine, ref = short(new["method"]), short(new["reference"])
     return _layouts_text(new, f"{mine} ", f", {ref} ", f"; {mine} - {ref} ")
@@ -299,11 +299,11 @@ def _layouts_text(study: dict, first: str, second: str, paired: str) -> str:
     return text + "; runs at 0: " + ", ".join(f"{m} {z}" for m, z in study["zero"].items())
 
 
-def _adoption_text(study: dict) -> str:
+def adoption_text(study: dict) -> str:
     rows = _adoption_rows(study)
     return (f"(1) no worse on the U-chains, {rows[0]['value']} ({rows[0]['verdict']}); (2) {rows[1]['value']} "
             f"({rows[1]['verdict']}): **{rows[2]['verdict']}**")
 
 
-def _fresh_text(fresh: dict) -> str:
+def fresh_text(fresh: dict) -> str:
     return _layouts_text(fresh, "", "; at sampled points ", "; centre - sampled ")

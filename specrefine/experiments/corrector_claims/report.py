@@ -8,7 +8,7 @@ from .. import comparison as cmp
 from .ant import ANT_BEFORE, ANT_GRID, ANT_METHOD, ANT_SEEDS
 from .common import CENTRE, HELD_OUT_SEEDS, METHOD, POINT_SEEDS, POLISH, SELF_CONTAINED, VARIANTS, _known
 from .formats import _ant_paired_text, _cost_text, _diff, _num, _paired_text, _signed
-from .rules import _helps, _sided, variant_verdicts, verdicts
+from .rules import _sided, helps_word, variant_verdicts, verdicts
 
 
 def markdown(point: dict, ant: dict | None, held_out: dict | None = None, levers: dict | None = None,
@@ -136,11 +136,11 @@ def levers_markdown(lv: dict) -> list[str]:
              "|---|---|---|---|---|---|---|---|---|"]
     for e in lv["entries"]:
         v = e["versus"]
-        repair = f"{_signed(v['ours-repair'])} {_helps(v['ours-repair'])}" if "ours-repair" in v else "—"
+        repair = f"{_signed(v['ours-repair'])} {helps_word(v['ours-repair'])}" if "ours-repair" in v else "—"
         lines.append(f"| {e['proposer']} | {e['lever']} | {e['runs']} | {_num(e['success'])} | "
-                     f"{_signed(v['ours'])} {_helps(v['ours'])} | {repair} | {_signed(v[METHOD])} {_sided(v[METHOD])}"
-                     f" | {_num(e['costs']['proposer_calls_ratio'], '{:.2f}x')} | {e['same']['ours']} / "
-                     f"{e['same'][METHOD]} |")
+                     f"{_signed(v['ours'])} {helps_word(v['ours'])} | {repair} | {_signed(v[METHOD])} "
+                     f"{_sided(v[METHOD])} | {_num(e['costs']['proposer_calls_ratio'], '{:.2f}x')} | "
+                     f"{e['same']['ours']} / {e['same'][METHOD]} |")
     return lines
 
 

@@ -105,7 +105,7 @@ def _verdict(ok: bool, complete: bool) -> str:
     return ("holds" if ok else "does not hold") + ("" if complete else " (partial)")
 
 
-def _helps(entry: dict) -> str:
+def helps_word(entry: dict) -> str:
     """The lever-alone rule's word for a paired difference against the method without it."""
     word = {"higher": "helps", "lower": "hurts"}.get(entry["verdict"], "undecided")
     return word + ("" if entry["complete"] else f" (partial: {entry['n_cells']} of {entry['n_expected']} cells)")
