@@ -993,12 +993,12 @@ def test_the_ants_fresh_layouts_are_described_cell_by_cell_with_the_paired_diffe
     assert ant_fresh.front_text(None) == "no cell yet"
 
 
-def lay_default(root, deep_rate, seeds=None):
-    """Grid corrector-deep-oracle's table under ``root``: ours at 0.99 with the oracle, deep at deep_rate(maze)."""
-    g = GRIDS["corrector-deep-oracle"]
+def lay_default(root, deep_rate, seeds=None, grid="corrector-deep-oracle", method=cc.DEEP):
+    """A default grid's table under ``root``: ours at 0.99 with the oracle, ``method`` at deep_rate(maze)."""
+    g = GRIDS[grid]
     rows = [row(maze, m, 0.99 if m == "ours" else deep_rate(maze), s, "geometric")
             | {"proposer_calls": 4 if m == "ours" else 6, "evaluations": 10 if m == "ours" else 30, "sim_steps": 100}
-            for maze in g.mazes for m in (cc.DEEP, "ours") for s in (seeds or g.seeds)]
+            for maze in g.mazes for m in (method, "ours") for s in (seeds or g.seeds)]
     (root / g.table).parent.mkdir(parents=True, exist_ok=True)
     write_csv(root / g.table, rows)
 
@@ -1017,6 +1017,21 @@ def test_deep_becomes_the_points_default_only_if_below_ours_with_the_oracle_on_n
     assert d["costs"]["proposer_calls_ratio"] == pytest.approx(1.5)
     assert d["costs"]["evaluations_ratio"] == pytest.approx(3.0)
     assert default_text(d).endswith(f"1.50x the proposer calls and 3.00x the evaluations of ours: {verdict}")
+
+
+def test_mend_meets_deeps_default_rule_on_its_own_oracle_grid_and_fills_its_own_marker(tmp_path):
+    from specrefine.experiments.corrector_claims.default import default_marker, default_studies, default_verdict
+
+    lay_default(tmp_path, lambda maze: 0.99)
+    assert [d["method"] for d in default_studies(tmp_path)] == [cc.DEEP]  # mend's grid has no row yet
+    lay_default(tmp_path, lambda maze: 0.9 if maze == "u_maze" else 0.99, grid="corrector-mend-oracle",
+                method=cc.MEND)
+    deep, mend = default_studies(tmp_path)
+    assert (deep["method"], mend["method"], mend["grid"]) == (cc.DEEP, cc.MEND, "corrector-mend-oracle")
+    assert default_verdict(deep)["verdict"] == "adopted" and mend["below"] == ["u_maze"]
+    assert default_verdict(mend)["verdict"] == "not adopted (below on no maze missed)"
+    assert default_verdict(mend)["rule"].startswith(f"point, the oracle: {cc.MEND} as --preset best's method")
+    assert (default_marker(cc.DEEP), default_marker(cc.MEND)) == ("point-default", "point-default-mend")
 
 
 def test_the_points_default_is_undecided_until_every_paired_cell_ran(tmp_path):

@@ -1,6 +1,6 @@
 """The point mass's default method (docs/corrector.md, "The point mass's default method: deep with the oracle"):
-ours-corrector-deep against ours with the oracle on the 17 suite mazes, and the rule that makes deep the point's
-``--preset best`` method."""
+a corrector against ours with the oracle on the 17 suite mazes, and the rule that makes it the point's ``--preset
+best`` method: ours-corrector-deep (grid corrector-deep-oracle), then ours-corrector-mend (corrector-mend-oracle)."""
 
 from __future__ import annotations
 
@@ -13,30 +13,42 @@ from .common import DEEP, MEND, costs, episodes_of, load, per_maze, zero_runs
 from .formats import _ant_paired_text, _diff, _num
 
 GRID = "corrector-deep-oracle"
+MEND_ORACLE_GRID = "corrector-mend-oracle"
+DEFAULTS = ((GRID, DEEP), (MEND_ORACLE_GRID, MEND))  # each candidate's oracle grid, in the order they were adopted
 PROPOSER = "geometric"
 MARGIN = 0.01  # the pooled difference's lower end at or above -MARGIN
 
 
-def default_study(root: Path = ROOT) -> dict | None:
-    """Deep and ours with the oracle per maze, pooled over the paired cells, runs at 0 and deep's cost over ours's;
-    None before the grid's first row."""
+def default_study(root: Path = ROOT, grid: str = GRID, method: str = DEEP) -> dict | None:
+    """``method`` and ours with the oracle per maze (grid ``grid``), pooled over the paired cells, runs at 0 and the
+    method's cost over ours's; None before the grid's first row."""
     from ..levers import lever_check
 
-    g = GRIDS[GRID]
+    g = GRIDS[grid]
     rows = load(g.tables, root)
     if not rows:
         return None
     by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m and r["proposer"] == PROPOSER
-              and cmp.is_done(r)} for m in (DEEP, "ours")}
-    paired = lever_check(by[DEEP], by["ours"], [(m, s) for m in g.mazes for s in g.seeds])
-    entries = per_maze(rows, PROPOSER, g.mazes, g.seeds, reference=("ours", "*"), method=DEEP)
+              and cmp.is_done(r)} for m in (method, "ours")}
+    paired = lever_check(by[method], by["ours"], [(m, s) for m in g.mazes for s in g.seeds])
+    entries = per_maze(rows, PROPOSER, g.mazes, g.seeds, reference=("ours", "*"), method=method)
     below = [e["maze"] for e in entries if "ci_high" in e and e["ci_high"] < 0]
     holds = {"below on no maze": not below, f"pooled lower end >= -{MARGIN}": paired["cells"] > 0
              and paired["ci"][0] >= -MARGIN}
-    return {"grid": GRID, "method": DEEP, "per_maze": entries, "paired": paired, "below": below, "parts": holds,
+    return {"grid": grid, "method": method, "per_maze": entries, "paired": paired, "below": below, "parts": holds,
             "adopted": paired["complete"] and all(holds.values()),
-            "zero": {m: zero_runs(rows, m, PROPOSER, g.mazes) for m in (DEEP, "ours")},
-            "costs": costs(rows, PROPOSER, g.mazes, g.seeds, first=DEEP)}
+            "zero": {m: zero_runs(rows, m, PROPOSER, g.mazes) for m in (method, "ours")},
+            "costs": costs(rows, PROPOSER, g.mazes, g.seeds, first=method)}
+
+
+def default_studies(root: Path = ROOT) -> list[dict]:
+    """``default_study`` of each candidate in ``DEFAULTS`` whose grid has a row."""
+    return [d for grid, method in DEFAULTS if (d := default_study(root, grid, method))]
+
+
+def default_marker(method: str) -> str:
+    """README's marker for a candidate's passage: ``point-default`` for deep, the first, then by name."""
+    return "point-default" if method == DEFAULTS[0][1] else f"point-default-{method.rsplit('-', 1)[1]}"
 
 
 def default_verdict(d: dict) -> dict:

@@ -29,7 +29,7 @@ from .common import (
     _below_ours,
     _known,
 )
-from .default import default_study, default_text, default_verdict, gr_study, gr_text
+from .default import DEFAULTS, default_marker, default_studies, default_text, default_verdict, gr_study, gr_text
 from .formats import _ant_paired_text, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
@@ -65,9 +65,9 @@ def fill(path: Path, texts: dict[str, str]) -> None:
         write_atomic(path, MARKER.sub(text, source))
 
 
-def rules_table(variant: dict | None, point: dict, ant: dict | None, default: dict | None = None) -> str:
+def rules_table(variant: dict | None, point: dict, ant: dict | None, defaults: list[dict] = ()) -> str:
     """Issue 39's rules for the reported variant, the held-out cells it is described on, the point mass's default
-    method (``default_study``) and the Ant's rules, as one markdown table (README's front page)."""
+    methods (``default_studies``) and the Ant's rules, as one markdown table (README's front page)."""
     if not variant:
         return "not run yet"
     method = variant["method"]
@@ -75,7 +75,7 @@ def rules_table(variant: dict | None, point: dict, ant: dict | None, default: di
     order = [v for v in rows if "cost at most" not in v["rule"] and not v["rule"].startswith(method)]
     order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
     order += [row for mix in MIX_NAMES.values() if (row := _held_out_row(variant, mix))]
-    order += [default_verdict(default)] if default else []
+    order += [default_verdict(d) for d in defaults]
     order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
     table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
     table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
@@ -107,9 +107,11 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
-          ant: dict | None = None, fresh: dict | None = None, **variants: dict | None) -> dict[str, str]:
+          ant: dict | None = None, fresh: dict | None = None, defaults: list[dict] | None = None,
+          gr: dict | None = None, **variants: dict | None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
-    their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s)."""
+    their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s; ``defaults`` and ``gr``: ``default_studies``'s and
+    ``gr_study``'s, computed here when not given)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
@@ -161,10 +163,11 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
             out[f"{name}-{part}"] = new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = ant_text(ant) if ant else "not run yet"
     out["unseen"] = unseen_text(unseen(root))
-    default = default_study(root)
-    out["table"] = rules_table(variants.get(reported(variants)), point, ant, default)
-    out["point-default"] = default_text(default)
-    out["point-default-gr"] = gr_text(gr_study(root))
+    defaults = default_studies(root) if defaults is None else defaults
+    out["table"] = rules_table(variants.get(reported(variants)), point, ant, defaults)
+    for _, method in DEFAULTS:
+        out[default_marker(method)] = default_text(next((d for d in defaults if d["method"] == method), None))
+    out["point-default-gr"] = gr_text(gr_study(root) if gr is None else gr)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
