@@ -812,13 +812,13 @@ def checked_last(tmp_path, short, grid, dead_maze, names):
     at 0, where its reference dies on ``dead_maze`` only (4 runs: two mixes, two seeds) and the variant nowhere."""
     variant = cc.VARIANTS[short]
     reference = cc.reference_of(variant)
-    assert cc.INFORMED_PARTS[variant] == ("informed", "check")  # README's markers NAME-informed, NAME-check
+    assert cc.INFORMED_PARTS[variant][-1] == "check"  # README's marker NAME-check (after NAME-informed, if any)
     assert cc.variant_studies(tmp_path)[short]["check"] is None  # its last check not laid yet
     lay_all_parts(tmp_path, grid, lambda maze, m, p: 0.0 if m == reference and cc.table_name(maze) == dead_maze
                   else 1.0)
     check = cc.variant_studies(tmp_path)[short]["check"]
-    assert check["names"] == names and check["zero"] == {variant: 0, reference: 4, "ours": 0}
-    assert check["grid"] == grid and check["runs"] == 16
+    assert check["names"] == names and check["zero"] == {variant: 0, reference: 2 * len(names), "ours": 0}
+    assert check["grid"] == grid and check["runs"] == 8 * len(names)  # four layouts, two seeds per mix
 
 
 def judged_after_its_reference(tmp_path, short, rate, laid, informed, new_grid, new, adoption_zero):
@@ -1094,3 +1094,5 @@ def test_mend_holds_its_second_part_with_no_more_runs_below_0_9_than_deep_not_fe
     assert a["adopted"] == (adopted and studies["deep"]["adoption"]["adopted"])  # only where deep is
     second = next(v for v in cc.variant_verdicts(vs) if "adoption 2" in v["rule"])
     assert second["rule"].startswith("ours-corrector-mend, adoption 2: no more runs below 0.9 than ours-corrector-deep")
+    if not weak_cell:  # its last check, made after its adoption: four mixes, each one kind of error at its extreme
+        checked_last(tmp_path, "mend", "corrector-mend-check", "random:15x8:29", ["AN", "AO", "AP", "AQ"])

@@ -458,6 +458,20 @@ MEND_MIXES = ("imperfect:position_sigma=0.4,coord_grid=0.25,radius=0.25,radius_l
               "p_drop_turn=0.5,p_false_opening=0.4,p_wrong_branch=0.35,p_uncapped=0.7,p_unparseable=0.05,"
               "alpha=0.5,rho=0.6")
 
+#: layouts and error mixes no run had used before grid corrector-mend-check (docs/corrector.md, "A last check of mend:
+#: error kinds at their extremes"), made after mend's grids had been looked at: four larger generated mazes (sizes
+#: chosen, seeds drawn by random.Random(202612051)), and four mixes, each one kind of error at its extreme over light
+#: noise, where every mix before mixed all kinds at middling rates: AN (mirrored and unparseable replies), AO (tiny
+#: regions pulled hard into corners), AP (hallucinated routes: most turns dropped, false openings, wrong branches,
+#: errors growing with the turns a query spans) and AQ (coarse: offsets of 0.6 cell rounded to whole cells, region
+#: sizes spread wide, every leg uncapped, feedback never used)
+MEND_CHECK_MAZES = ("random:14x9:33", "random:9x14:57", "random:12x12:61", "random:15x8:29")
+MEND_CHECK_MIXES = ("imperfect:position_sigma=0.15,p_mirror_y=0.5,p_unparseable=0.4,rho=0.5",
+                    "imperfect:position_sigma=0.2,coord_grid=0.1,radius=0.15,radius_log_sigma=0.3,corner_pull=0.8",
+                    "imperfect:position_sigma=0.2,p_drop_turn=0.7,p_false_opening=0.7,p_wrong_branch=0.8,alpha=0.3,"
+                    "rho=0.6",
+                    "imperfect:position_sigma=0.6,coord_grid=1.0,radius_log_sigma=0.8,p_uncapped=1.0,rho=0.0")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -952,6 +966,10 @@ GRIDS = {g.name: g for g in (
                           informed=Part(("ours-corrector-mend",), GR_MIXES, mazes=GR_MAZES, split="proposers",
                                         table="data/results/corrector/mend_gr.csv", out="gr"),
                           fixed="2026-12-05"),
+    # docs/corrector.md, "A last check of mend: error kinds at their extremes" (fixed 2026-12-05, before it ran)
+    new_layouts_grid("corrector-mend-check", "docs/corrector.md, 'A last check of mend' (issue 39; fixed 2026-12-05 "
+                     "before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
+                     MEND_CHECK_MAZES, MEND_CHECK_MIXES, "mend_check", code=MEND_CODE),
     ExperimentGrid("corrector-mend-oracle", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
                    "2026-12-05 before it ran): ours-corrector-mend and ours with the oracle on the 17 suite mazes",
                    "point", parts=(Part(("ours-corrector-mend", "ours"), ("geometric",), split="seeds"),),

@@ -29,6 +29,8 @@ from ..grids import (
     KEEP_MIXES,
     MEMORY_MAZES,
     MEMORY_MIXES,
+    MEND_CHECK_MAZES,
+    MEND_CHECK_MIXES,
     MEND_MAZES,
     MEND_MIXES,
     NEW_MAZES,
@@ -90,17 +92,18 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                PROBE: ("corrector-probe-new", PROBE_MAZES, PROBE_MIXES, ("AC", "AD")),
                DEEP: ("corrector-deep-new", DEEP_MAZES, DEEP_MIXES, ("AE", "AF")),
                "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH")),
-               MEND: ("corrector-mend-new", MEND_MAZES, MEND_MIXES, ("AL", "AM"))}  # as made
+               MEND: ("corrector-mend-new", MEND_MAZES, MEND_MIXES, ("AL", "AM")),
+               "mend-check": ("corrector-mend-check", MEND_CHECK_MAZES, MEND_CHECK_MIXES, ("AN", "AO", "AP", "AQ"))}
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
-LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check"}
+LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check", MEND: "mend-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
                DEEP: PROBE}
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
-INFORMED_PARTS = {m: ("informed", "check") if m in LAST_CHECK or m == SNAP else ("informed",)
-                  for m in (SNAP, *INFORMED_ON)}
+INFORMED_PARTS = {m: ("informed",) * (m in INFORMED_ON or m == SNAP) + ("check",) * (m in LAST_CHECK or m == SNAP)
+                  for m in (SNAP, *INFORMED_ON, *LAST_CHECK)}
 
 
 def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: str | None = None) -> dict | None:
