@@ -966,7 +966,7 @@ GRIDS = {g.name: g for g in (
                           informed=Part(("ours-corrector-mend",), GR_MIXES, mazes=GR_MAZES, split="proposers",
                                         table="data/results/corrector/mend_gr.csv", out="gr"),
                           fixed="2026-12-05"),
-    # docs/corrector.md, "A last check of mend: error kinds at their extremes" (fixed 2026-12-05, before it ran)
+    # docs/corrector.md, "A last check of mend: error kinds at their extremes" (fixed 2026-12-05 12:29 UTC)
     new_layouts_grid("corrector-mend-check", "docs/corrector.md, 'A last check of mend' (issue 39; fixed 2026-12-05 "
                      "before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
                      MEND_CHECK_MAZES, MEND_CHECK_MIXES, "mend_check", code=MEND_CODE),
