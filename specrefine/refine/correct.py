@@ -369,8 +369,7 @@ class _State:
                     entry["nearer"] = gain
         if wins and self.second is not None and current > 0.0:  # a dead window's advance is judged by ground won
             wins, here, there = self.crosschecked(best[1], best[2], s, e)
-            tried[next(i for i, option in enumerate(judged) if option is best)] |= {
-                "p_window_second": there, "p_current_second": here}
+            _entry(tried, judged, best).update(p_window_second=there, p_current_second=here)
         if wins:
             before = (self.graph, self.path, self.check, self.second)
             second_start = self.start_of_leg(s, self.second) if self.second is not None else None
@@ -379,8 +378,7 @@ class _State:
             if self.second is not None:
                 self.second = self._checked_from(s, self.second, second_start, self.second_seed)
             if self.guard and self.score(self.check) < self.score(check):  # the path lost what its window won
-                tried[next(i for i, option in enumerate(judged) if option is best)] |= {
-                    "p_path": self.check.p, "p_path_before": check.p, "reverted": True}
+                _entry(tried, judged, best).update(p_path=self.check.p, p_path_before=check.p, reverted=True)
                 self.graph, self.path, self.check, self.second = before
                 wins = False
         return Judged(current, tried), best[0] if wins else None
@@ -389,6 +387,11 @@ class _State:
         """``check``'s legs before leg ``s``, and the (new) path's legs from there estimated again from ``start``."""
         rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=seed, start=start)
         return Check(results=check.results[:s] + rest.results, path=list(self.path))
+
+
+def _entry(tried: list[dict], judged: list, option) -> dict:
+    """The steps-log entry of ``option``, one of ``judged`` (by identity: two options' checks may compare equal)."""
+    return tried[next(i for i, o in enumerate(judged) if o is option)]
 
 
 def _furthest(graph: TaskGraph, path: list[str], leg: int, s: int, judged: list) -> tuple[tuple | None, list]:
