@@ -11,7 +11,7 @@ from ...core.results import wilson_ci
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT, SCALING_MAZES
-from .common import METHOD, NON_INFERIORITY, as_ours, costs, episodes_of, load, zero_runs
+from .common import METHOD, NON_INFERIORITY, as_ours, costs, episodes_of, load, paired_rows, zero_runs
 
 ANT_FLOOR = 0.85
 #: the Ant's rules read this grid and its method (docs/corrector.md, "The Ant with a confirmed pick")
@@ -159,8 +159,4 @@ def _ant_paired(first: tuple[str, str], second: tuple[str, str], root: Path) -> 
 
 def _ant_paired_rows(rows: list[dict], first: str, second: str) -> dict:
     """``first`` - ``second`` (methods) pooled over the Ant's cells both finished in ``rows``."""
-    from ..levers import lever_check
-
-    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m and cmp.is_done(r)}
-          for m in (first, second)}
-    return lever_check(by[first], by[second], [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])
+    return paired_rows(rows, first, second, [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS])

@@ -162,6 +162,19 @@ def paired_across(cells, failed, proposers, first, second, seeds, mazes) -> dict
                                  [f"{maze} {p}" for p in proposers for maze in mazes])
 
 
+def paired_rows(rows: list[dict], first: str, second: str, cells: list[tuple], proposer: str | None = None) -> dict:
+    """``first`` - ``second`` (methods) pooled over the finished ``cells`` of ``rows`` both ran
+    (``levers.lever_check``): cells (maze, seed) of ``proposer``'s rows (None: every row), or (maze, proposer, seed)."""
+    from ..levers import lever_check
+
+    def key(r):
+        return (r["maze"], r["proposer"], int(r["seed"])) if len(cells[0]) == 3 else (r["maze"], int(r["seed"]))
+
+    by = {m: {key(r): r for r in rows if r["method"] == m and proposer in (None, r["proposer"]) and cmp.is_done(r)}
+          for m in (first, second)}
+    return lever_check(by[first], by[second], cells)
+
+
 def named(rows: list[dict], method: str) -> list[dict]:
     """A variant's grid rows under the variant's name (``VARIANT_RUNS``: a grid that runs a method by another)."""
     runs = VARIANT_RUNS.get(method, method)

@@ -7,9 +7,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .. import comparison as cmp
 from ..grids import GR_MIXES, GRIDS, ROOT
-from .common import DEEP, MEND, costs, episodes_of, load, per_maze, zero_runs
+from .common import DEEP, MEND, costs, episodes_of, load, paired_rows, per_maze, zero_runs
 from .formats import _ant_paired_text, _diff, _num
 
 GRID = "corrector-deep-oracle"
@@ -22,15 +21,11 @@ MARGIN = 0.01  # the pooled difference's lower end at or above -MARGIN
 def default_study(root: Path = ROOT, grid: str = GRID, method: str = DEEP) -> dict | None:
     """``method`` and ours with the oracle per maze (grid ``grid``), pooled over the paired cells, runs at 0 and the
     method's cost over ours's; None before the grid's first row."""
-    from ..levers import lever_check
-
     g = GRIDS[grid]
     rows = load(g.tables, root)
     if not rows:
         return None
-    by = {m: {(r["maze"], int(r["seed"])): r for r in rows if r["method"] == m and r["proposer"] == PROPOSER
-              and cmp.is_done(r)} for m in (method, "ours")}
-    paired = lever_check(by[method], by["ours"], [(m, s) for m in g.mazes for s in g.seeds])
+    paired = paired_rows(rows, method, "ours", [(m, s) for m in g.mazes for s in g.seeds], proposer=PROPOSER)
     entries = per_maze(rows, PROPOSER, g.mazes, g.seeds, reference=("ours", "*"), method=method)
     below = [e["maze"] for e in entries if "ci_high" in e and e["ci_high"] < 0]
     holds = {"below on no maze": not below, f"pooled lower end >= -{MARGIN}": paired["cells"] > 0
@@ -101,8 +96,6 @@ def gr_study(root: Path = ROOT) -> dict | None:
     """Described (docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps"): deep beside ours and
     the oracle per map and proposer, runs at 0, deep - ours pooled over the cells both ran, deep's cost over ours's;
     None before the grid's first row of deep."""
-    from ..levers import lever_check
-
     g = GRIDS[GR_GRID]
     rows = load(g.tables + (GRIDS[MEND_GRID].part_table(0),), root)  # mend on these cells: its grid's first part
     if not any(r["method"] == DEEP for r in rows):
@@ -115,10 +108,8 @@ def gr_study(root: Path = ROOT) -> dict | None:
             km, nm, rm = episodes_of(rows, e["maze"], MEND, mix, g.seeds)
             entries.append(e | {"mix": name, "oracle": k / n if n else math.nan,
                                 "mend": km / nm if nm else math.nan, "mend_runs": rm})
-    by = {m: {(r["maze"], r["proposer"], int(r["seed"])): r for r in rows if r["method"] == m and cmp.is_done(r)}
-          for m in (DEEP, "ours")}
     cells = [(m, p, s) for p in GR_MIXES for m in g.mazes for s in g.seeds]
-    return {"grid": GR_GRID, "per_maze": entries, "paired": lever_check(by[DEEP], by["ours"], cells),
+    return {"grid": GR_GRID, "per_maze": entries, "paired": paired_rows(rows, DEEP, "ours", cells),
             "zero": {m: sum(zero_runs(rows, m, mix, g.mazes)[0] for mix in GR_MIXES) for m in (DEEP, "ours")},
             "mend_runs": sum(e["mend_runs"] for e in entries),
             "runs": sum(e["runs"] for e in entries),
