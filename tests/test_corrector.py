@@ -20,7 +20,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import DEEP, GUARD, MEND, get_method
+from specrefine.runs.methods import BRIDGE, DEEP, GUARD, MEND, get_method
 
 
 class LegTable:
@@ -787,6 +787,37 @@ def test_mending_needs_the_roadmap_and_a_level_in_0_1():
     with pytest.raises(ValueError, match="roadmap_weak must lie in"):
         SearchConfig(roadmap_weak=1.5, correct_roadmap=True, correct_reach=3.0)
     assert MEND == {"roadmap_weak": 0.9} and get_method("ours-corrector-mend").name == "ours-corrector-mend"
+
+
+# --- a weak leg bridged from the leg before (SearchConfig.roadmap_bridge): method ours-corrector-bridge ------------
+#: as WEAK_LEG, but every leg out of 3 fails half its rollouts (the way into 3 spoils what follows): no chain from 3
+#: is sound, while 2.5, pooled from the split over 6, leads from S to 6 on sound legs
+ENTERED_BADLY = WEAK_LEG | {(3.0, 5.0): 0.5, (3.0, 2.5): 0.5}
+BADLY_REPLIES = WEAK_REPLIES | {(3.0, 10.0): [2.5, 5, 8]}
+
+
+@pytest.mark.parametrize("bridge", [False, True])
+def test_a_weak_leg_no_chain_from_its_start_mends_is_bridged_from_the_leg_before(bridge):
+    book = AnswerBook(BADLY_REPLIES)
+    g, result = run(LegTable(ENTERED_BADLY, ENTERED_BADLY), book, roadmap_weak=0.9, roadmap_bridge=bridge, **MENDED)
+    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
+    kinds = [t["kind"] for t in legs[0]["tried"]]
+    assert set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 10.0)}  # no proposer call more either way
+    mended = [s for s in result.steps if s["event"] == "roadmap" and s["edge"] == ["x0", "x1"]]
+    assert mended and not mended[0]["reaches_end"]  # mend's chain from 3 reaches no further on sound legs
+    if bridge:
+        assert kinds == ["split", "resplit", "bridge"] and legs[0]["accepted"] == "bridge"
+        assert xs(result) == [0.0, 2.5, 6.0, 10.0] and check_refines(result.graph, g) == []
+        assert result.predicted_success == pytest.approx(1.0)
+    else:
+        assert kinds == ["split", "resplit"] and legs[0]["accepted"] is None
+        assert xs(result) == [0.0, 3.0, 6.0, 10.0]
+
+
+def test_bridging_needs_mending():
+    with pytest.raises(ValueError, match="roadmap_bridge needs roadmap_weak"):
+        SearchConfig(roadmap_bridge=True, correct_roadmap=True, correct_reach=3.0)
+    assert BRIDGE == {"roadmap_bridge": True} and get_method("ours-corrector-bridge").name == "ours-corrector-bridge"
 
 
 # --- a window's win checked on the whole path (SearchConfig.correct_guard): method ours-corrector-guard ------------

@@ -63,6 +63,12 @@ least that sound, so that the weak leg itself does not count as reaching its end
 a dead leg of a dead path, and a live leg the proposer cannot mend stays as it is (docs/corrector.md, "Weak legs
 mended on the roadmap").
 
+``roadmap_bridge`` (method ``ours-corrector-bridge``): where mend's chain is offered, the weak leg is also offered,
+last, the roadmap's chain from the leg before it to its end, on legs as sound, replacing the waypoint between them.
+A leg that fails because of how it is entered (the body arrives at its start too fast, or aimed into the turn) fails
+from every node near its start, so no chain from there is sound; a chain that starts one waypoint earlier can enter
+the turn another way (docs/corrector.md, "Bridged from the leg before").
+
 ``guard`` (method ``ours-corrector-guard``): a win on the window is kept only if the whole path, checked again from the
 window on, scores no lower than before. The window is the changed legs and the one after them, but the legs further on
 start from the new legs' end states: a split that wins its window can leave the next weak leg downstream worse, and
@@ -196,7 +202,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
             crosscheck: bool = False, roadmap_weak: float = 0.0,
-            guard: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            guard: bool = False, bridge: bool = False) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -211,7 +217,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     the point a re-aimed waypoint of that region aims at; ``crosscheck``: a win is taken only if it also wins on a
     second draw (module doc); ``roadmap_weak``: a live leg whose fresh success is below it is offered the roadmap's
     chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
-    kept only if the path checked again from the window on scores no lower than before (module doc)."""
+    kept only if the path checked again from the window on scores no lower than before (module doc); ``bridge``: such a
+    leg is also offered the chain from the leg before it (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
                    guard=guard)
@@ -224,7 +231,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim, roadmap_weak)
+                               reaim, roadmap_weak, bridge)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -244,12 +251,13 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
                   may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
-                  roadmap: Callable | None = None, reaim: Callable | None = None, roadmap_weak: float = 0.0):
+                  roadmap: Callable | None = None, reaim: Callable | None = None, roadmap_weak: float = 0.0,
+                  bridge: bool = False):
     """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses and,
     given ``reaim``, its waypoints re-aimed (no proposer call), then, for a dead leg of a dead path given ``roadmap``,
     the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
-    Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end. Lazy: a
-    split is asked for only when its group is reached."""
+    Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end (and given
+    ``bridge``, from the leg before it). Lazy: a split is asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
     if reaim is not None:
@@ -260,6 +268,9 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
         yield [option for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak)
                if option[0] == "roadmap"]
+        if bridge and leg > 0:
+            yield [("bridge", *option[1:]) for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak,
+                                                                          back=1) if option[0] == "roadmap"]
 
 
 def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable, may_split: Callable[[], bool],
@@ -291,17 +302,19 @@ def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Cal
             yield options
 
 
-def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None) -> list:
-    """The pooled waypoints' chain for ``leg`` (``sound``: on legs at least that sound only): the whole leg
-    ("roadmap") where it reaches the leg's end, else its live part ("advance"); none where it reaches no waypoint."""
-    graph, path = state.graph, state.path
-    start = state.start_of_leg(leg)
+def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None, back: int = 0) -> list:
+    """The pooled waypoints' chain for ``leg`` (``sound``: on legs at least that sound only; ``back``: from the start
+    of the leg that many before it, replacing the waypoints between): the whole span ("roadmap") where it reaches the
+    leg's end, else its live part ("advance"); none where it reaches no waypoint."""
+    graph, path, first = state.graph, state.path, leg - back
+    start = state.start_of_leg(first)
     if start is None:
         return []
-    found = roadmap(graph, path[leg], path[leg + 1], start, **({"sound": sound} if sound is not None else {}))
+    found = roadmap(*_with_edge(graph, path, first, leg + 1), path[first], path[leg + 1], start,
+                    **({"sound": sound} if sound is not None else {}))
     if not found.waypoints:
         return []
-    return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, leg, leg + 1, found.waypoints))]
+    return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, first, leg + 1, found.waypoints))]
 
 
 @dataclass

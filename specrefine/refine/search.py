@@ -119,6 +119,8 @@ class SearchConfig:
     roadmap_weak: float = 0.0  # beyond the paper: a live leg whose fresh success is below this is also offered the
     #                            roadmap's chain, after the proposer's alternatives and whatever budget is left (0:
     #                            dead legs of dead paths only; correct.py; method ours-corrector-mend)
+    roadmap_bridge: bool = False  # beyond the paper: such a weak leg is also offered the chain from the leg before it
+    #                               (correct.py; method ours-corrector-bridge)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -138,6 +140,8 @@ class SearchConfig:
         if self.correct_roadmap and not (self.correct_reach and self.correct_reach > 0):
             raise ValueError("correct_roadmap needs correct_reach > 0 (the longest leg its chain may try; methods "
                              "give 'policy', the agent's goal range)")
+        if self.roadmap_bridge and not self.roadmap_weak:
+            raise ValueError("roadmap_bridge needs roadmap_weak > 0 (it bridges the weak legs mend offers its chain)")
         for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe", "roadmap_weak"):
             if getattr(self, name) and not self.correct_roadmap:
                 raise ValueError(f"{name} needs correct_roadmap (it changes the roadmap's searches)")
@@ -598,6 +602,7 @@ class RefinementSearch:
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
                                       roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
+                                      bridge=self.cfg.roadmap_bridge,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
                                       crosscheck=self.cfg.correct_crosscheck)
         return path, check

@@ -350,6 +350,14 @@ register_method("ours-corrector-mend",
                 "beyond the paper: ours-corrector-deep whose correction also offers a live leg that fails on more "
                 "than a tenth of its fresh rollouts the roadmap's chain to its end (the pooled waypoints and probes, "
                 "no proposer call), after the proposer's alternatives and whatever budget they left", colour="#7b1fa2")
+#: ours-corrector-bridge: mend, whose weak leg is also offered the roadmap's chain from the leg before it
+#: (docs/corrector.md, "Bridged from the leg before")
+BRIDGE = dict(roadmap_bridge=True)
+register_method("ours-corrector-bridge",
+                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND | BRIDGE),
+                "beyond the paper: ours-corrector-mend whose weak leg is also offered, last, the roadmap's chain from "
+                "the start of the leg before it to its end on legs as sound, replacing the waypoint between them: a "
+                "leg that fails because of how it is entered fails from every node near its start", colour="#8e24aa")
 #: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
 #: lower (docs/corrector.md, "A window's win checked on the whole path")
 GUARD = dict(correct_guard=True)
