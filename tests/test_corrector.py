@@ -20,7 +20,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import BRIDGE, DEEP, GUARD, MEND, get_method
+from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, GUARD, MEND, get_method
 
 
 class LegTable:
@@ -818,6 +818,36 @@ def test_bridging_needs_mending():
     with pytest.raises(ValueError, match="roadmap_bridge needs roadmap_weak"):
         SearchConfig(roadmap_bridge=True, correct_roadmap=True, correct_reach=3.0)
     assert BRIDGE == {"roadmap_bridge": True} and get_method("ours-corrector-bridge").name == "ours-corrector-bridge"
+
+
+# --- ground given back (SearchConfig.roadmap_backtrack): method ours-corrector-backtrack -----------------------------
+#: S -> G is answered 4, 8: 8 lies nearest G but in a pocket (no leg out of 8 succeeds: to G, to 4, to 6, the reply
+#: to 8 -> G). Pooled, 6 leads from 4 to G, which the chain from S finds and no chain from 8 can
+POCKET = {(0.0, 10.0): 0.0, (8.0, 10.0): 0.0, (8.0, 6.0): 0.0, (8.0, 4.0): 0.0}
+POCKET_REPLIES = {(0.0, 10.0): [[4, 8]], (8.0, 10.0): [[6]]}
+BACKED = dict(correct_rollouts=4, correct_while_dead=True, correct_advance=True, correct_reach=4.5,
+              correct_roadmap=True, max_edge_splits=8)
+
+
+@pytest.mark.parametrize("backtrack", [False, True])
+def test_a_dead_leg_in_a_pocket_is_rerouted_from_the_paths_start(backtrack):
+    g, result = run(LegTable(POCKET), EdgeQueue(POCKET_REPLIES), roadmap_backtrack=backtrack, **BACKED)
+    legs = [s for s in result.steps if s["event"] == "correct-leg"]
+    assert legs[0]["accepted"] == "advance" and legs[0]["edge"] == ["S", "G"]  # ground won: S -> 4 -> 8
+    if backtrack:
+        assert any(s["accepted"] == "backtrack" for s in legs)
+        assert xs(result) == [0.0, 4.0, 6.0, 10.0] and check_refines(result.graph, g) == []
+        assert result.predicted_success == pytest.approx(1.0)
+    else:  # every later search starts in the pocket
+        assert xs(result) == [0.0, 4.0, 8.0, 10.0] and result.predicted_success == 0.0
+        assert all(t["kind"] != "backtrack" for s in legs for t in s["tried"])
+
+
+def test_backtracking_needs_the_roadmap():
+    with pytest.raises(ValueError, match="roadmap_backtrack needs correct_roadmap"):
+        SearchConfig(roadmap_backtrack=True)
+    assert BACKTRACK == {"roadmap_backtrack": True}
+    assert get_method("ours-corrector-backtrack").name == "ours-corrector-backtrack"
 
 
 # --- a window's win checked on the whole path (SearchConfig.correct_guard): method ours-corrector-guard ------------

@@ -69,6 +69,13 @@ A leg that fails because of how it is entered (the body arrives at its start too
 from every node near its start, so no chain from there is sound; a chain that starts one waypoint earlier can enter
 the turn another way (docs/corrector.md, "Bridged from the leg before").
 
+``backtrack`` (method ``ours-corrector-backtrack``): a dead leg of a dead path whose alternatives all lose is also
+offered, last, the roadmap's chain from the path's start to the dead leg's end. Ground won while the path is dead is
+never given back otherwise: where the waypoints nearest the goal lie in a pocket walled off from it (a proposer that
+takes the wrong branch, or sees an opening that is not there), every later search starts in the pocket, and the
+correction spends its budget there. The chain from the start, over everything pooled and with the start's remembered
+tree, may go round (docs/corrector.md, "Ground given back").
+
 ``guard`` (method ``ours-corrector-guard``): a win on the window is kept only if the whole path, checked again from the
 window on, scores no lower than before. The window is the changed legs and the one after them, but the legs further on
 start from the new legs' end states: a split that wins its window can leave the next weak leg downstream worse, and
@@ -202,7 +209,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
             crosscheck: bool = False, roadmap_weak: float = 0.0,
-            guard: bool = False, bridge: bool = False) -> tuple[TaskGraph, list[str], Check]:
+            guard: bool = False, bridge: bool = False, backtrack: bool = False
+            ) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
 
@@ -218,7 +226,8 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     second draw (module doc); ``roadmap_weak``: a live leg whose fresh success is below it is offered the roadmap's
     chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
     kept only if the path checked again from the window on scores no lower than before (module doc); ``bridge``: such a
-    leg is also offered the chain from the leg before it (module doc)."""
+    leg is also offered the chain from the leg before it; ``backtrack``: a dead leg of a dead path, the chain from the
+    path's start (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
                    guard=guard)
@@ -231,7 +240,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim, roadmap_weak, bridge)
+                               reaim, roadmap_weak, bridge, backtrack)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -252,12 +261,13 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
                   may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
                   roadmap: Callable | None = None, reaim: Callable | None = None, roadmap_weak: float = 0.0,
-                  bridge: bool = False):
+                  bridge: bool = False, backtrack: bool = False):
     """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses and,
     given ``reaim``, its waypoints re-aimed (no proposer call), then, for a dead leg of a dead path given ``roadmap``,
     the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
     Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end (and given
-    ``bridge``, from the leg before it). Lazy: a split is asked for only when its group is reached."""
+    ``bridge``, from the leg before it); given ``backtrack``, for a dead leg of a dead path, the chain from the path's
+    start. Lazy: a split is asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
     if reaim is not None:
@@ -265,6 +275,9 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
     if roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0:
         yield _roadmap_options(state, leg, roadmap)
     yield from _splits(state, leg, evaluator, split_leg, may_split, min_failures)
+    if backtrack and roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0 and leg > 0:
+        yield [("backtrack", *option[1:]) for option in _roadmap_options(state, leg, roadmap, back=leg)
+               if option[0] == "roadmap"]
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
         yield [option for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak)
                if option[0] == "roadmap"]
@@ -363,7 +376,8 @@ class _State:
         the path (and the path is checked again from the window on) when it wins. -> (what was judged, the kind
         accepted or None)."""
         graph, path, check = self.graph, self.path, self.check
-        s, e = max(leg - 1, 0), min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e]
+        e = min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e], from where an option departs
+        s = min([max(leg - 1, 0)] + [_kept(path, p) for _, _, p in options])
         start = self.start_of_leg(s)
         current = self.score(Check(results=check.results[s:e]))
         judged = [(kind, g, p, check_path(g, p[s:p.index(path[e]) + 1], self.evaluator, rollouts=self.rollouts,
@@ -400,6 +414,11 @@ class _State:
         """``check``'s legs before leg ``s``, and the (new) path's legs from there estimated again from ``start``."""
         rest = check_path(self.graph, self.path[s:], self.evaluator, rollouts=self.rollouts, seed=seed, start=start)
         return Check(results=check.results[:s] + rest.results, path=list(self.path))
+
+
+def _kept(path: list[str], other: list[str]) -> int:
+    """The last index up to which ``other`` follows ``path`` (0: only the start)."""
+    return next((i - 1 for i, (a, b) in enumerate(zip(path, other)) if a != b), min(len(path), len(other)) - 1)
 
 
 def _entry(tried: list[dict], judged: list, option) -> dict:

@@ -121,6 +121,8 @@ class SearchConfig:
     #                            dead legs of dead paths only; correct.py; method ours-corrector-mend)
     roadmap_bridge: bool = False  # beyond the paper: such a weak leg is also offered the chain from the leg before it
     #                               (correct.py; method ours-corrector-bridge)
+    roadmap_backtrack: bool = False  # beyond the paper: a dead leg of a dead path whose alternatives all lose is also
+    #                                  offered the chain from the path's start (correct.py; ours-corrector-backtrack)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -142,7 +144,7 @@ class SearchConfig:
                              "give 'policy', the agent's goal range)")
         if self.roadmap_bridge and not self.roadmap_weak:
             raise ValueError("roadmap_bridge needs roadmap_weak > 0 (it bridges the weak legs mend offers its chain)")
-        for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe", "roadmap_weak"):
+        for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe", "roadmap_weak", "roadmap_backtrack"):
             if getattr(self, name) and not self.correct_roadmap:
                 raise ValueError(f"{name} needs correct_roadmap (it changes the roadmap's searches)")
         for name in ("roadmap_explore", "roadmap_probe"):
@@ -602,7 +604,7 @@ class RefinementSearch:
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
                                       roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
-                                      bridge=self.cfg.roadmap_bridge,
+                                      bridge=self.cfg.roadmap_bridge, backtrack=self.cfg.roadmap_backtrack,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
                                       crosscheck=self.cfg.correct_crosscheck)
         return path, check

@@ -358,6 +358,15 @@ register_method("ours-corrector-bridge",
                 "beyond the paper: ours-corrector-mend whose weak leg is also offered, last, the roadmap's chain from "
                 "the start of the leg before it to its end on legs as sound, replacing the waypoint between them: a "
                 "leg that fails because of how it is entered fails from every node near its start", colour="#8e24aa")
+#: ours-corrector-backtrack: mend, whose dead leg of a dead path is also offered the roadmap's chain from the path's
+#: start (docs/corrector.md, "Ground given back")
+BACKTRACK = dict(roadmap_backtrack=True)
+register_method("ours-corrector-backtrack",
+                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND | BACKTRACK),
+                "beyond the paper: ours-corrector-mend whose dead leg of a dead path, where its alternatives all lose, "
+                "is also offered the roadmap's chain from the path's start to the leg's end: ground won toward the "
+                "goal is otherwise never given back, and a pocket walled off from the goal holds the run",
+                colour="#5e35b1")
 #: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
 #: lower (docs/corrector.md, "A window's win checked on the whole path")
 GUARD = dict(correct_guard=True)
