@@ -1096,3 +1096,28 @@ def test_mend_holds_its_second_part_with_no_more_runs_below_0_9_than_deep_not_fe
     assert second["rule"].startswith("ours-corrector-mend, adoption 2: no more runs below 0.9 than ours-corrector-deep")
     if not weak_cell:  # its last check, made after its adoption: four mixes, each one kind of error at its extreme
         checked_last(tmp_path, "mend", "corrector-mend-check", "random:15x8:29", ["AN", "AO", "AP", "AQ"])
+
+
+def test_backtrack_is_judged_against_mend_on_its_new_layouts_and_mends_last_check_that_informed_it(tmp_path):
+    """corrector-backtrack: mend its reference and control; mend's last check (AN-AQ), where mend ended a run at 0,
+    is its informed part; its new layouts (AR, AS) put it, mend and ours side by side; its adoption counts runs below
+    0.9 and asks for no more than mend's; adopted only where mend is."""
+    deep = later_rate(cc.DEEP, (cc.PROBE,), cc.DEEP_MIXES, ("random:12x9:7",), base=probe_rate())
+    dead = {"random:9x14:57", "random:13x11:88"}
+
+    def rate(maze, method, proposer):
+        if method == cc.BACKTRACK:
+            return 0.99
+        if method in (cc.MEND, cc.DEEP) and proposer in cc.MEND_CHECK_MIXES + cc.BACKTRACK_MIXES:
+            return 0.0 if cc.table_name(maze) in dead else 0.99
+        return 0.99 if method == cc.MEND else deep(maze, method, proposer)
+
+    laid = (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite", "corrector-deep-new",
+            "corrector-mend", "corrector-mend-suite", "corrector-mend-new", "corrector-mend-check",
+            "corrector-backtrack", "corrector-backtrack-suite")
+    _, vs = judged_after_its_reference(
+        tmp_path, "backtrack", rate, laid,
+        (["AN", "AO", "AP", "AQ"], "corrector-mend-check", {cc.BACKTRACK: 0, cc.MEND: 8, cc.DEEP: 8, "ours": 0}),
+        "corrector-backtrack-new", (["AR", "AS"], {cc.BACKTRACK: 0, cc.MEND: 4, "ours": 0}),
+        {cc.BACKTRACK: 0, cc.MEND: 4})
+    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.BACKTRACK] == ("informed",)

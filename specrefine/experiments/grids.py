@@ -472,12 +472,27 @@ MEND_CHECK_MIXES = ("imperfect:position_sigma=0.15,p_mirror_y=0.5,p_unparseable=
                     "rho=0.6",
                     "imperfect:position_sigma=0.6,coord_grid=1.0,radius_log_sigma=0.8,p_uncapped=1.0,rho=0.0")
 
+#: layouts and error mixes no run had used before grid corrector-backtrack-new (docs/corrector.md, "Ground given back"),
+#: made after corrector-mend-check's mixes AN-AP had been looked at (its run at 0 informed backtrack) and before AQ's:
+#: four larger generated mazes (sizes chosen, seeds drawn by random.Random(202612052)), and two mixes: AR (routes
+#: that take the wrong branch or a false opening most of the time, half the turns dropped, errors growing with the
+#: turns a query spans: pockets near the goal) and AS (coordinates rounded to half cells, regions pulled into corners,
+#: wrong branches and dropped turns often, uncapped legs, mirrored and unparseable replies, feedback used a third of
+#: the time)
+BACKTRACK_MAZES = ("random:13x11:88", "random:11x13:95", "random:14x10:83", "random:10x14:79")
+BACKTRACK_MIXES = ("imperfect:position_sigma=0.25,p_drop_turn=0.5,p_false_opening=0.6,p_wrong_branch=0.9,alpha=0.2,"
+                   "rho=0.5",
+                   "imperfect:position_sigma=0.3,coord_grid=0.5,radius=0.3,radius_log_sigma=0.4,corner_pull=0.5,"
+                   "p_drop_turn=0.4,p_false_opening=0.3,p_wrong_branch=0.6,p_mirror_y=0.2,p_uncapped=0.6,"
+                   "p_unparseable=0.15,alpha=0.3,rho=0.3")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
 PROBE_CODE = "fef6e19"  # the commit of ours-corrector-probe's code (Roadmap.probe)
 DEEP_CODE = "d788274"  # the commit of ours-corrector-deep's code (SearchConfig.roadmap_evaluations)
 MEND_CODE = "cc4f1d3"  # the commit of ours-corrector-mend's code (SearchConfig.roadmap_weak)
+BACKTRACK_CODE = "e3a8950"  # the commit of ours-corrector-backtrack's code (SearchConfig.roadmap_backtrack)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -970,6 +985,22 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-mend-check", "docs/corrector.md, 'A last check of mend' (issue 39; fixed 2026-12-05 "
                      "before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
                      MEND_CHECK_MAZES, MEND_CHECK_MIXES, "mend_check", code=MEND_CODE),
+    # docs/corrector.md, "Ground given back" (fixed 2026-12-05, before they ran)
+    new_layouts_grid("corrector-backtrack-new", "docs/corrector.md, 'Ground given back' (issue 39; fixed 2026-12-05 "
+                     "before it ran)", ("ours-corrector-backtrack", "ours-corrector-mend", "ours"),
+                     BACKTRACK_MAZES, BACKTRACK_MIXES, "backtrack_new", code=BACKTRACK_CODE),
+    *centre_variant_grids("corrector-backtrack", "Ground given back", "ours-corrector-backtrack", "backtrack",
+                          code=BACKTRACK_CODE,
+                          informed=Part(("ours-corrector-backtrack",), MEND_CHECK_MIXES, mazes=MEND_CHECK_MAZES,
+                                        seeds=(0, 1), split="proposers",
+                                        table="data/results/corrector/backtrack_check.csv", out="check"),
+                          fixed="2026-12-05"),
+    ExperimentGrid("corrector-backtrack-oracle", "docs/corrector.md, 'Ground given back' (issue 39; fixed 2026-12-05 "
+                   "before it ran): ours-corrector-backtrack and ours with the oracle on the 17 suite mazes", "point",
+                   parts=(Part(("ours-corrector-backtrack", "ours"), ("geometric",), split="seeds"),),
+                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
+                   code=BACKTRACK_CODE, table="data/results/corrector/backtrack_oracle.csv",
+                   out="runs/corrector_backtrack_oracle"),
     ExperimentGrid("corrector-mend-oracle", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
                    "2026-12-05 before it ran): ours-corrector-mend and ours with the oracle on the 17 suite mazes",
                    "point", parts=(Part(("ours-corrector-mend", "ours"), ("geometric",), split="seeds"),),

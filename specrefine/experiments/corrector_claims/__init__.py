@@ -25,6 +25,7 @@ from ...core.errors import SpecrefineError
 from ..grids import (
     ADVANCE_CHECK_MIXES,
     ADVANCE_MIXES,
+    BACKTRACK_MIXES,
     CHECK_MIXES,
     DEEP_MIXES,
     EXTEND_MIXES,
@@ -33,6 +34,7 @@ from ..grids import (
     FRESH_MIXES,
     KEEP_MIXES,
     MEMORY_MIXES,
+    MEND_CHECK_MIXES,
     MEND_MIXES,
     NEW_MAZES,
     PROBE_MIXES,
@@ -66,6 +68,7 @@ from .cli import add_arguments, main, run
 from .common import (
     ADOPTABLE,
     ADVANCE,
+    BACKTRACK,
     CENTRE,
     DEEP,
     EXTEND,
@@ -114,10 +117,12 @@ from .variants import variant_studies, variant_study
 
 __all__ = [
     "ADOPTABLE", "ADVANCE", "ADVANCE_CHECK_MIXES", "ADVANCE_MIXES", "ANT_BEFORE", "ANT_CANDIDATES", "ANT_FLOOR",
+    "BACKTRACK", "BACKTRACK_MIXES",
     "ANT_GRID", "ANT_METHOD", "ANT_REAIM", "ANT_REDRAW", "ANT_SPARING", "ANT_SPARING_FRUGAL", "ANT_SUCCESSORS",
     "ANT_WIDE", "CENTRE", "CHECK_MIXES", "DEEP", "DEEP_MIXES", "EXTEND", "EXTEND_MIXES", "FALLBACK",
     "FALLBACK_MIXES", "FRESH_MAZES", "FRESH_MIXES", "GATED", "INFORMED_PARTS", "KEEP", "KEEP_MIXES", "LEAN",
-    "MEMORY", "MEMORY_MIXES", "MEND", "MEND_MIXES", "METHOD", "NEW_MAZES", "PERSIST", "POINT_SEEDS", "POLISH",
+    "MEMORY", "MEMORY_MIXES", "MEND", "MEND_CHECK_MIXES", "MEND_MIXES", "METHOD", "NEW_MAZES", "PERSIST",
+    "POINT_SEEDS", "POLISH",
     "PRECISE", "PROBE",
     "PROBE_MIXES", "REAIM", "RECHECK", "REDRAW", "ROADMAP", "ROADMAP_CHECK_MIXES", "ROADMAP_MIXES", "SNAP",
     "SNAP_MIXES", "SOUND", "SOUND_MIXES", "SPARING", "SPARING_FRUGAL", "SPREAD", "SpecrefineError", "Successor",
