@@ -985,7 +985,7 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-mend-check", "docs/corrector.md, 'A last check of mend' (issue 39; fixed 2026-12-05 "
                      "before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
                      MEND_CHECK_MAZES, MEND_CHECK_MIXES, "mend_check", code=MEND_CODE),
-    # docs/corrector.md, "Ground given back" (fixed 2026-12-05, before they ran)
+    # docs/corrector.md, "Ground given back" (fixed 2026-12-05 13:28 UTC, before they ran)
     new_layouts_grid("corrector-backtrack-new", "docs/corrector.md, 'Ground given back' (issue 39; fixed 2026-12-05 "
                      "before it ran)", ("ours-corrector-backtrack", "ours-corrector-mend", "ours"),
                      BACKTRACK_MAZES, BACKTRACK_MIXES, "backtrack_new", code=BACKTRACK_CODE),
