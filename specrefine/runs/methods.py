@@ -345,8 +345,9 @@ register_method("ours-corrector-deep",
 #: ours-corrector-mend: deep, a live leg below 0.9 on the fresh check also offered the roadmap's chain to its end,
 #: after the proposer's alternatives (docs/corrector.md, "Weak legs mended on the roadmap")
 MEND = dict(roadmap_weak=0.9)
+MENDED = ROADMAPPED | MEMORY | PROBE | DEEP | MEND  # mend's settings, which its variants extend
 register_method("ours-corrector-mend",
-                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND),
+                ours_variant(**MENDED),
                 "beyond the paper: ours-corrector-deep whose correction also offers a live leg that fails on more "
                 "than a tenth of its fresh rollouts the roadmap's chain to its end (the pooled waypoints and probes, "
                 "no proposer call), after the proposer's alternatives and whatever budget they left", colour="#7b1fa2")
@@ -354,7 +355,7 @@ register_method("ours-corrector-mend",
 #: (docs/corrector.md, "Bridged from the leg before")
 BRIDGE = dict(roadmap_bridge=True)
 register_method("ours-corrector-bridge",
-                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND | BRIDGE),
+                ours_variant(**MENDED | BRIDGE),
                 "beyond the paper: ours-corrector-mend whose weak leg is also offered, last, the roadmap's chain from "
                 "the start of the leg before it to its end on legs as sound, replacing the waypoint between them: a "
                 "leg that fails because of how it is entered fails from every node near its start", colour="#8e24aa")
@@ -362,7 +363,7 @@ register_method("ours-corrector-bridge",
 #: start (docs/corrector.md, "Ground given back")
 BACKTRACK = dict(roadmap_backtrack=True)
 register_method("ours-corrector-backtrack",
-                ours_variant(**ROADMAPPED | MEMORY | PROBE | DEEP | MEND | BACKTRACK),
+                ours_variant(**MENDED | BACKTRACK),
                 "beyond the paper: ours-corrector-mend whose dead leg of a dead path, where its alternatives all lose, "
                 "is also offered the roadmap's chain from the path's start to the leg's end: ground won toward the "
                 "goal is otherwise never given back, and a pocket walled off from the goal holds the run",
