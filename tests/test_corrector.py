@@ -843,6 +843,19 @@ def test_a_dead_leg_in_a_pocket_is_rerouted_from_the_paths_start(backtrack):
         assert all(t["kind"] != "backtrack" for s in legs for t in s["tried"])
 
 
+def test_bridge_and_backtrack_leave_a_run_alone_where_their_case_does_not_arise():
+    """backtrack on a live path with a weak leg (mend's case), bridge on a dead path (backtrack's): the same steps."""
+    cases = ((WEAK_LEG, WEAK_REPLIES, "roadmap_backtrack", dict(roadmap_weak=0.9, **MENDED)),
+             (POCKET, POCKET_REPLIES, "roadmap_bridge", dict(roadmap_weak=0.9, **BACKED)))
+    for table, replies, setting, cfg in cases:
+        runs = []
+        for on in (False, True):
+            book = (AnswerBook if replies is WEAK_REPLIES else EdgeQueue)(replies)
+            _, result = run(LegTable(table, table), book, **{setting: on}, **cfg)
+            runs.append((book.queries, xs(result), [(s["event"], s.get("accepted")) for s in result.steps]))
+        assert runs[0] == runs[1]
+
+
 def test_backtracking_needs_the_roadmap():
     with pytest.raises(ValueError, match="roadmap_backtrack needs correct_roadmap"):
         SearchConfig(roadmap_backtrack=True)
