@@ -276,14 +276,11 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
         yield _roadmap_options(state, leg, roadmap)
     yield from _splits(state, leg, evaluator, split_leg, may_split, min_failures)
     if backtrack and roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0 and leg > 0:
-        yield [("backtrack", *option[1:]) for option in _roadmap_options(state, leg, roadmap, back=leg)
-               if option[0] == "roadmap"]
+        yield _whole_chain(state, leg, roadmap, "backtrack", back=leg)
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
-        yield [option for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak)
-               if option[0] == "roadmap"]
+        yield _whole_chain(state, leg, roadmap, "roadmap", sound=roadmap_weak)
         if bridge and leg > 0:
-            yield [("bridge", *option[1:]) for option in _roadmap_options(state, leg, roadmap, sound=roadmap_weak,
-                                                                          back=1) if option[0] == "roadmap"]
+            yield _whole_chain(state, leg, roadmap, "bridge", sound=roadmap_weak, back=1)
 
 
 def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable, may_split: Callable[[], bool],
@@ -328,6 +325,13 @@ def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | 
     if not found.waypoints:
         return []
     return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, first, leg + 1, found.waypoints))]
+
+
+def _whole_chain(state: _State, leg: int, roadmap: Callable, kind: str, sound: float | None = None,
+                 back: int = 0) -> list:
+    """``_roadmap_options``' chain only where it reaches the leg's end, as an option of ``kind``."""
+    return [(kind, *option[1:]) for option in _roadmap_options(state, leg, roadmap, sound=sound, back=back)
+            if option[0] == "roadmap"]
 
 
 @dataclass
