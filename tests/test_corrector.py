@@ -20,7 +20,7 @@ from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, 
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, GUARD, MEND, get_method
+from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, FINE, GUARD, MEND, get_method
 
 
 class LegTable:
@@ -720,6 +720,40 @@ def test_a_probing_roadmap_probes_the_node_nearest_the_goal_and_tries_its_probes
     assert set(roadmap.probes.values()) == {Roadmap._key(np.array([3.0, 0.0]), np.array([3.0, 0.0]))}
     from_origin = [c for c in ev.calls if c[0] == 0.0]
     assert [c[1] for c in from_origin] == [3.0]  # no probe of x = 3 was tried from the origin
+
+
+class ShortLegs:
+    """A leg succeeds where it is at most 1 m long and ends within 0.2 m of a point of ``way``: a way on that no
+    ring of probes 1.75 m out can land on."""
+
+    def __init__(self, way):
+        self.way, self.calls = [np.asarray(w, dtype=float) for w in way], []
+
+    def evaluate(self, start, goal, avoid, goal_point=None, seed=None, n=None):
+        a, b = np.zeros(2) if isinstance(start, Box) else np.asarray(start[1]), np.asarray(goal.centre(), dtype=float)
+        self.calls.append((tuple(a), tuple(b)))
+        ok = np.linalg.norm(b - a) <= 1.0 and min(np.linalg.norm(b - w) for w in self.way) <= 0.2
+        return _Arrive(1.0 if ok else 0.0, at=tuple(b))
+
+
+@pytest.mark.parametrize("rings", [1, 2])
+def test_a_second_ring_of_probes_at_half_the_radius_finds_a_turn_the_first_steps_over(rings):
+    turn = 0.875 * np.array([np.cos(np.pi / 8), np.sin(np.pi / 8)])  # on the second ring, turned by pi / 8
+    goal = turn + np.array([0.0, 0.9])
+    roadmap = Roadmap(reach=3.5, probe=0.5, rings=rings)
+    found = roadmap.chain(ShortLegs([turn, goal]), box_at(0, 0), box_at(0, 0), Disc(*goal, 0.3), WALLS)
+    assert found.reaches_goal == (rings == 2)
+    assert found.explored == 8 * rings  # the second ring only once the first is spent
+    if rings == 2:
+        assert np.allclose(found.waypoints[0].centre(), turn, atol=1e-9) and len(found.waypoints) == 1
+
+
+def test_the_finer_rings_need_the_probes():
+    with pytest.raises(ValueError, match="roadmap_rings > 1 needs roadmap_probe"):
+        SearchConfig(roadmap_rings=2, correct_roadmap=True, correct_reach=3.0)
+    with pytest.raises(ValueError, match="roadmap_rings must be at least 1"):
+        SearchConfig(roadmap_rings=0)
+    assert FINE == {"roadmap_rings": 2}  # the one thing ours-corrector-fine changes in backtrack
 
 
 def test_exploring_needs_the_roadmap_and_a_fraction():

@@ -37,6 +37,13 @@ legs, the node reached nearest the goal that has not been probed gets eight wayp
 from that node only, and the search goes on. Exploring every node at once adds legs from every node within reach of
 every new waypoint, and each search then spends its evaluations on dead ones (docs/corrector.md, "Probes from the
 nearest node").
+
+``rings`` (method ``ours-corrector-fine``): where every node reached has had its probes and the search still has
+evaluations, each node, nearest the goal first, gets another ring at half the radius, turned by an eighth of a
+turn, up to ``rings`` rings per node. One ring of eight at half the policy's reach steps over a turn in a corridor
+narrower than the ring's spacing (a point past the corner lies in the wall beside it), so a search in a maze of 1 m
+corridors can spend its probes and stop with evaluations left and the way on untried (docs/corrector.md, "Finer
+probes"). Until a search has spent every node's first ring nothing changes.
 """
 
 from __future__ import annotations
@@ -72,6 +79,7 @@ class Roadmap:
     remember: bool = False  # a search starts from the nodes the searches before it reached from the same origin
     explore: float = 0.0  # where a search runs out of legs to try: waypoints this x reach from each node (0: none)
     probe: float = 0.0  # where a search runs out of legs: eight waypoints this x reach from one node, its own (0: none)
+    rings: int = 1  # probe rings per node at most, each at half the radius of the one before and turned by pi / 8
     explore_radius: float = 0.3  # the radius of a waypoint the search adds
     points: list[Region] = field(default_factory=list)
     dead: set = field(default_factory=set)  # (from, to) centres of legs that never succeeded (or were not sound)
@@ -157,14 +165,14 @@ class Roadmap:
         heapq.heapify(queue)
         return queue
 
-    def _ring(self, here, step: float) -> range:
-        """Eight waypoints ``step`` from ``here``, pooled, unless ``here`` had its ring already; their indices in
-        points (those not merged into one kept already)."""
-        before, key = len(self.points), self._key(here, here)
+    def _ring(self, here, step: float, ring: int = 0) -> range:
+        """Eight waypoints ``step`` from ``here``, turned by ``ring`` x pi / 8, pooled, unless ``here`` had that
+        ring already; their indices in points (those not merged into one kept already)."""
+        before, key = len(self.points), self._key(here, here) + ((ring,) if ring else ())
         if key not in self.explored:
             self.explored.add(key)
             self.add(Disc(float(here[0] + step * np.cos(a)), float(here[1] + step * np.sin(a)), self.explore_radius)
-                     for a in np.arange(8) * np.pi / 4)
+                     for a in (np.arange(8) * 2 + ring) * np.pi / 8)
         return range(before, len(self.points))
 
     def _explore(self, first, reached: dict, centres) -> int:
@@ -174,13 +182,16 @@ class Roadmap:
 
     def _probe(self, first, reached: dict, centres, to_goal) -> int:
         """Eight waypoints ``probe`` x ``reach`` out from the node reached nearest the goal not probed yet, pooled as
-        that node's own; how many were new (0: every node reached is probed)."""
-        for v in sorted(reached, key=lambda v: self._to_goal(first, centres, to_goal, v)):
-            here = first if v < 0 else centres[v]
-            new = self._ring(here, self.probe * self.reach)
-            self.probes |= dict.fromkeys(new, self._key(here, here))
-            if new:
-                return len(new)
+        that node's own; where every node reached has that ring, the next ring (``rings``); how many were new (0:
+        every node reached has all its rings)."""
+        nearest_first = sorted(reached, key=lambda v: self._to_goal(first, centres, to_goal, v))
+        for ring in range(self.rings):
+            for v in nearest_first:
+                here = first if v < 0 else centres[v]
+                new = self._ring(here, self.probe * self.reach / 2 ** ring, ring)
+                self.probes |= dict.fromkeys(new, self._key(here, here))
+                if new:
+                    return len(new)
         return 0
 
     def _untried(self, here, centres, to_goal, exclude: set) -> list[int]:

@@ -112,6 +112,8 @@ class SearchConfig:
     #                               fraction of correct_reach from what it reached (roadmap.py; ours-corrector-explore)
     roadmap_probe: float = 0.0  # beyond the paper: the same from one node at a time, nearest the goal first, its own
     #                             waypoints tried from it only (roadmap.py; method ours-corrector-probe)
+    roadmap_rings: int = 1  # beyond the paper: probe rings per node, each at half the radius of the one before, once
+    #                         every node reached has the one before (roadmap.py; 2: method ours-corrector-fine)
     roadmap_evaluations: int = 120  # subtask evaluations one roadmap search may spend at most (roadmap.py; 360:
     #                                 method ours-corrector-deep)
     correct_guard: bool = False  # beyond the paper: a correction's win on its window is kept only if the whole path,
@@ -153,6 +155,10 @@ class SearchConfig:
                 raise ValueError(f"{name} must lie in [0, 1] (a fraction of correct_reach), got {fraction!r}")
         if self.roadmap_evaluations < 1:
             raise ValueError(f"roadmap_evaluations must be at least 1, got {self.roadmap_evaluations!r}")
+        if self.roadmap_rings < 1:
+            raise ValueError(f"roadmap_rings must be at least 1, got {self.roadmap_rings!r}")
+        if self.roadmap_rings > 1 and not self.roadmap_probe:
+            raise ValueError("roadmap_rings > 1 needs roadmap_probe > 0 (they are the probes' finer rings)")
         for name in ("roadmap_sound", "roadmap_weak"):
             if not 0.0 <= getattr(self, name) <= 1.0:
                 raise ValueError(f"{name} must lie in [0, 1], got {getattr(self, name)!r}")
@@ -250,7 +256,8 @@ class RefinementSearch:
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
         self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound,
                                 remember=self.cfg.roadmap_remember, explore=self.cfg.roadmap_explore,
-                                probe=self.cfg.roadmap_probe, evaluations=self.cfg.roadmap_evaluations)
+                                probe=self.cfg.roadmap_probe, rings=self.cfg.roadmap_rings,
+                                evaluations=self.cfg.roadmap_evaluations)
                         if self.cfg.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")

@@ -368,6 +368,15 @@ register_method("ours-corrector-backtrack",
                 "is also offered the roadmap's chain from the path's start to the leg's end: ground won toward the "
                 "goal is otherwise never given back, and a pocket walled off from the goal holds the run",
                 colour="#5e35b1")
+#: ours-corrector-fine: backtrack, whose roadmap searches give each node a second ring of probes at half the radius
+#: once every node reached has its first (docs/corrector.md, "Finer probes")
+FINE = dict(roadmap_rings=2)
+register_method("ours-corrector-fine",
+                ours_variant(**MENDED | BACKTRACK | FINE),
+                "beyond the paper: ours-corrector-backtrack whose roadmap search, once every node it reached has had "
+                "its eight probes, gives each node, nearest the goal first, eight more at half the distance turned by "
+                "an eighth of a turn: one ring steps over a turn in a corridor narrower than its spacing",
+                colour="#3949ab")
 #: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
 #: lower (docs/corrector.md, "A window's win checked on the whole path")
 GUARD = dict(correct_guard=True)
