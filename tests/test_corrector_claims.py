@@ -1098,10 +1098,8 @@ def test_mend_holds_its_second_part_with_no_more_runs_below_0_9_than_deep_not_fe
         checked_last(tmp_path, "mend", "corrector-mend-check", "random:15x8:29", ["AN", "AO", "AP", "AQ"])
 
 
-def test_backtrack_is_judged_against_mend_on_its_new_layouts_and_mends_last_check_that_informed_it(tmp_path):
-    """corrector-backtrack: mend its reference and control; mend's last check (AN-AQ), where mend ended a run at 0,
-    is its informed part; its new layouts (AR, AS) put it, mend and ours side by side; its adoption counts runs below
-    0.9 and asks for no more than mend's; adopted only where mend is."""
+def backtrack_rate():
+    """Backtrack 0.99; mend and deep 0 on one AN-AQ and one AR/AS layout under those mixes (backtrack's grids)."""
     deep = later_rate(cc.DEEP, (cc.PROBE,), cc.DEEP_MIXES, ("random:12x9:7",), base=probe_rate())
     dead = {"random:9x14:57", "random:13x11:88"}
 
@@ -1111,13 +1109,43 @@ def test_backtrack_is_judged_against_mend_on_its_new_layouts_and_mends_last_chec
         if method in (cc.MEND, cc.DEEP) and proposer in cc.MEND_CHECK_MIXES + cc.BACKTRACK_MIXES:
             return 0.0 if cc.table_name(maze) in dead else 0.99
         return 0.99 if method == cc.MEND else deep(maze, method, proposer)
+    return rate
 
-    laid = (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite", "corrector-deep-new",
-            "corrector-mend", "corrector-mend-suite", "corrector-mend-new", "corrector-mend-check",
-            "corrector-backtrack", "corrector-backtrack-suite")
+
+THROUGH_BACKTRACK = (*THROUGH_PROBE, "corrector-probe-new", "corrector-deep", "corrector-deep-suite",
+                     "corrector-deep-new", "corrector-mend", "corrector-mend-suite", "corrector-mend-new",
+                     "corrector-mend-check", "corrector-backtrack", "corrector-backtrack-suite")
+
+
+def test_backtrack_is_judged_against_mend_on_its_new_layouts_and_mends_last_check_that_informed_it(tmp_path):
+    """corrector-backtrack: mend its reference and control; mend's last check (AN-AQ), where mend ended a run at 0,
+    is its informed part; its new layouts (AR, AS) put it, mend and ours side by side; its adoption counts runs below
+    0.9 and asks for no more than mend's; adopted only where mend is."""
     _, vs = judged_after_its_reference(
-        tmp_path, "backtrack", rate, laid,
+        tmp_path, "backtrack", backtrack_rate(), THROUGH_BACKTRACK,
         (["AN", "AO", "AP", "AQ"], "corrector-mend-check", {cc.BACKTRACK: 0, cc.MEND: 8, cc.DEEP: 8, "ours": 0}),
         "corrector-backtrack-new", (["AR", "AS"], {cc.BACKTRACK: 0, cc.MEND: 4, "ours": 0}),
         {cc.BACKTRACK: 0, cc.MEND: 4})
     assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.BACKTRACK] == ("informed",)
+
+
+def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_cells_that_informed_it(tmp_path):
+    """corrector-fine: backtrack its reference and control; backtrack's new cells (AR, AS), where backtrack ended runs
+    at 0, are its informed part; its new layouts (AT, AU) put it, backtrack and ours side by side; its adoption counts
+    runs below 0.9 and asks for no more than backtrack's; adopted only where backtrack is."""
+    base, dead = backtrack_rate(), {"random:14x10:83", "random:12x13:64"}
+
+    def rate(maze, method, proposer):
+        if method == cc.FINE:
+            return 0.99
+        if method in (cc.BACKTRACK, cc.MEND) and proposer in cc.BACKTRACK_MIXES + cc.FINE_MIXES:
+            return 0.0 if cc.table_name(maze) in dead else 0.99
+        return base(maze, method, proposer)
+
+    laid = (*THROUGH_BACKTRACK, "corrector-backtrack-new", "corrector-fine", "corrector-fine-suite")
+    _, vs = judged_after_its_reference(
+        tmp_path, "fine", rate, laid,
+        (["AR", "AS"], "corrector-backtrack-new", {cc.FINE: 0, cc.BACKTRACK: 4, cc.MEND: 4, "ours": 0}),
+        "corrector-fine-new", (["AT", "AU"], {cc.FINE: 0, cc.BACKTRACK: 4, "ours": 0}),
+        {cc.FINE: 0, cc.BACKTRACK: 4})
+    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.FINE] == ("informed",)

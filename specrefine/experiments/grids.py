@@ -486,6 +486,19 @@ BACKTRACK_MIXES = ("imperfect:position_sigma=0.25,p_drop_turn=0.5,p_false_openin
                    "p_drop_turn=0.4,p_false_opening=0.3,p_wrong_branch=0.6,p_mirror_y=0.2,p_uncapped=0.6,"
                    "p_unparseable=0.15,alpha=0.3,rho=0.3")
 
+#: layouts and error mixes no run had used before grid corrector-fine-new (docs/corrector.md, "Finer probes"), made
+#: after corrector-backtrack-new had been looked at (its three runs at 0, all on random:14x10:83, informed fine): four
+#: larger generated mazes (sizes chosen, seeds drawn by random.Random(202612053)), and two mixes: AT (wrong branches,
+#: false openings and dropped turns most of the time, errors growing with the turns a query spans: long detours no
+#: reply names) and AU (large offsets rounded to half cells, regions of spread sizes pulled toward corners, most turns
+#: dropped, some wrong branches and false openings, uncapped legs, unparseable replies, feedback used a third of the
+#: time)
+FINE_MAZES = ("random:14x11:10", "random:11x14:75", "random:15x10:38", "random:12x13:64")
+FINE_MIXES = ("imperfect:position_sigma=0.2,p_drop_turn=0.6,p_false_opening=0.5,p_wrong_branch=0.8,alpha=0.25,rho=0.4",
+              "imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,"
+              "p_drop_turn=0.55,p_false_opening=0.2,p_wrong_branch=0.3,p_uncapped=0.5,p_unparseable=0.1,alpha=0.4,"
+              "rho=0.3")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -493,6 +506,7 @@ PROBE_CODE = "fef6e19"  # the commit of ours-corrector-probe's code (Roadmap.pro
 DEEP_CODE = "d788274"  # the commit of ours-corrector-deep's code (SearchConfig.roadmap_evaluations)
 MEND_CODE = "cc4f1d3"  # the commit of ours-corrector-mend's code (SearchConfig.roadmap_weak)
 BACKTRACK_CODE = "e3a8950"  # the commit of ours-corrector-backtrack's code (SearchConfig.roadmap_backtrack)
+FINE_CODE = "dc68dea"  # the commit of ours-corrector-fine's code (SearchConfig.roadmap_rings)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -1001,6 +1015,20 @@ GRIDS = {g.name: g for g in (
                    seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
                    code=BACKTRACK_CODE, table="data/results/corrector/backtrack_oracle.csv",
                    out="runs/corrector_backtrack_oracle"),
+    # docs/corrector.md, "Finer probes" (fixed 2026-12-05, before they ran)
+    new_layouts_grid("corrector-fine-new", "docs/corrector.md, 'Finer probes' (issue 39; fixed 2026-12-05 before it "
+                     "ran)", ("ours-corrector-fine", "ours-corrector-backtrack", "ours"),
+                     FINE_MAZES, FINE_MIXES, "fine_new", code=FINE_CODE),
+    *centre_variant_grids("corrector-fine", "Finer probes", "ours-corrector-fine", "fine", code=FINE_CODE,
+                          informed=Part(("ours-corrector-fine",), BACKTRACK_MIXES, mazes=BACKTRACK_MAZES,
+                                        seeds=(0, 1), split="proposers",
+                                        table="data/results/corrector/fine_backtrack_new.csv", out="informed"),
+                          fixed="2026-12-05"),
+    ExperimentGrid("corrector-fine-oracle", "docs/corrector.md, 'Finer probes' (issue 39; fixed 2026-12-05 before it "
+                   "ran): ours-corrector-fine and ours with the oracle on the 17 suite mazes", "point",
+                   parts=(Part(("ours-corrector-fine", "ours"), ("geometric",), split="seeds"),),
+                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
+                   code=FINE_CODE, table="data/results/corrector/fine_oracle.csv", out="runs/corrector_fine_oracle"),
     ExperimentGrid("corrector-mend-oracle", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
                    "2026-12-05 before it ran): ours-corrector-mend and ours with the oracle on the 17 suite mazes",
                    "point", parts=(Part(("ours-corrector-mend", "ours"), ("geometric",), split="seeds"),),

@@ -24,6 +24,8 @@ from ..grids import (
     EXTEND_MIXES,
     FALLBACK_MAZES,
     FALLBACK_MIXES,
+    FINE_MAZES,
+    FINE_MIXES,
     FRESH_MAZES,
     FRESH_MIXES,
     GRIDS,
@@ -56,6 +58,7 @@ from .common import (
     DEEP,
     EXTEND,
     FALLBACK,
+    FINE,
     KEEP,
     MEMORY,
     MEND,
@@ -97,14 +100,15 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                "deep-check": ("corrector-deep-check", DEEP_CHECK_MAZES, DEEP_CHECK_MIXES, ("AG", "AH")),
                MEND: ("corrector-mend-new", MEND_MAZES, MEND_MIXES, ("AL", "AM")),
                "mend-check": ("corrector-mend-check", MEND_CHECK_MAZES, MEND_CHECK_MIXES, ("AN", "AO", "AP", "AQ")),
-               BACKTRACK: ("corrector-backtrack-new", BACKTRACK_MAZES, BACKTRACK_MIXES, ("AR", "AS"))}
+               BACKTRACK: ("corrector-backtrack-new", BACKTRACK_MAZES, BACKTRACK_MIXES, ("AR", "AS")),
+               FINE: ("corrector-fine-new", FINE_MAZES, FINE_MIXES, ("AT", "AU"))}
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check", MEND: "mend-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
-               DEEP: PROBE, BACKTRACK: "mend-check"}
+               DEEP: PROBE, BACKTRACK: "mend-check", FINE: BACKTRACK}
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {m: ("informed",) * (m in INFORMED_ON or m == SNAP) + ("check",) * (m in LAST_CHECK or m == SNAP)
                   for m in (SNAP, *INFORMED_ON, *LAST_CHECK)}
