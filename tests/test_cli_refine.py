@@ -16,7 +16,7 @@ REQUIRED = ["success_rate", "success_ci", "episodes", "predicted_success", "eval
 FAST = ["--rollouts", "8", "--episodes", "24"]
 
 
-@pytest.mark.parametrize("method", ["dirl", "symbolic", "ours", "vlm-oneshot"])
+@pytest.mark.parametrize("method", ["dirl", "symbolic", "ours", "vlm-oneshot", "ours-corrector-mend"])
 def test_refine_writes_every_result_key(tmp_path, method, capsys):
     out = tmp_path / method
     code = main(["refine", "u_maze", "--agent", "point", "--method", method, "--proposer", "geometric",
@@ -33,6 +33,7 @@ def test_refine_writes_every_result_key(tmp_path, method, capsys):
     if method != "vlm-oneshot":
         assert check_refines(refined, original) == [] and data["refines_input"] is True
     assert (out / "refined.png").stat().st_size > 1000 and (out / "graph.png").exists()
+    assert (out / "roadmap.png").exists() == (method == "ours-corrector-mend")  # the correction's roadmap, if any
     assert (out / "steps.jsonl").exists()
     assert "success on the original task" in capsys.readouterr().out
 

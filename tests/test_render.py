@@ -58,3 +58,25 @@ def test_graph_diagram():
     img = decode(to_png(render_graph_diagram(tg, {("S", "a"): 0.9, ("a", "G"): 0.5}, path=["S", "a", "G"],
                                              title="choices", size_px=400)))
     assert img.shape[1] == 400 and img[..., :3].std() > 0.05
+
+
+def test_the_roadmap_picture_shows_replies_probes_and_the_legs_its_searches_built_on():
+    from specrefine.pictures.render import PATH, PROPOSED, SUBGOAL, SUCCESS, render_roadmap
+    from specrefine.refine.roadmap import Roadmap
+
+    maze = load_maze("u_maze")
+    graph = maze_task(maze)
+    roadmap = Roadmap(reach=3.0)
+    roadmap.add([Disc(1.0, 1.0, 0.3), Disc(2.0, 1.0, 0.3)])  # two reply waypoints, the second one a probe
+    roadmap.probes = {1: Roadmap._key(np.array([1.0, 1.0]), np.array([1.0, 1.0]))}
+    roadmap.trees = {(0.0, 0.0, 0.0, 0.0): {0: (None, -1), 1: (None, 0)}}  # origin -> 1 -> 2
+    fig = render_roadmap(maze, roadmap, graph, ["S", "G"], title="roadmap", size_px=400)
+    lines = fig.axes[0].get_lines()
+    colours = [line.get_color() for line in lines]
+    dots = {c: line.get_xydata().tolist() for c, line in zip(colours, lines) if line.get_marker() == "."}
+    assert dots == {PROPOSED: [[1.0, 1.0]], SUBGOAL: [[2.0, 1.0]]}
+    legs = [line.get_xydata().tolist() for line in lines if line.get_color() == SUCCESS]
+    assert legs == [[[1.0, 1.0], [0.0, 0.0]], [[2.0, 1.0], [1.0, 1.0]]]
+    assert colours.count(PATH) == 1
+    img = decode(to_png(fig))
+    assert max(img.shape[:2]) == 400

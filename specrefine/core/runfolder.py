@@ -41,7 +41,7 @@ from .records import read_json, read_result  # noqa: F401 - read_result: its rea
 
 LOCK, RECORD = ".lock", "run.json"
 #: what a run writes into its folder (besides the cache): no other command may write over them
-RUN_FILES = (LOCK, RECORD, "result.json", "policy.json", "steps.jsonl", "refined.png", "graph.png",
+RUN_FILES = (LOCK, RECORD, "result.json", "policy.json", "steps.jsonl", "refined.png", "graph.png", "roadmap.png",
              "vlm_recording.jsonl")
 FULL = (errno.ENOSPC, errno.EDQUOT)  # a write failed for want of room
 APPENDED = ("vlm_recording.jsonl",)  # appended to as the run goes, not replaced whole

@@ -61,9 +61,9 @@ PATH = "#1f4fff"
 DPI = 100
 
 __all__ = [
-    "render_task", "render_graph_diagram", "to_png", "save_png", "new_figure", "subplots", "PngFigure", "draw_walls",
-    "draw_hazards", "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories", "draw_waypoints",
-    "draw_points",
+    "render_task", "render_graph_diagram", "render_roadmap", "to_png", "save_png", "new_figure", "subplots",
+    "PngFigure", "draw_walls", "draw_hazards", "draw_region", "draw_maze_regions", "draw_graph", "draw_trajectories",
+    "draw_waypoints", "draw_points",
 ]
 
 
@@ -328,6 +328,41 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
                 k = int(np.sum(success))
                 items += [(f"success ({k})", SUCCESS, "line"), (f"failure ({len(success) - k})", FAILURE, "line")]
         _legend(fig, ax, items)
+    return fig
+
+
+# --- the correction's roadmap ------------------------------------------------------------------
+def render_roadmap(maze, roadmap, graph=None, path=None, *, title=None, size_px=768):
+    """The correction's roadmap (``refine/roadmap.py``; methods ``ours-corrector-roadmap`` and after): every
+    waypoint the proposer's replies named, pooled (grey); the search's own probes (orange); the legs its searches
+    built on from each origin they started at (green; remembered trees only, ``ours-corrector-memory`` and after);
+    and the found path through the refined ``graph`` (blue). Where its searches went and where they stopped: a
+    picture of why a dead leg stayed dead."""
+    fig, ax = new_figure(maze.bounds(), size_px, title)
+    ax.set_facecolor("white")
+    _grid(ax, maze.cell_size)
+    draw_walls(ax, maze)
+    draw_hazards(ax, maze)
+    draw_maze_regions(ax, maze, alpha=0.18, labels=False)
+    centres = np.asarray([p.centre() for p in roadmap.points], dtype=float).reshape(-1, 2)
+    probe = np.zeros(len(centres), dtype=bool)
+    probe[[i for i in roadmap.probes if i < len(centres)]] = True
+    fs = _fs(ax)
+    for points, colour in ((centres[~probe], PROPOSED), (centres[probe], SUBGOAL)):
+        ax.plot(points[:, 0], points[:, 1], ".", color=colour, ms=fs / 3, lw=0, zorder=3)
+    for key, tree in roadmap.trees.items():
+        origin = np.asarray(key[:2], dtype=float)
+        for v, (_, u) in tree.items():
+            a, b = centres[v], origin if u is None or u < 0 else centres[u]
+            ax.plot([a[0], b[0]], [a[1], b[1]], "-", color=SUCCESS, lw=1.0, alpha=0.8, zorder=3.5)
+    if graph is not None and path:
+        line = np.asarray([graph.region(v).centre() for v in path], dtype=float)
+        ax.plot(line[:, 0], line[:, 1], "-", color=PATH, lw=2.0, zorder=4)
+    items = [("wall", WALL, "patch"), ("reply waypoint", PROPOSED, "line"), ("probe", SUBGOAL, "line"),
+             ("leg a search built on", SUCCESS, "line")]
+    if graph is not None and path:
+        items.append(("found path", PATH, "line"))
+    _legend(fig, ax, items)
     return fig
 
 

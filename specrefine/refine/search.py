@@ -216,6 +216,7 @@ class SearchResult:
     refinements: int
     edge_splits_generated: int
     vertex_refinements_generated: int
+    roadmap: Roadmap | None = None  # the correction's pooled waypoints, probes and searches (roadmap methods)
 
     @property
     def predicted_success(self) -> float:
@@ -300,7 +301,7 @@ class RefinementSearch:
                   max_edge_splits=self.cfg.max_edge_splits,
                   **({"dead_budget": self.cfg.dead_budget} if self.cfg.dead_budget is not None else {}))
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
-                            self.vertex_generated)
+                            self.vertex_generated, self.roadmap)
 
     def _relax(self, u: str, v: str) -> None:
         f = self.f

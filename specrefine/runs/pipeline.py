@@ -216,7 +216,7 @@ def _result_dict(exp, config: RunConfig, search, measured, t0) -> dict:
 
 
 def _pictures(maze, search, measured, out, data) -> None:
-    from ..pictures.render import render_graph_diagram, render_task, save_png
+    from ..pictures.render import render_graph_diagram, render_roadmap, render_task, save_png
 
     pr = measured.path_result
     lo, hi = data["success_ci"]
@@ -231,6 +231,10 @@ def _pictures(maze, search, measured, out, data) -> None:
         if search.path else None
     save_png(render_graph_diagram(search.graph, probs, path=search.path, title="refined task graph"),
              out / "graph.png")
+    roadmap = getattr(search, "roadmap", None)
+    if roadmap is not None and roadmap.points:
+        save_png(render_roadmap(maze, roadmap, search.graph, search.path,
+                                title=f"{maze.name} [{data['method']}]\nthe correction's roadmap"), out / "roadmap.png")
 
 
 def _jsonable(obj):

@@ -23,6 +23,7 @@ from .pipeline import RunResult
 PHASES = (("search_seconds", "search"), ("measure_seconds", "measurement"), ("calibrate_seconds", "calibration"),
           ("input_seconds", "input task (after the run's counters)"))
 FILES = (("refined.png", "the refined task and the measured episodes"), ("graph.png", "the refined task graph"),
+         ("roadmap.png", "the correction's roadmap: pooled waypoints, probes and what its searches reached"),
          ("policy.json", "the compositional policy, docs/official_env.md"),
          ("steps.jsonl", "the search, step by step"),
          ("official.json", "the policy in the official Gymnasium-Robotics environment"),
