@@ -1149,3 +1149,17 @@ def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_
         "corrector-fine-new", (["AT", "AU"], {cc.FINE: 0, cc.BACKTRACK: 4, "ours": 0}),
         {cc.FINE: 0, cc.BACKTRACK: 4})
     assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.FINE] == ("informed",)
+
+
+def test_the_reported_methods_severe_line_reads_its_cells_runs_at_0_and_cost():
+    from specrefine.experiments.corrector_claims.frontpage import severe_text
+
+    per = [{"runs": 4, "success": s, "reference_success": 1.0} for s in (1.0, 0.9, 0.97)]
+    vs = {"method": cc.MEND, "severe": per, "severe_zero": {cc.MEND: (0, 12), cc.DEEP: (1, 12)},
+          "severe_baselines": {"ours": (10, 12), "ours-repair": (7, 12)},
+          "costs": [{"proposer": "imperfect:severe", "pairs": 12, "proposer_calls_ratio": 4.4,
+                     "evaluations_ratio": 15.5, "sim_steps_ratio": 30.0}]}
+    assert severe_text(vs) == ("0.900-1.000 per U-chain, within 0.05 of the oracle on 2 of 3; runs at 0: "
+                               "ours-corrector-mend 0 of 12, ours 10 of 12, ours-repair 7 of 12; 4.40x ours's "
+                               "proposer calls and 15.50x its evaluations over 12 pairs")
+    assert severe_text(None) == severe_text({"severe": []}) == "not run yet"

@@ -169,6 +169,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         out[default_marker(method)] = default_text(next((d for d in defaults if d["method"] == method), None))
     out["point-default-gr"] = gr_text(gr_study(root) if gr is None else gr)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
+    out["reported-severe"] = severe_text(variants.get(reported(variants)))
     if held_out:
         done = [e for e in held_out["per_maze"] if e["runs"]]
         lo = min(e["success"] for e in done)
@@ -186,6 +187,25 @@ def unseen_text(sets: list[dict]) -> str:
         return "not run yet"
     return "; ".join(f"{e['mixes']} {e['zero']} of {e['runs']}" for e in sets) + " (the oracle at least " + \
         f"{min(e['oracle_min'] for e in sets):.3f} on every one of those runs' cells)"
+
+
+def severe_text(vs: dict | None) -> str:
+    """The reported variant at imperfect:severe on the U-chains: per maze against the oracle, runs at 0 beside ours's
+    and ours-repair's (the same settings' cells), and its cost over ours's there."""
+    ran = [e for e in (vs or {}).get("severe", []) if e["runs"]]
+    if not ran:
+        return "not run yet"
+    within = sum(1 for e in ran if e["success"] >= e["reference_success"] - TOLERANCE)
+    zero = {**vs["severe_zero"], **vs.get("severe_baselines", {})}
+    runs = ", ".join(f"{m} {zero[m][0]} of {zero[m][1]}" for m in (vs["method"], "ours", "ours-repair")
+                     if m in zero and zero[m][1])
+    cost = next((c for c in vs["costs"] if c["proposer"] == "imperfect:severe" and c["pairs"]), None)
+    text = (f"{min(e['success'] for e in ran):.3f}-{max(e['success'] for e in ran):.3f} per U-chain, within "
+            f"{TOLERANCE} of the oracle on {within} of {len(ran)}; runs at 0: {runs}")
+    if cost:
+        text += (f"; {_num(cost['proposer_calls_ratio'], '{:.2f}x')} ours's proposer calls and "
+                 f"{_num(cost['evaluations_ratio'], '{:.2f}x')} its evaluations over {cost['pairs']} pairs")
+    return text
 
 
 def reported(variants: dict) -> str:

@@ -86,6 +86,8 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
         study["severe_vs_corrector"] = cmp.paired_difference(cells, failed, "imperfect:severe", method, ref,
                                                              POINT_SEEDS, SCALING_MAZES)
         study["severe_zero"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES) for m in (method, ref)}
+        study["severe_baselines"] = {m: zero_runs(rows, m, "imperfect:severe", SCALING_MAZES)
+                                     for m in ("ours", "ours-repair")}
         study["costs"].append(costs(rows, "imperfect:severe", SCALING_MAZES, POINT_SEEDS, first=method))
     if method == SNAP:  # on persist's new cells, which informed it, and a last check (described)
         study["informed"] = new_study(SNAP, root, on=PERSIST)
