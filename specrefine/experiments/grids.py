@@ -595,6 +595,17 @@ def new_layouts_grid(name: str, source: str, methods: tuple, mazes: tuple, mixes
                           out=f"runs/{name.replace('-', '_')}")
 
 
+def default_oracle_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
+    """``method`` and ours with the oracle on the 17 suite mazes, seeds 0-3, centre goal points (issue 39: the point
+    mass's default rule, docs/corrector.md SECTION), into data/results/corrector/STEM_oracle.csv."""
+    return ExperimentGrid(name, f"docs/corrector.md, '{section}' (issue 39; fixed 2026-12-05 before it ran): {method} "
+                          "and ours with the oracle on the 17 suite mazes", "point",
+                          parts=(Part((method, "ours"), ("geometric",), split="seeds"),),
+                          seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
+                          code=code, table=f"data/results/corrector/{stem}_oracle.csv",
+                          out=f"runs/{name.replace('-', '_')}")
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector",
                        split_pick: str | None = None) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
@@ -980,12 +991,8 @@ GRIDS = {g.name: g for g in (
                        "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
                        code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
     # docs/corrector.md, "The point mass's default method: deep with the oracle" (fixed 2026-12-05 09:22 UTC)
-    ExperimentGrid("corrector-deep-oracle", "docs/corrector.md, 'The point mass's default method: deep with the "
-                   "oracle' (issue 39; fixed 2026-12-05 before it ran): ours-corrector-deep and ours with the oracle "
-                   "on the 17 suite mazes", "point",
-                   parts=(Part(("ours-corrector-deep", "ours"), ("geometric",), split="seeds"),),
-                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
-                   code=DEEP_CODE, table="data/results/corrector/deep_oracle.csv", out="runs/corrector_deep_oracle"),
+    default_oracle_grid("corrector-deep-oracle", "The point mass's default method: deep with the oracle",
+                        "ours-corrector-deep", "deep", DEEP_CODE),
     # docs/corrector.md, "Weak legs mended on the roadmap" (fixed 2026-12-05 10:19 UTC, before its grids ran)
     new_layouts_grid("corrector-mend-new", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-mend", "ours-corrector-deep", "ours"),
@@ -1009,12 +1016,8 @@ GRIDS = {g.name: g for g in (
                                         seeds=(0, 1), split="proposers",
                                         table="data/results/corrector/backtrack_check.csv", out="check"),
                           fixed="2026-12-05"),
-    ExperimentGrid("corrector-backtrack-oracle", "docs/corrector.md, 'Ground given back' (issue 39; fixed 2026-12-05 "
-                   "before it ran): ours-corrector-backtrack and ours with the oracle on the 17 suite mazes", "point",
-                   parts=(Part(("ours-corrector-backtrack", "ours"), ("geometric",), split="seeds"),),
-                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
-                   code=BACKTRACK_CODE, table="data/results/corrector/backtrack_oracle.csv",
-                   out="runs/corrector_backtrack_oracle"),
+    default_oracle_grid("corrector-backtrack-oracle", "Ground given back", "ours-corrector-backtrack", "backtrack",
+                        BACKTRACK_CODE),
     # docs/corrector.md, "Finer probes" (fixed 2026-12-05, before they ran)
     new_layouts_grid("corrector-fine-new", "docs/corrector.md, 'Finer probes' (issue 39; fixed 2026-12-05 before it "
                      "ran)", ("ours-corrector-fine", "ours-corrector-backtrack", "ours"),
@@ -1024,16 +1027,9 @@ GRIDS = {g.name: g for g in (
                                         seeds=(0, 1), split="proposers",
                                         table="data/results/corrector/fine_backtrack_new.csv", out="informed"),
                           fixed="2026-12-05"),
-    ExperimentGrid("corrector-fine-oracle", "docs/corrector.md, 'Finer probes' (issue 39; fixed 2026-12-05 before it "
-                   "ran): ours-corrector-fine and ours with the oracle on the 17 suite mazes", "point",
-                   parts=(Part(("ours-corrector-fine", "ours"), ("geometric",), split="seeds"),),
-                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
-                   code=FINE_CODE, table="data/results/corrector/fine_oracle.csv", out="runs/corrector_fine_oracle"),
-    ExperimentGrid("corrector-mend-oracle", "docs/corrector.md, 'Weak legs mended on the roadmap' (issue 39; fixed "
-                   "2026-12-05 before it ran): ours-corrector-mend and ours with the oracle on the 17 suite mazes",
-                   "point", parts=(Part(("ours-corrector-mend", "ours"), ("geometric",), split="seeds"),),
-                   seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
-                   code=MEND_CODE, table="data/results/corrector/mend_oracle.csv", out="runs/corrector_mend_oracle"),
+    default_oracle_grid("corrector-fine-oracle", "Finer probes", "ours-corrector-fine", "fine", FINE_CODE),
+    default_oracle_grid("corrector-mend-oracle", "Weak legs mended on the roadmap", "ours-corrector-mend", "mend",
+                        MEND_CODE),
     # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:52 UTC)
     ExperimentGrid("corrector-deep-gr", "docs/corrector.md, 'The point mass's default on Gymnasium-Robotics' maps' "
                    "(issue 39; fixed 2026-12-05 before it ran; described, no rule): the default, ours-corrector-deep, "
