@@ -1148,7 +1148,8 @@ def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_
         (["AR", "AS"], "corrector-backtrack-new", {cc.FINE: 0, cc.BACKTRACK: 4, cc.MEND: 4, "ours": 0}),
         "corrector-fine-new", (["AT", "AU"], {cc.FINE: 0, cc.BACKTRACK: 4, "ours": 0}),
         {cc.FINE: 0, cc.BACKTRACK: 4})
-    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.FINE] == ("informed",)
+    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.FINE] == ("informed", "check")
+    checked_last(tmp_path, "fine", "corrector-fine-check", "random:16x8:17", ["AV", "AW"])
 
 
 def test_the_reported_methods_severe_line_reads_its_cells_runs_at_0_and_cost():

@@ -493,6 +493,19 @@ BACKTRACK_MIXES = ("imperfect:position_sigma=0.25,p_drop_turn=0.5,p_false_openin
 #: reply names) and AU (large offsets rounded to half cells, regions of spread sizes pulled toward corners, most turns
 #: dropped, some wrong branches and false openings, uncapped legs, unparseable replies, feedback used a third of the
 #: time)
+#: layouts and error mixes no run had used before grid corrector-fine-check (docs/corrector.md, "Finer probes", its
+#: last check), made after corrector-fine-new had been looked at and before any cell of fine's adoption grids ran: two
+#: generated mazes of unusual aspect (sizes chosen, seeds drawn by random.Random(202612054)) and two of
+#: Gymnasium-Robotics' maps with diverse goals (the walls of MEDIUM and LARGE, another goal), and two mixes: AV
+#: (hallucinated routes read off a mirrored picture: most turns dropped, wrong branches, false openings, mirrored and
+#: unparseable replies, errors growing with the turns a query spans, feedback used a third of the time) and AW (coarse
+#: and deaf: large offsets rounded to whole cells, region sizes spread wide and pulled hard toward corners, wrong
+#: branches often, every leg uncapped, feedback never used)
+FINE_CHECK_MAZES = ("random:16x8:17", "random:8x16:4", "gr:LARGE_MAZE_DIVERSE_G", "gr:MEDIUM_MAZE_DIVERSE_GR")
+FINE_CHECK_MIXES = ("imperfect:position_sigma=0.3,p_drop_turn=0.6,p_false_opening=0.5,p_wrong_branch=0.7,"
+                    "p_mirror_y=0.3,p_unparseable=0.2,alpha=0.3,rho=0.3",
+                    "imperfect:position_sigma=0.5,coord_grid=1.0,radius_log_sigma=0.8,corner_pull=0.6,"
+                    "p_wrong_branch=0.6,p_uncapped=1.0,rho=0.0")
 FINE_MAZES = ("random:14x11:10", "random:11x14:75", "random:15x10:38", "random:12x13:64")
 FINE_MIXES = ("imperfect:position_sigma=0.2,p_drop_turn=0.6,p_false_opening=0.5,p_wrong_branch=0.8,alpha=0.25,rho=0.4",
               "imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,"
@@ -1028,6 +1041,9 @@ GRIDS = {g.name: g for g in (
                                         table="data/results/corrector/fine_backtrack_new.csv", out="informed"),
                           fixed="2026-12-05"),
     default_oracle_grid("corrector-fine-oracle", "Finer probes", "ours-corrector-fine", "fine", FINE_CODE),
+    new_layouts_grid("corrector-fine-check", "docs/corrector.md, 'Finer probes' (issue 39; its last check, fixed "
+                     "2026-12-05 before it ran)", ("ours-corrector-fine", "ours-corrector-backtrack", "ours"),
+                     FINE_CHECK_MAZES, FINE_CHECK_MIXES, "fine_check", code=FINE_CODE),
     default_oracle_grid("corrector-mend-oracle", "Weak legs mended on the roadmap", "ours-corrector-mend", "mend",
                         MEND_CODE),
     # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:52 UTC)

@@ -24,6 +24,8 @@ from ..grids import (
     EXTEND_MIXES,
     FALLBACK_MAZES,
     FALLBACK_MIXES,
+    FINE_CHECK_MAZES,
+    FINE_CHECK_MIXES,
     FINE_MAZES,
     FINE_MIXES,
     FRESH_MAZES,
@@ -101,10 +103,12 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                MEND: ("corrector-mend-new", MEND_MAZES, MEND_MIXES, ("AL", "AM")),
                "mend-check": ("corrector-mend-check", MEND_CHECK_MAZES, MEND_CHECK_MIXES, ("AN", "AO", "AP", "AQ")),
                BACKTRACK: ("corrector-backtrack-new", BACKTRACK_MAZES, BACKTRACK_MIXES, ("AR", "AS")),
-               FINE: ("corrector-fine-new", FINE_MAZES, FINE_MIXES, ("AT", "AU"))}
+               FINE: ("corrector-fine-new", FINE_MAZES, FINE_MIXES, ("AT", "AU")),
+               "fine-check": ("corrector-fine-check", FINE_CHECK_MAZES, FINE_CHECK_MIXES, ("AV", "AW"))}
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
-LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check", MEND: "mend-check"}
+LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check", MEND: "mend-check",
+              FINE: "fine-check"}
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
