@@ -493,6 +493,12 @@ BACKTRACK_MIXES = ("imperfect:position_sigma=0.25,p_drop_turn=0.5,p_false_openin
 #: reply names) and AU (large offsets rounded to half cells, regions of spread sizes pulled toward corners, most turns
 #: dropped, some wrong branches and false openings, uncapped legs, unparseable replies, feedback used a third of the
 #: time)
+FINE_MAZES = ("random:14x11:10", "random:11x14:75", "random:15x10:38", "random:12x13:64")
+FINE_MIXES = ("imperfect:position_sigma=0.2,p_drop_turn=0.6,p_false_opening=0.5,p_wrong_branch=0.8,alpha=0.25,rho=0.4",
+              "imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,"
+              "p_drop_turn=0.55,p_false_opening=0.2,p_wrong_branch=0.3,p_uncapped=0.5,p_unparseable=0.1,alpha=0.4,"
+              "rho=0.3")
+
 #: layouts and error mixes no run had used before grid corrector-fine-check (docs/corrector.md, "Finer probes", its
 #: last check), made after corrector-fine-new had been looked at and before any cell of fine's adoption grids ran: two
 #: generated mazes of unusual aspect (sizes chosen, seeds drawn by random.Random(202612054)) and two of
@@ -506,11 +512,6 @@ FINE_CHECK_MIXES = ("imperfect:position_sigma=0.3,p_drop_turn=0.6,p_false_openin
                     "p_mirror_y=0.3,p_unparseable=0.2,alpha=0.3,rho=0.3",
                     "imperfect:position_sigma=0.5,coord_grid=1.0,radius_log_sigma=0.8,corner_pull=0.6,"
                     "p_wrong_branch=0.6,p_uncapped=1.0,rho=0.0")
-FINE_MAZES = ("random:14x11:10", "random:11x14:75", "random:15x10:38", "random:12x13:64")
-FINE_MIXES = ("imperfect:position_sigma=0.2,p_drop_turn=0.6,p_false_opening=0.5,p_wrong_branch=0.8,alpha=0.25,rho=0.4",
-              "imperfect:position_sigma=0.45,coord_grid=0.5,radius=0.25,radius_log_sigma=0.5,corner_pull=0.4,"
-              "p_drop_turn=0.55,p_false_opening=0.2,p_wrong_branch=0.3,p_uncapped=0.5,p_unparseable=0.1,alpha=0.4,"
-              "rho=0.3")
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)

@@ -37,7 +37,7 @@ PROBE = "ours-corrector-probe"  # memory, a search that runs out of legs probing
 DEEP = "ours-corrector-deep"  # probe, each roadmap search allowed 360 evaluations instead of 120
 MEND = "ours-corrector-mend"  # deep, a live leg below 0.9 also offered the roadmap's chain over sound legs
 BACKTRACK = "ours-corrector-backtrack"  # mend, a dead leg of a dead path also offered the chain from the path's start
-FINE = "ours-corrector-fine"  # backtrack, a roadmap search's nodes probed again at half the radius once all are
+FINE = "ours-corrector-fine"  # backtrack, probes at half the radius once every first ring of a search is spent
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 #: a variant whose adoption counts runs below this success instead of runs at 0 (its docs/corrector.md section)
 ADOPTION_FLOOR = {SOUND: 0.5, MEND: 0.9, BACKTRACK: 0.9, FINE: 0.9}
