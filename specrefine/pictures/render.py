@@ -278,6 +278,16 @@ def _legend(fig, ax, items) -> None:
                handletextpad=0.4, borderaxespad=0.0)
 
 
+def _maze_figure(maze, size_px: int, title, legend_row: bool = True):
+    """A figure of ``maze``'s floor: white, a light grid at every cell, walls and hazards; (fig, ax)."""
+    fig, ax = new_figure(maze.bounds(), size_px, title, legend_row=legend_row)
+    ax.set_facecolor("white")
+    _grid(ax, maze.cell_size)
+    draw_walls(ax, maze)
+    draw_hazards(ax, maze)
+    return fig, ax
+
+
 # --- the task picture ----------------------------------------------------------------------------
 def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=None, waypoints=None, path=None,
                 title=None, size_px=768, edge_labels=None, points=None, legend=True, proposed=None):
@@ -293,11 +303,7 @@ def render_task(maze, graph=None, *, trajectories=None, success=None, lengths=No
     path: a list of graph vertices to highlight; edge_labels: {(u, v): text}; points: extra (x, y) dots.
     size_px: the longer side of the picture in pixels (the other follows the maze's aspect ratio).
     """
-    fig, ax = new_figure(maze.bounds(), size_px, title, legend_row=legend)
-    ax.set_facecolor("white")
-    _grid(ax, maze.cell_size)
-    draw_walls(ax, maze)
-    draw_hazards(ax, maze)
+    fig, ax = _maze_figure(maze, size_px, title, legend_row=legend)
     if graph is None:
         draw_maze_regions(ax, maze)
     else:
@@ -338,11 +344,7 @@ def render_roadmap(maze, roadmap, graph=None, path=None, *, title=None, size_px=
     built on from each origin they started at (green; remembered trees only, ``ours-corrector-memory`` and after);
     and the found path through the refined ``graph`` (blue). Where its searches went and where they stopped: a
     picture of why a dead leg stayed dead."""
-    fig, ax = new_figure(maze.bounds(), size_px, title)
-    ax.set_facecolor("white")
-    _grid(ax, maze.cell_size)
-    draw_walls(ax, maze)
-    draw_hazards(ax, maze)
+    fig, ax = _maze_figure(maze, size_px, title)
     draw_maze_regions(ax, maze, alpha=0.18, labels=False)
     centres = np.asarray([p.centre() for p in roadmap.points], dtype=float).reshape(-1, 2)
     probe = np.zeros(len(centres), dtype=bool)
@@ -355,12 +357,11 @@ def render_roadmap(maze, roadmap, graph=None, path=None, *, title=None, size_px=
         for v, (_, u) in tree.items():
             a, b = centres[v], origin if u is None or u < 0 else centres[u]
             ax.plot([a[0], b[0]], [a[1], b[1]], "-", color=SUCCESS, lw=1.0, alpha=0.8, zorder=3.5)
-    if graph is not None and path:
-        line = np.asarray([graph.region(v).centre() for v in path], dtype=float)
-        ax.plot(line[:, 0], line[:, 1], "-", color=PATH, lw=2.0, zorder=4)
     items = [("wall", WALL, "patch"), ("reply waypoint", PROPOSED, "line"), ("probe", SUBGOAL, "line"),
              ("leg a search built on", SUCCESS, "line")]
     if graph is not None and path:
+        line = np.asarray([graph.region(v).centre() for v in path], dtype=float)
+        ax.plot(line[:, 0], line[:, 1], "-", color=PATH, lw=2.0, zorder=4)
         items.append(("found path", PATH, "line"))
     _legend(fig, ax, items)
     return fig
