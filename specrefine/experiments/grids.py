@@ -513,6 +513,12 @@ FINE_CHECK_MIXES = ("imperfect:position_sigma=0.3,p_drop_turn=0.6,p_false_openin
                     "imperfect:position_sigma=0.5,coord_grid=1.0,radius_log_sigma=0.8,corner_pull=0.6,"
                     "p_wrong_branch=0.6,p_uncapped=1.0,rho=0.0")
 
+#: layouts no run had used before grid corrector-fine-random (docs/corrector.md, "A proposer that knows nothing"),
+#: made after corrector-fine-check had been looked at: four generated mazes larger than any before (sizes chosen,
+#: seeds drawn by random.Random(202612055)); that grid's one proposer is `random` (1-4 random free-space discs, deaf
+#: to feedback), no error model at all
+RANDOM_CHECK_MAZES = ("random:17x12:40", "random:12x17:58", "random:18x10:27", "random:15x14:40")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -1047,6 +1053,18 @@ GRIDS = {g.name: g for g in (
                      FINE_CHECK_MAZES, FINE_CHECK_MIXES, "fine_check", code=FINE_CODE),
     default_oracle_grid("corrector-mend-oracle", "Weak legs mended on the roadmap", "ours-corrector-mend", "mend",
                         MEND_CODE),
+    # docs/corrector.md, "A proposer that knows nothing" (fixed 2026-12-05 21:18 UTC, before it ran; described)
+    ExperimentGrid("corrector-fine-random", "docs/corrector.md, 'A proposer that knows nothing' (issue 39; fixed "
+                   "2026-12-05 before it ran; described): the point mass's default with the random proposer on the "
+                   "17 suite mazes and four new layouts", "point",
+                   parts=(Part(("ours-corrector-fine", "ours"), ("random",), mazes=SCALING_MAZES + OTHER_POINT_MAZES,
+                               split="seeds"),
+                          Part(("ours-corrector-fine", "ours-corrector-backtrack", "ours"), ("random",),
+                               mazes=RANDOM_CHECK_MAZES, table="data/results/corrector/fine_random_new.csv", out="new"),
+                          Part(("ours",), ("geometric",), mazes=RANDOM_CHECK_MAZES,
+                               table="data/results/corrector/fine_random_new_oracle.csv", out="oracle")),
+                   seeds=(0, 1), goal_points="centre", workers=1, code=FINE_CODE,
+                   table="data/results/corrector/fine_random.csv", out="runs/corrector_fine_random"),
     # docs/corrector.md, "The point mass's default on Gymnasium-Robotics' maps" (fixed 2026-12-05 09:52 UTC)
     ExperimentGrid("corrector-deep-gr", "docs/corrector.md, 'The point mass's default on Gymnasium-Robotics' maps' "
                    "(issue 39; fixed 2026-12-05 before it ran; described, no rule): the default, ours-corrector-deep, "
