@@ -4,7 +4,7 @@ import nbformat
 import numpy as np
 from nbformat.v4 import new_code_cell, new_notebook, new_output
 
-from specrefine.runs.notebook import MIME, _jsonable, compare, read_records
+from specrefine.runs.notebook import MIME, _jsonable, compare, for_readers, read_records
 
 
 def _nb(*payloads):
@@ -38,3 +38,16 @@ def test_exact_unless_a_tolerance_is_given():
 
 def test_jsonable_numpy_and_tuples():
     assert _jsonable({"a": np.float32(0.5), "b": (np.int64(2), np.arange(2))}) == {"a": 0.5, "b": [2, [0, 1]]}
+
+
+def test_readers_copy_keeps_values_not_the_machine():
+    """An executed copy for readers keeps every recorded value and drops the package path (a local path) and
+    papermill's timestamps."""
+    nb = nbformat.from_dict(_nb({"name": "p", "value": 0.875, "tol": 0.125, "rel": None}))
+    nb.metadata["papermill"] = {"start_time": "t"}
+    nb.cells[0].metadata["papermill"] = {"duration": 1.0}
+    for_readers(nb)
+    rec = read_records(nb)
+    assert rec["p"]["value"] == 0.875 and rec["p"]["package"] is None
+    assert "papermill" not in nb.metadata and "papermill" not in nb.cells[0].metadata
+    assert MIME not in nb.cells[0].outputs[0].metadata  # the package path was all it held

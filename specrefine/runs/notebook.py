@@ -263,6 +263,22 @@ def _git(*args) -> str:
         return ""
 
 
+def for_readers(nb):
+    """``nb`` (an executed nbformat node) without what only this run and machine had: papermill's per-cell
+    timestamps (a regenerated copy differs only where results do) and the package path ``record`` notes for the
+    test's kernel check (a local path). Returns ``nb``, changed in place."""
+    nb.metadata.pop("papermill", None)
+    for cell in nb.cells:
+        cell.metadata.pop("papermill", None)
+        cell.metadata.pop("execution", None)
+        for out in cell.get("outputs", []):
+            meta = out.get("metadata", {})
+            meta.get(MIME, {}).pop("package", None)
+            if MIME in meta and not meta[MIME]:
+                del meta[MIME]
+    return nb
+
+
 def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
     """Executed copies of the notebooks (outputs and figures) for readers; 0 when all ran."""
     import shutil
@@ -297,11 +313,7 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
                 print(log[-3000:])
                 if not out.exists():
                     continue
-            copy = nbformat.read(out, as_version=4)
-            for cell in copy.cells:  # no per-cell timestamps: a regenerated copy differs only where results do
-                cell.metadata.pop("papermill", None)
-                cell.metadata.pop("execution", None)
-            copy.metadata.pop("papermill", None)
+            copy = for_readers(nbformat.read(out, as_version=4))
             shown = ", ".join(f"{k}={v!r}" for k, v in params.items() if k != "OUT_DIR") or "the notebook's defaults"
             note = harness.get("note", "")
             header = (f"> **Executed copy** of [`notebooks/{nb.name}`](../{nb.name}) for reading: produced by "
