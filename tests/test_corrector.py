@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from test_refine_search import WALLS, _Arrive, _chain_graph, _Query, box_at
 
-from specrefine.core.graph import check_refines
+from specrefine.core.graph import TaskGraph, check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
-from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, weakest_untried
+from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, split_start, weakest_untried
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
@@ -895,6 +895,25 @@ def test_backtracking_needs_the_roadmap():
         SearchConfig(roadmap_backtrack=True)
     assert BACKTRACK == {"roadmap_backtrack": True}
     assert get_method("ours-corrector-backtrack").name == "ours-corrector-backtrack"
+
+
+def _subgoal_path() -> tuple[TaskGraph, list[str]]:
+    """S -> a -> G with a a subgoal, each edge split through two waypoints: S w1 w2 a w3 w4 G."""
+    g = TaskGraph("S")
+    for name, x in (("S", 0), ("a", 5), ("G", 10)):
+        g.add_vertex(name, box_at(x, 0))
+    g.add_edge("S", "a", WALLS)
+    g.add_edge("a", "G", WALLS)
+    g.finals = {"G"}
+    return g, ["S", *g.split_edge("S", "a", [box_at(2, 0), box_at(3, 0)]), "a",
+               *g.split_edge("a", "G", [box_at(7, 0), box_at(8, 0)]), "G"]
+
+
+def test_backtracking_never_skips_a_subgoal():
+    """backtrack's chain starts where the dead leg's split starts, a subgoal, not the path's start (found on a
+    random-proposer run of u_chain_2_subgoals whose refined graph then failed Theorem 4.1's check)."""
+    g, path = _subgoal_path()
+    assert [split_start(g, path, leg) for leg in range(6)] == [0, 0, 0, 3, 3, 3]
 
 
 # --- a window's win checked on the whole path (SearchConfig.correct_guard): method ours-corrector-guard ------------

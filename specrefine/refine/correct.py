@@ -70,7 +70,8 @@ from every node near its start, so no chain from there is sound; a chain that st
 the turn another way (docs/corrector.md, "Bridged from the leg before").
 
 ``backtrack`` (method ``ours-corrector-backtrack``): a dead leg of a dead path whose alternatives all lose is also
-offered, last, the roadmap's chain from the path's start to the dead leg's end. Ground won while the path is dead is
+offered, last, the roadmap's chain from the start of its split (the path's start, or the last subgoal before it: a chain
+never skips a subgoal) to the dead leg's end. Ground won while the path is dead is
 never given back otherwise: where the waypoints nearest the goal lie in a pocket walled off from it (a proposer that
 takes the wrong branch, or sees an opening that is not there), every later search starts in the pocket, and the
 correction spends its budget there. The chain from the start, over everything pooled and with the start's remembered
@@ -275,8 +276,9 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
     if roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0:
         yield _roadmap_options(state, leg, roadmap)
     yield from _splits(state, leg, evaluator, split_leg, may_split, min_failures)
-    if backtrack and roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0 and leg > 0:
-        yield _whole_chain(state, leg, roadmap, "backtrack", back=leg)
+    if backtrack and roadmap is not None and check.p <= 0.0 and check.results[leg].p <= 0.0 \
+            and (back := leg - split_start(graph, path, leg)) > 0:
+        yield _whole_chain(state, leg, roadmap, "backtrack", back=back)
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
         yield _whole_chain(state, leg, roadmap, "roadmap", sound=roadmap_weak)
         if bridge and leg > 0:
@@ -310,6 +312,15 @@ def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Cal
             if state.advance and check.results[leg].p <= 0.0 and 0 < live < len(fix.results):
                 options.append(("advance", *spliced(graph, path, i, j, fix.waypoints[:live])))
             yield options
+
+
+def split_start(graph: TaskGraph, path: list[str], leg: int) -> int:
+    """The index in ``path`` of the first vertex of ``leg``'s split: the vertices after it up to the leg's start are
+    all waypoints of that split. A chain may replace the legs from there, never a subgoal or the task's own vertex."""
+    i = leg
+    while i > 0 and one_split(graph, path, i - 1):
+        i -= 1
+    return i
 
 
 def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None, back: int = 0) -> list:

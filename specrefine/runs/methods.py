@@ -365,8 +365,9 @@ BACKTRACK = dict(roadmap_backtrack=True)
 register_method("ours-corrector-backtrack",
                 ours_variant(**MENDED | BACKTRACK),
                 "beyond the paper: ours-corrector-mend whose dead leg of a dead path, where its alternatives all lose, "
-                "is also offered the roadmap's chain from the path's start to the leg's end: ground won toward the "
-                "goal is otherwise never given back, and a pocket walled off from the goal holds the run",
+                "is also offered the roadmap's chain from the path's start (or the last subgoal before it) to the "
+                "leg's end: ground won toward the goal is otherwise never given back, and a pocket walled off from the "
+                "goal holds the run",
                 colour="#5e35b1")
 #: ours-corrector-fine: backtrack, whose roadmap searches give each node a second ring of probes at half the radius
 #: once every node reached has its first (docs/corrector.md, "Finer probes")
