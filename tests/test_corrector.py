@@ -16,11 +16,18 @@ from test_refine_search import WALLS, _Arrive, _chain_graph, _Query, box_at
 from specrefine.core.graph import TaskGraph, check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
-from specrefine.refine.correct import CHECK_SEED_OFFSET, PASS_SEED_STEP, Check, split_start, weakest_untried
+from specrefine.refine.correct import (
+    CHECK_SEED_OFFSET,
+    PASS_SEED_STEP,
+    Check,
+    _span_ahead,
+    split_start,
+    weakest_untried,
+)
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, FINE, GUARD, MEND, get_method
+from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, FINE, GUARD, MEND, SPAN, get_method
 
 
 class LegTable:
@@ -878,9 +885,11 @@ def test_a_dead_leg_in_a_pocket_is_rerouted_from_the_paths_start(backtrack):
 
 
 def test_bridge_and_backtrack_leave_a_run_alone_where_their_case_does_not_arise():
-    """backtrack on a live path with a weak leg (mend's case), bridge on a dead path (backtrack's): the same steps."""
+    """backtrack on a live path with a weak leg (mend's case), bridge and span on a dead path (backtrack's): the same
+    steps."""
     cases = ((WEAK_LEG, WEAK_REPLIES, "roadmap_backtrack", dict(roadmap_weak=0.9, **MENDED)),
-             (POCKET, POCKET_REPLIES, "roadmap_bridge", dict(roadmap_weak=0.9, **BACKED)))
+             (POCKET, POCKET_REPLIES, "roadmap_bridge", dict(roadmap_weak=0.9, **BACKED)),
+             (POCKET, POCKET_REPLIES, "roadmap_span", dict(roadmap_weak=0.9, **BACKED)))
     for table, replies, setting, cfg in cases:
         runs = []
         for on in (False, True):
@@ -914,6 +923,45 @@ def test_backtracking_never_skips_a_subgoal():
     random-proposer run of u_chain_2_subgoals whose refined graph then failed Theorem 4.1's check)."""
     g, path = _subgoal_path()
     assert [split_start(g, path, leg) for leg in range(6)] == [0, 0, 0, 3, 3, 3]
+
+
+def test_a_chain_past_a_weak_legs_end_stays_on_its_split_and_in_the_judges_window():
+    """span's chains end at most two vertices past the weak leg's end, never past a subgoal or the window's end."""
+    g, path = _subgoal_path()
+    assert [_span_ahead(g, path, leg, 2) for leg in range(6)] == [2, 1, 0, 2, 1, 0]
+    assert _span_ahead(g, path, 0, 1) == 1 and _span_ahead(g, path, 0, 0) == 0
+
+
+#: S -> 3 -> 6 -> 8 -> G, where 6 is a bad waypoint: every leg into it fails half its rollouts or more. The split of
+#: 3 -> 6 (4.5) and the split over 6 (5, 7: 5 -> 7 dead) lose, and no chain of sound legs ends in 6; pooled, 5 leads
+#: from 3 to 8 past it on sound legs
+BAD_WAYPOINT = {(0.0, 10.0): 0.0, (3.0, 6.0): 0.5, (3.0, 4.5): 0.25, (4.5, 6.0): 0.25, (5.0, 6.0): 0.5, (5.0, 7.0): 0.0,
+                (7.0, 6.0): 0.5, (8.0, 6.0): 0.5}
+BAD_WAYPOINT_REPLIES = {(0.0, 10.0): [3, 6, 8], (3.0, 6.0): [4.5], (3.0, 8.0): [5, 7]}
+
+
+@pytest.mark.parametrize("span", [0, 2])
+def test_a_weak_leg_into_a_bad_waypoint_is_mended_past_it(span):
+    book = AnswerBook(BAD_WAYPOINT_REPLIES)
+    g, result = run(LegTable(BAD_WAYPOINT, BAD_WAYPOINT), book, roadmap_weak=0.9, roadmap_span=span, **MENDED)
+    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
+    kinds = [t["kind"] for t in legs[0]["tried"]]
+    assert set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 8.0)}  # no proposer call more either way
+    if span:
+        assert kinds == ["split", "resplit", "span", "span"] and legs[0]["accepted"] == "span"  # to 8, to G
+        assert xs(result) == [0.0, 3.0, 5.0, 8.0, 10.0] and check_refines(result.graph, g) == []
+        assert result.predicted_success == pytest.approx(1.0)
+    else:  # mend's chain from 3 reaches 6 on no sound leg
+        assert kinds == ["split", "resplit"] and legs[0]["accepted"] is None
+        assert xs(result) == [0.0, 3.0, 6.0, 8.0, 10.0]
+
+
+def test_spanning_needs_mending_and_a_count():
+    with pytest.raises(ValueError, match="roadmap_span needs roadmap_weak"):
+        SearchConfig(roadmap_span=2, correct_roadmap=True, correct_reach=3.0)
+    with pytest.raises(ValueError, match="roadmap_span must be at least 0"):
+        SearchConfig(roadmap_span=-1, roadmap_weak=0.9, correct_roadmap=True, correct_reach=3.0)
+    assert SPAN == {"roadmap_span": 2} and get_method("ours-corrector-span").name == "ours-corrector-span"
 
 
 # --- a window's win checked on the whole path (SearchConfig.correct_guard): method ours-corrector-guard ------------

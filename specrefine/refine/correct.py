@@ -63,6 +63,13 @@ least that sound, so that the weak leg itself does not count as reaching its end
 a dead leg of a dead path, and a live leg the proposer cannot mend stays as it is (docs/corrector.md, "Weak legs
 mended on the roadmap").
 
+``roadmap_span`` (method ``ours-corrector-span``): such a weak leg is also offered, last, the roadmap's chain from its
+start to each of the next ``span`` vertices past its end that lie on its split, skipping the waypoints between, on
+legs as sound. A mend that enters the leg's end from another side changes where the next legs start, and a next leg
+that grazed a corner (alive at a few tenths, or even whole) can die from there: the mend loses its window and the
+weak leg stays. A chain past that waypoint judges the way on together (docs/corrector.md, "Weak legs mended past
+their end").
+
 ``roadmap_bridge`` (method ``ours-corrector-bridge``): where mend's chain is offered, the weak leg is also offered,
 last, the roadmap's chain from the leg before it to its end, on legs as sound, replacing the waypoint between them.
 A leg that fails because of how it is entered (the body arrives at its start too fast, or aimed into the turn) fails
@@ -210,7 +217,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
             crosscheck: bool = False, roadmap_weak: float = 0.0,
-            guard: bool = False, bridge: bool = False, backtrack: bool = False
+            guard: bool = False, bridge: bool = False, backtrack: bool = False, span: int = 0
             ) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
     split candidate of a -> b (repaired if it has a dead leg) or None; ``may_split()``: the budget allows one.
@@ -228,7 +235,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
     kept only if the path checked again from the window on scores no lower than before (module doc); ``bridge``: such a
     leg is also offered the chain from the leg before it; ``backtrack``: a dead leg of a dead path, the chain from the
-    path's start (module doc)."""
+    path's start; ``span``: such a weak leg, the chains past its end (module doc)."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
                    guard=guard)
@@ -241,7 +248,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim, roadmap_weak, bridge, backtrack)
+                               reaim, roadmap_weak, bridge, backtrack, span)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -262,13 +269,14 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
 def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable,
                   may_split: Callable[[], bool], reach: float, clearance: float, min_failures: int,
                   roadmap: Callable | None = None, reaim: Callable | None = None, roadmap_weak: float = 0.0,
-                  bridge: bool = False, backtrack: bool = False):
+                  bridge: bool = False, backtrack: bool = False, span: int = 0):
     """The alternatives to ``leg`` of the path, cheapest first, as groups of (kind, graph, path): its bypasses and,
     given ``reaim``, its waypoints re-aimed (no proposer call), then, for a dead leg of a dead path given ``roadmap``,
     the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
     Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end (and given
-    ``bridge``, from the leg before it); given ``backtrack``, for a dead leg of a dead path, the chain from the path's
-    start. Lazy: a split is asked for only when its group is reached."""
+    ``bridge``, from the leg before it; given ``span``, to each of the next ``span`` vertices of its split past its
+    end); given ``backtrack``, for a dead leg of a dead path, the chain from the path's start. Lazy: a split is asked
+    for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
     if reaim is not None:
@@ -283,6 +291,8 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
         yield _whole_chain(state, leg, roadmap, "roadmap", sound=roadmap_weak)
         if bridge and leg > 0:
             yield _whole_chain(state, leg, roadmap, "bridge", sound=roadmap_weak, back=1)
+        for ahead in range(1, _span_ahead(graph, path, leg, span) + 1):
+            yield _whole_chain(state, leg, roadmap, "span", sound=roadmap_weak, ahead=ahead)
 
 
 def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Callable, may_split: Callable[[], bool],
@@ -314,6 +324,30 @@ def _splits(state: _State, leg: int, evaluator: SubtaskEvaluator, split_leg: Cal
             yield options
 
 
+def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None, back: int = 0,
+                     ahead: int = 0) -> list:
+    """The pooled waypoints' chain for ``leg`` (``sound``: on legs at least that sound only; ``back``: from the start
+    of the leg that many before it, ``ahead``: to the end of the leg that many after it, replacing the waypoints
+    between): the whole span ("roadmap") where it reaches its end, else its live part ("advance"); none where it
+    reaches no waypoint."""
+    graph, path, first, end = state.graph, state.path, leg - back, leg + 1 + ahead
+    start = state.start_of_leg(first)
+    if start is None:
+        return []
+    found = roadmap(*_with_edge(graph, path, first, end), path[first], path[end], start,
+                    **({"sound": sound} if sound is not None else {}))
+    if not found.waypoints:
+        return []
+    return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, first, end, found.waypoints))]
+
+
+def _whole_chain(state: _State, leg: int, roadmap: Callable, kind: str, sound: float | None = None,
+                 back: int = 0, ahead: int = 0) -> list:
+    """``_roadmap_options``' chain only where it reaches its end, as an option of ``kind``."""
+    return [(kind, *option[1:]) for option in _roadmap_options(state, leg, roadmap, sound=sound, back=back,
+                                                               ahead=ahead) if option[0] == "roadmap"]
+
+
 def split_start(graph: TaskGraph, path: list[str], leg: int) -> int:
     """The index in ``path`` of the first vertex of ``leg``'s split: the vertices after it up to the leg's start are
     all waypoints of that split. A chain may replace the legs from there, never a subgoal or the task's own vertex."""
@@ -323,26 +357,13 @@ def split_start(graph: TaskGraph, path: list[str], leg: int) -> int:
     return i
 
 
-def _roadmap_options(state: _State, leg: int, roadmap: Callable, sound: float | None = None, back: int = 0) -> list:
-    """The pooled waypoints' chain for ``leg`` (``sound``: on legs at least that sound only; ``back``: from the start
-    of the leg that many before it, replacing the waypoints between): the whole span ("roadmap") where it reaches the
-    leg's end, else its live part ("advance"); none where it reaches no waypoint."""
-    graph, path, first = state.graph, state.path, leg - back
-    start = state.start_of_leg(first)
-    if start is None:
-        return []
-    found = roadmap(*_with_edge(graph, path, first, leg + 1), path[first], path[leg + 1], start,
-                    **({"sound": sound} if sound is not None else {}))
-    if not found.waypoints:
-        return []
-    return [("roadmap" if found.reaches_goal else "advance", *spliced(graph, path, first, leg + 1, found.waypoints))]
-
-
-def _whole_chain(state: _State, leg: int, roadmap: Callable, kind: str, sound: float | None = None,
-                 back: int = 0) -> list:
-    """``_roadmap_options``' chain only where it reaches the leg's end, as an option of ``kind``."""
-    return [(kind, *option[1:]) for option in _roadmap_options(state, leg, roadmap, sound=sound, back=back)
-            if option[0] == "roadmap"]
+def _span_ahead(graph: TaskGraph, path: list[str], leg: int, span: int) -> int:
+    """How many vertices past ``leg``'s end (at most ``span``) a chain from its start may end at: each skipped vertex a
+    waypoint of the leg's split, and the end within the judge's window (path[leg + 3] at most)."""
+    ahead = 0
+    while ahead < span and leg + 2 + ahead <= min(leg + 3, len(path) - 1) and one_split(graph, path, leg + ahead):
+        ahead += 1
+    return ahead
 
 
 @dataclass

@@ -125,6 +125,8 @@ class SearchConfig:
     #                               (correct.py; method ours-corrector-bridge)
     roadmap_backtrack: bool = False  # beyond the paper: a dead leg of a dead path whose alternatives all lose is also
     #                                  offered the chain from the path's start (correct.py; ours-corrector-backtrack)
+    roadmap_span: int = 0  # beyond the paper: such a weak leg is also offered the chains from its start to each of
+    #                        this many vertices of its split past its end (correct.py; 2: method ours-corrector-span)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
 
@@ -146,6 +148,10 @@ class SearchConfig:
                              "give 'policy', the agent's goal range)")
         if self.roadmap_bridge and not self.roadmap_weak:
             raise ValueError("roadmap_bridge needs roadmap_weak > 0 (it bridges the weak legs mend offers its chain)")
+        if self.roadmap_span < 0:
+            raise ValueError(f"roadmap_span must be at least 0, got {self.roadmap_span!r}")
+        if self.roadmap_span and not self.roadmap_weak:
+            raise ValueError("roadmap_span needs roadmap_weak > 0 (it spans past the weak legs mend offers its chain)")
         for name in ("roadmap_remember", "roadmap_explore", "roadmap_probe", "roadmap_weak", "roadmap_backtrack"):
             if getattr(self, name) and not self.correct_roadmap:
                 raise ValueError(f"{name} needs correct_roadmap (it changes the roadmap's searches)")
@@ -613,6 +619,7 @@ class RefinementSearch:
                                       roadmap=self._roadmap_chain if self.roadmap is not None else None,
                                       roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
                                       bridge=self.cfg.roadmap_bridge, backtrack=self.cfg.roadmap_backtrack,
+                                      span=self.cfg.roadmap_span,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,
                                       crosscheck=self.cfg.correct_crosscheck)
         return path, check

@@ -378,6 +378,15 @@ register_method("ours-corrector-fine",
                 "its eight probes, gives each node, nearest the goal first, eight more at half the distance turned by "
                 "an eighth of a turn: one ring steps over a turn in a corridor narrower than its spacing",
                 colour="#3949ab")
+#: ours-corrector-span: fine, whose weak leg is also offered the roadmap's chains from its start past its end, to each
+#: of the next two vertices of its split (docs/corrector.md, "Weak legs mended past their end")
+SPAN = dict(roadmap_span=2)
+register_method("ours-corrector-span",
+                ours_variant(**MENDED | BACKTRACK | FINE | SPAN),
+                "beyond the paper: ours-corrector-fine whose weak leg is also offered, last, the roadmap's chains from "
+                "its start to each of the next two vertices of its split past its end, on legs as sound: a mend that "
+                "enters the leg's end from another side can kill the next leg, which a chain past it judges together",
+                colour="#283593")
 #: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
 #: lower (docs/corrector.md, "A window's win checked on the whole path")
 GUARD = dict(correct_guard=True)
