@@ -519,6 +519,16 @@ FINE_CHECK_MIXES = ("imperfect:position_sigma=0.3,p_drop_turn=0.6,p_false_openin
 #: to feedback), no error model at all
 RANDOM_CHECK_MAZES = ("random:17x12:40", "random:12x17:58", "random:18x10:27", "random:15x14:40")
 
+#: layouts and error mixes no run had used before grid corrector-span-new (docs/corrector.md, "Weak legs mended past
+#: their end"), made after corrector-fine-random's suite cells had been looked at (its four weak runs informed span):
+#: four generated mazes (sizes chosen, seeds drawn by random.Random(202612056)), and two proposers: the random one (no
+#: route, deaf to feedback) and AX (small regions pulled toward corners, large offsets, dropped turns, wrong branches
+#: and false openings, uncapped legs, errors growing with the turns a query spans, feedback used half the time)
+SPAN_MAZES = ("random:13x13:48", "random:16x9:91", "random:9x16:32", "random:14x12:90")
+SPAN_MIXES = ("random",
+              "imperfect:position_sigma=0.4,radius=0.25,radius_log_sigma=0.4,corner_pull=0.5,p_drop_turn=0.4,"
+              "p_wrong_branch=0.4,p_false_opening=0.3,p_uncapped=0.5,alpha=0.3,rho=0.5")
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -527,6 +537,7 @@ DEEP_CODE = "d788274"  # the commit of ours-corrector-deep's code (SearchConfig.
 MEND_CODE = "cc4f1d3"  # the commit of ours-corrector-mend's code (SearchConfig.roadmap_weak)
 BACKTRACK_CODE = "e3a8950"  # the commit of ours-corrector-backtrack's code (SearchConfig.roadmap_backtrack)
 FINE_CODE = "dc68dea"  # the commit of ours-corrector-fine's code (SearchConfig.roadmap_rings)
+SPAN_CODE = "968b715"  # the commit of ours-corrector-span's code (SearchConfig.roadmap_span)
 
 
 def six_cell_grid(name: str, section: str, method: str, **grid) -> ExperimentGrid:
@@ -1051,6 +1062,18 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-fine-check", "docs/corrector.md, 'Finer probes' (issue 39; its last check, fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-fine", "ours-corrector-backtrack", "ours"),
                      FINE_CHECK_MAZES, FINE_CHECK_MIXES, "fine_check", code=FINE_CODE),
+    # docs/corrector.md, "Weak legs mended past their end" (fixed 2026-12-05 21:35 UTC, before they ran)
+    new_layouts_grid("corrector-span-new", "docs/corrector.md, 'Weak legs mended past their end' (issue 39; fixed "
+                     "2026-12-05 before it ran)", ("ours-corrector-span", "ours-corrector-fine", "ours"),
+                     SPAN_MAZES, SPAN_MIXES, "span_new", code=SPAN_CODE),
+    *centre_variant_grids("corrector-span", "Weak legs mended past their end", "ours-corrector-span", "span",
+                          code=SPAN_CODE,
+                          informed=Part(("ours-corrector-span",), ("random",), mazes=SCALING_MAZES + OTHER_POINT_MAZES,
+                                        seeds=(0, 1), table="data/results/corrector/span_fine_random.csv",
+                                        out="informed"),
+                          fixed="2026-12-05"),
+    default_oracle_grid("corrector-span-oracle", "Weak legs mended past their end", "ours-corrector-span", "span",
+                        SPAN_CODE),
     default_oracle_grid("corrector-mend-oracle", "Weak legs mended on the roadmap", "ours-corrector-mend", "mend",
                         MEND_CODE),
     # docs/corrector.md, "A proposer that knows nothing" (fixed 2026-12-05 21:18 UTC, before it ran; described)
