@@ -1129,10 +1129,8 @@ def test_backtrack_is_judged_against_mend_on_its_new_layouts_and_mends_last_chec
     assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.BACKTRACK] == ("informed",)
 
 
-def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_cells_that_informed_it(tmp_path):
-    """corrector-fine: backtrack its reference and control; backtrack's new cells (AR, AS), where backtrack ended runs
-    at 0, are its informed part; its new layouts (AT, AU) put it, backtrack and ours side by side; its adoption counts
-    runs below 0.9 and asks for no more than backtrack's; adopted only where backtrack is."""
+def fine_rate():
+    """Fine 0.99; backtrack and mend 0 on one AR/AS and one AT/AU layout under those mixes (fine's grids)."""
     base, dead = backtrack_rate(), {"random:14x10:83", "random:12x13:64"}
 
     def rate(maze, method, proposer):
@@ -1141,8 +1139,17 @@ def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_
         if method in (cc.BACKTRACK, cc.MEND) and proposer in cc.BACKTRACK_MIXES + cc.FINE_MIXES:
             return 0.0 if cc.table_name(maze) in dead else 0.99
         return base(maze, method, proposer)
+    return rate
 
-    laid = (*THROUGH_BACKTRACK, "corrector-backtrack-new", "corrector-fine", "corrector-fine-suite")
+
+THROUGH_FINE = (*THROUGH_BACKTRACK, "corrector-backtrack-new", "corrector-fine", "corrector-fine-suite")
+
+
+def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_cells_that_informed_it(tmp_path):
+    """corrector-fine: backtrack its reference and control; backtrack's new cells (AR, AS), where backtrack ended runs
+    at 0, are its informed part; its new layouts (AT, AU) put it, backtrack and ours side by side; its adoption counts
+    runs below 0.9 and asks for no more than backtrack's; adopted only where backtrack is."""
+    rate, laid = fine_rate(), THROUGH_FINE
     _, vs = judged_after_its_reference(
         tmp_path, "fine", rate, laid,
         (["AR", "AS"], "corrector-backtrack-new", {cc.FINE: 0, cc.BACKTRACK: 4, cc.MEND: 4, "ours": 0}),
@@ -1150,6 +1157,46 @@ def test_fine_is_judged_against_backtrack_on_its_new_layouts_and_backtracks_new_
         {cc.FINE: 0, cc.BACKTRACK: 4})
     assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.FINE] == ("informed", "check")
     checked_last(tmp_path, "fine", "corrector-fine-check", "random:16x8:17", ["AV", "AW"])
+
+
+def test_span_is_judged_against_fine_on_its_new_layouts_and_the_random_proposers_cells_that_informed_it(tmp_path):
+    """corrector-span: fine its reference and control; fine's cells with the random proposer (corrector-fine-random's
+    suite part), where fine ended runs weak, are its informed part; its new layouts (the random proposer and AX) put
+    it, fine and ours side by side; its adoption counts runs below 0.9 and asks for no more than fine's."""
+    base, dead = fine_rate(), {"u_chain_5", "random:16x9:91"}
+
+    def rate(maze, method, proposer):
+        if method == cc.SPAN:
+            return 0.99
+        if method == cc.FINE and proposer in cc.SPAN_MIXES:
+            return 0.0 if cc.table_name(maze) in dead else 0.99
+        return base(maze, method, proposer)
+
+    laid = (*THROUGH_FINE, "corrector-fine-new", "corrector-fine-random", "corrector-span", "corrector-span-suite")
+    _, vs = judged_after_its_reference(
+        tmp_path, "span", rate, laid,
+        (["random"], "corrector-fine-random", {cc.SPAN: 0, cc.FINE: 2, cc.BACKTRACK: 0, "ours": 0}),
+        "corrector-span-new", (["random", "AX"], {cc.SPAN: 0, cc.FINE: 4, "ours": 0}), {cc.SPAN: 0, cc.FINE: 4})
+    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.SPAN] == ("informed",)
+
+
+def test_the_random_proposers_statement_needs_every_maze_near_the_oracle_and_no_run_at_0(tmp_path):
+    """corrector-fine-random (described): fine against the oracle per maze (fine's oracle grid on the suite, the
+    grid's own on its new layouts); the statement holds only when every maze is within 0.05 and no run is at 0."""
+    from specrefine.experiments.corrector_claims.anyproposer import any_study, any_text
+
+    assert any_study(tmp_path) is None and any_text(None) == "not run yet"
+    lay_all_parts(tmp_path, "corrector-fine-oracle", lambda maze, m, p: 1.0)
+    lay_all_parts(tmp_path, "corrector-fine-random", lambda maze, m, p: 0.0 if m == "ours" else 0.99)
+    d = any_study(tmp_path)
+    assert d["verdict"] == "holds" and d["runs"] == 42 and d["zero"] == d["weak"] == 0 and not d["misses"]
+    assert len(d["per_maze"]) == 21 and sum(e["new"] for e in d["per_maze"]) == 4
+    lay_all_parts(tmp_path, "corrector-fine-random",
+                  lambda maze, m, p: 0.0 if m == "ours" or maze == "u_chain_5" and m != "ours" and p == "random"
+                  else 0.99)
+    d = any_study(tmp_path)
+    assert d["verdict"] == "does not hold" and d["misses"] == ["u_chain_5"] and d["zero"] == d["weak"] == 2
+    assert "not on u_chain_5 0.000 against 1.000" in any_text(d) and any_text(d).endswith("does not hold")
 
 
 def test_the_reported_methods_severe_line_reads_its_cells_runs_at_0_and_cost():

@@ -43,6 +43,7 @@ from ..grids import (
     ROADMAP_MIXES,
     SNAP_MIXES,
     SOUND_MIXES,
+    SPAN_MIXES,
 )
 from .ant import (
     ANT_BEFORE,
@@ -90,6 +91,7 @@ from .common import (
     ROADMAP,
     SNAP,
     SOUND,
+    SPAN,
     SPREAD,
     TRIM,
     VARIANT_GRIDS,
@@ -127,7 +129,8 @@ __all__ = [
     "POINT_SEEDS", "POLISH",
     "PRECISE", "PROBE",
     "PROBE_MIXES", "REAIM", "RECHECK", "REDRAW", "ROADMAP", "ROADMAP_CHECK_MIXES", "ROADMAP_MIXES", "SNAP",
-    "SNAP_MIXES", "SOUND", "SOUND_MIXES", "SPARING", "SPARING_FRUGAL", "SPREAD", "SpecrefineError", "Successor",
+    "SNAP_MIXES", "SOUND", "SOUND_MIXES", "SPAN", "SPAN_MIXES", "SPARING", "SPARING_FRUGAL", "SPREAD",
+    "SpecrefineError", "Successor",
     "TRIM", "VARIANTS", "VARIANT_GRIDS", "WIDE", "add_arguments", "ant_fresh_study", "ant_study", "fill",
     "fresh_study", "front", "held_out_study", "levers_markdown", "levers_study", "load", "main", "markdown",
     "new_study", "point_study", "reference_of", "reported", "rules_table", "run", "table_name", "unseen",

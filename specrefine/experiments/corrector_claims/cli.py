@@ -10,6 +10,7 @@ from pathlib import Path
 from ...core.runfolder import ensure_dir, locked, save_figure, write_atomic
 from .. import ant_fresh
 from .ant import ant_fresh_study, ant_study
+from .anyproposer import any_markdown, any_study
 from .default import default_markdown, default_studies, default_verdict, gr_markdown, gr_study
 from .figure import rooms_figure
 from .frontpage import fill, front
@@ -38,17 +39,18 @@ def run(args, p) -> int:
     point, ant, held_out = point_study(), ant_study(), held_out_study()
     levers = levers_study()
     variants = variant_studies()
-    fresh, defaults, gr = ant_fresh_study(), default_studies(), gr_study()
+    fresh, defaults, gr, anyone = ant_fresh_study(), default_studies(), gr_study(), any_study()
     record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "ant_fresh": fresh, **variants,
-              "point_default": defaults, "point_default_gr": gr,
+              "point_default": defaults, "point_default_gr": gr, "any_proposer": anyone,
               "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)]
               + [default_verdict(d) for d in defaults],
               "front": front(point, held_out, levers=levers, ant=ant, fresh=fresh, defaults=defaults, gr=gr,
-                             **variants)}
+                             anyone=anyone, **variants)}
     with locked(ensure_dir(args.out)):
         tail = "\n".join(ant_fresh.markdown(fresh)) + "\n" if fresh else ""
         tail += "".join("\n".join(default_markdown(d)) + "\n" for d in defaults)
         tail += "\n".join(gr_markdown(gr)) + "\n" if gr else ""
+        tail += "\n".join(any_markdown(anyone)) + "\n" if anyone else ""
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants) + tail)
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)

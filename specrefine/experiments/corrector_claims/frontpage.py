@@ -13,6 +13,7 @@ from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT
 from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD
+from .anyproposer import any_study, any_text
 from .common import (
     ADOPTABLE,
     COST_CAP,
@@ -108,10 +109,10 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
           ant: dict | None = None, fresh: dict | None = None, defaults: list[dict] | None = None,
-          gr: dict | None = None, **variants: dict | None) -> dict[str, str]:
+          gr: dict | None = None, anyone: dict | None = None, **variants: dict | None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
     their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s; ``defaults`` and ``gr``: ``default_studies``'s and
-    ``gr_study``'s, computed here when not given)."""
+    ``gr_study``'s, ``anyone`` ``any_study``'s, computed here when not given)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
@@ -168,6 +169,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     for _, method in DEFAULTS:
         out[default_marker(method)] = default_text(next((d for d in defaults if d["method"] == method), None))
     out["point-default-gr"] = gr_text(gr_study(root) if gr is None else gr)
+    out["any-proposer"] = any_text(any_study(root) if anyone is None else anyone)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     out["reported-severe"] = severe_text(variants.get(reported(variants)))
     if held_out:

@@ -41,6 +41,7 @@ from ..grids import (
     MEND_MIXES,
     NEW_MAZES,
     NEW_MIXES,
+    OTHER_POINT_MAZES,
     PROBE_MAZES,
     PROBE_MIXES,
     ROADMAP_CHECK_MAZES,
@@ -48,10 +49,13 @@ from ..grids import (
     ROADMAP_MAZES,
     ROADMAP_MIXES,
     ROOT,
+    SCALING_MAZES,
     SNAP_MAZES,
     SNAP_MIXES,
     SOUND_MAZES,
     SOUND_MIXES,
+    SPAN_MAZES,
+    SPAN_MIXES,
 )
 from .common import (
     ADVANCE,
@@ -72,6 +76,7 @@ from .common import (
     SHOWN_BESIDE,
     SNAP,
     SOUND,
+    SPAN,
     VARIANT_GRIDS,
     VARIANTS,
     episodes_of,
@@ -104,6 +109,8 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                "mend-check": ("corrector-mend-check", MEND_CHECK_MAZES, MEND_CHECK_MIXES, ("AN", "AO", "AP", "AQ")),
                BACKTRACK: ("corrector-backtrack-new", BACKTRACK_MAZES, BACKTRACK_MIXES, ("AR", "AS")),
                FINE: ("corrector-fine-new", FINE_MAZES, FINE_MIXES, ("AT", "AU")),
+               "fine-random": ("corrector-fine-random", SCALING_MAZES + OTHER_POINT_MAZES, ("random",), ("random",)),
+               SPAN: ("corrector-span-new", SPAN_MAZES, SPAN_MIXES, ("random", "AX")),
                "fine-check": ("corrector-fine-check", FINE_CHECK_MAZES, FINE_CHECK_MIXES, ("AV", "AW"))}
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
@@ -112,7 +119,7 @@ LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-ch
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
-               DEEP: PROBE, BACKTRACK: "mend-check", FINE: BACKTRACK}
+               DEEP: PROBE, BACKTRACK: "mend-check", FINE: BACKTRACK, SPAN: "fine-random"}
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {m: ("informed",) * (m in INFORMED_ON or m == SNAP) + ("check",) * (m in LAST_CHECK or m == SNAP)
                   for m in (SNAP, *INFORMED_ON, *LAST_CHECK)}
