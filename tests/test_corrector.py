@@ -795,19 +795,25 @@ WEAK_REPLIES = {(0.0, 10.0): [3, 6], (3.0, 6.0): [4.5], (3.0, 10.0): [5, 8]}
 MENDED = dict(correct_rollouts=4, correct_reach=3.5, correct_roadmap=True)
 
 
+def weak_leg_run(table: dict, replies: dict, **cfg):
+    """A run over ``table`` with ``replies`` and mend's settings (and ``cfg``) -> (the proposer's answer book, the
+    input graph, the result, the kinds tried on the weak leg x0 -> x1, its correct-leg step)."""
+    book = AnswerBook(replies)
+    g, result = run(LegTable(table, table), book, **cfg, **MENDED)
+    leg = next(s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"])
+    return book, g, result, [t["kind"] for t in leg["tried"]], leg
+
+
 @pytest.mark.parametrize("weak", [0.0, 0.9])
 def test_a_weak_leg_the_proposer_cannot_mend_is_offered_the_roadmaps_chain_only_below_the_level(weak):
-    book = AnswerBook(WEAK_REPLIES)
-    g, result = run(LegTable(WEAK_LEG, WEAK_LEG), book, roadmap_weak=weak, **MENDED)
-    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
-    kinds = [t["kind"] for t in legs[0]["tried"]]
+    book, g, result, kinds, leg = weak_leg_run(WEAK_LEG, WEAK_REPLIES, roadmap_weak=weak)
     assert kinds[:2] == ["split", "resplit"] and set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 10.0)}
     if weak:  # the pooled 5 mends the leg: no proposer call more
-        assert kinds[-1] == "roadmap" and legs[0]["accepted"] == "roadmap"
+        assert kinds[-1] == "roadmap" and leg["accepted"] == "roadmap"
         assert xs(result) == [0.0, 3.0, 5.0, 6.0, 10.0] and check_refines(result.graph, g) == []
         assert result.predicted_success == pytest.approx(1.0)
     else:  # deep's correction: the roadmap is for dead legs of dead paths only
-        assert "roadmap" not in kinds and legs[0]["accepted"] is None
+        assert "roadmap" not in kinds and leg["accepted"] is None
         assert xs(result) == [0.0, 3.0, 6.0, 10.0] and not any(s["event"] == "roadmap" for s in result.steps)
 
 
@@ -839,19 +845,16 @@ BADLY_REPLIES = WEAK_REPLIES | {(3.0, 10.0): [2.5, 5, 8]}
 
 @pytest.mark.parametrize("bridge", [False, True])
 def test_a_weak_leg_no_chain_from_its_start_mends_is_bridged_from_the_leg_before(bridge):
-    book = AnswerBook(BADLY_REPLIES)
-    g, result = run(LegTable(ENTERED_BADLY, ENTERED_BADLY), book, roadmap_weak=0.9, roadmap_bridge=bridge, **MENDED)
-    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
-    kinds = [t["kind"] for t in legs[0]["tried"]]
+    book, g, result, kinds, leg = weak_leg_run(ENTERED_BADLY, BADLY_REPLIES, roadmap_weak=0.9, roadmap_bridge=bridge)
     assert set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 10.0)}  # no proposer call more either way
     mended = [s for s in result.steps if s["event"] == "roadmap" and s["edge"] == ["x0", "x1"]]
     assert mended and not mended[0]["reaches_end"]  # mend's chain from 3 reaches no further on sound legs
     if bridge:
-        assert kinds == ["split", "resplit", "bridge"] and legs[0]["accepted"] == "bridge"
+        assert kinds == ["split", "resplit", "bridge"] and leg["accepted"] == "bridge"
         assert xs(result) == [0.0, 2.5, 6.0, 10.0] and check_refines(result.graph, g) == []
         assert result.predicted_success == pytest.approx(1.0)
     else:
-        assert kinds == ["split", "resplit"] and legs[0]["accepted"] is None
+        assert kinds == ["split", "resplit"] and leg["accepted"] is None
         assert xs(result) == [0.0, 3.0, 6.0, 10.0]
 
 
@@ -942,17 +945,14 @@ BAD_WAYPOINT_REPLIES = {(0.0, 10.0): [3, 6, 8], (3.0, 6.0): [4.5], (3.0, 8.0): [
 
 @pytest.mark.parametrize("span", [0, 2])
 def test_a_weak_leg_into_a_bad_waypoint_is_mended_past_it(span):
-    book = AnswerBook(BAD_WAYPOINT_REPLIES)
-    g, result = run(LegTable(BAD_WAYPOINT, BAD_WAYPOINT), book, roadmap_weak=0.9, roadmap_span=span, **MENDED)
-    legs = [s for s in result.steps if s["event"] == "correct-leg" and s["edge"] == ["x0", "x1"]]
-    kinds = [t["kind"] for t in legs[0]["tried"]]
+    book, g, result, kinds, leg = weak_leg_run(BAD_WAYPOINT, BAD_WAYPOINT_REPLIES, roadmap_weak=0.9, roadmap_span=span)
     assert set(book.queries) == {(0.0, 10.0), (3.0, 6.0), (3.0, 8.0)}  # no proposer call more either way
     if span:
-        assert kinds == ["split", "resplit", "span", "span"] and legs[0]["accepted"] == "span"  # to 8, to G
+        assert kinds == ["split", "resplit", "span", "span"] and leg["accepted"] == "span"  # to 8, to G
         assert xs(result) == [0.0, 3.0, 5.0, 8.0, 10.0] and check_refines(result.graph, g) == []
         assert result.predicted_success == pytest.approx(1.0)
     else:  # mend's chain from 3 reaches 6 on no sound leg
-        assert kinds == ["split", "resplit"] and legs[0]["accepted"] is None
+        assert kinds == ["split", "resplit"] and leg["accepted"] is None
         assert xs(result) == [0.0, 3.0, 6.0, 8.0, 10.0]
 
 
