@@ -921,11 +921,13 @@ def _subgoal_path() -> tuple[TaskGraph, list[str]]:
                *g.split_edge("a", "G", [box_at(7, 0), box_at(8, 0)]), "G"]
 
 
-def test_backtracking_never_skips_a_subgoal():
+def test_backtracking_and_bridging_never_skip_a_subgoal():
     """backtrack's chain starts where the dead leg's split starts, a subgoal, not the path's start (found on a
-    random-proposer run of u_chain_2_subgoals whose refined graph then failed Theorem 4.1's check)."""
+    random-proposer run of u_chain_2_subgoals whose refined graph then failed Theorem 4.1's check); bridge's starts a
+    leg before only where the vertex between is one of that split's waypoints (legs 1, 2, 4, 5 here, not 3)."""
     g, path = _subgoal_path()
     assert [split_start(g, path, leg) for leg in range(6)] == [0, 0, 0, 3, 3, 3]
+    assert [split_start(g, path, leg) < leg for leg in range(6)] == [False, True, True, False, True, True]
 
 
 def test_a_chain_past_a_weak_legs_end_stays_on_its_split_and_in_the_judges_window():

@@ -235,7 +235,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
     kept only if the path checked again from the window on scores no lower than before (module doc); ``bridge``: such a
     leg is also offered the chain from the leg before it; ``backtrack``: a dead leg of a dead path, the chain from the
-    path's start; ``span``: such a weak leg, the chains past its end (module doc)."""
+    start of its split; ``span``: such a weak leg, the chains past its end (module doc). No chain skips a subgoal."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
                    guard=guard)
@@ -275,8 +275,8 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
     the chain over the pooled waypoints (no proposer call), then its split, then its split over the next waypoint (one
     Algorithm 1 each), then, for a live leg below ``roadmap_weak``, the pooled waypoints' chain to its end (and given
     ``bridge``, from the leg before it; given ``span``, to each of the next ``span`` vertices of its split past its
-    end); given ``backtrack``, for a dead leg of a dead path, the chain from the path's start. Lazy: a split is asked
-    for only when its group is reached."""
+    end); given ``backtrack``, for a dead leg of a dead path, the chain from the start of its split. Lazy: a split is
+    asked for only when its group is reached."""
     graph, path, check = state.graph, state.path, state.check
     yield [("bypass", *bypassed(graph, path, i, j)) for i, j in bypasses(graph, path, leg, reach, clearance)]
     if reaim is not None:
@@ -289,7 +289,7 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
         yield _whole_chain(state, leg, roadmap, "backtrack", back=back)
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
         yield _whole_chain(state, leg, roadmap, "roadmap", sound=roadmap_weak)
-        if bridge and leg > 0:
+        if bridge and split_start(graph, path, leg) < leg:  # the waypoint it replaces is one of the leg's split
             yield _whole_chain(state, leg, roadmap, "bridge", sound=roadmap_weak, back=1)
         for ahead in range(1, _span_ahead(graph, path, leg, span) + 1):
             yield _whole_chain(state, leg, roadmap, "span", sound=roadmap_weak, ahead=ahead)
