@@ -817,6 +817,17 @@ def test_a_weak_leg_the_proposer_cannot_mend_is_offered_the_roadmaps_chain_only_
         assert xs(result) == [0.0, 3.0, 6.0, 10.0] and not any(s["event"] == "roadmap" for s in result.steps)
 
 
+def test_the_roadmap_merges_a_waypoint_near_one_pooled_and_finds_the_same_nodes_in_reach():
+    roadmap = Roadmap(reach=2.0)
+    roadmap.add([Disc(0.0, 0, 0.3), Disc(0.2, 0, 0.3), Disc(1.0, 0, 0.3), Disc(0.25 + 1e-12, 0, 0.3)])
+    assert [float(p.centre()[0]) for p in roadmap.points] == [0.0, 1.0, 0.25 + 1e-12]  # 0.2 merged, 0.25+ kept
+    roadmap.add([Disc(3.0, 0, 0.3), Disc(2.0, 0, 0.3)])
+    centres = np.asarray([p.centre() for p in roadmap.points] + [(4.0, 0.0)])
+    to_goal = np.abs(centres[:, 0] - 4.0)
+    every = [v for v in np.argsort(to_goal) if np.linalg.norm(centres[v] - centres[0]) <= roadmap.reach]
+    assert roadmap._untried(centres[0], centres, to_goal, exclude=set()) == every == [4, 1, 2, 0]
+
+
 def test_a_weak_legs_chain_builds_on_sound_legs_only_and_leaves_the_roadmaps_memory_alone():
     roadmap = Roadmap(reach=3.5, remember=True)
     roadmap.add([Disc(1.5, 0, 0.5)])
