@@ -82,7 +82,7 @@ AGENTS: dict[str, Agent] = {
         # centre goal points passed their rule on the corrector's grids (docs/corrector.md, "Aimed at the centre");
         # the corrector, adopted with erring proposers, passed its rule with the oracle (docs/corrector.md, "The point
         # mass's default method")
-        default_goal_points="centre", default_method="ours-corrector-fine"),
+        default_goal_points="centre", default_method="ours-corrector-span"),
     "ant": Agent(
         name="ant",
         description="the MuJoCo Ant, a four-legged walking robot (as in Gymnasium-Robotics AntMaze); it is slow to "

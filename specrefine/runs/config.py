@@ -103,7 +103,7 @@ class RunConfig:
 
     agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
     method: str | None = option(None, _methods_help, choices=_methods,
-                                shown="the preset's: best: ours-corrector-fine for point, ours-corrector-redraw "
+                                shown="the preset's: best: ours-corrector-span for point, ours-corrector-redraw "
                                       "for ant; paper: ours")
     proposer: str = option("geometric", _proposers_help)
     spec: str | None = option(None, "the task as an expression over the maze's letters: a..z its subgoal regions, G "
