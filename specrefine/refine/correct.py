@@ -289,7 +289,7 @@ def _alternatives(state: _State, leg: int, evaluator: SubtaskEvaluator, split_le
         yield _whole_chain(state, leg, roadmap, "backtrack", back=back)
     if roadmap is not None and check.p > 0.0 and 0.0 < check.results[leg].p < roadmap_weak:
         yield _whole_chain(state, leg, roadmap, "roadmap", sound=roadmap_weak)
-        if bridge and split_start(graph, path, leg) < leg:  # the waypoint it replaces is one of the leg's split
+        if bridge and leg > 0 and one_split(graph, path, leg - 1):  # it replaces a waypoint of the leg's split
             yield _whole_chain(state, leg, roadmap, "bridge", sound=roadmap_weak, back=1)
         for ahead in range(1, _span_ahead(graph, path, leg, span) + 1):
             yield _whole_chain(state, leg, roadmap, "span", sound=roadmap_weak, ahead=ahead)
@@ -348,6 +348,12 @@ def _whole_chain(state: _State, leg: int, roadmap: Callable, kind: str, sound: f
                                                                ahead=ahead) if option[0] == "roadmap"]
 
 
+def window_end(path: list[str], leg: int) -> int:
+    """The index in ``path`` where the judge's window around ``leg`` ends: the leg, the one after it (a split over the
+    next waypoint spans both) and the one after them."""
+    return min(leg + 3, len(path) - 1)
+
+
 def split_start(graph: TaskGraph, path: list[str], leg: int) -> int:
     """The index in ``path`` of the first vertex of ``leg``'s split: the vertices after it up to the leg's start are
     all waypoints of that split. A chain may replace the legs from there, never a subgoal or the task's own vertex."""
@@ -359,9 +365,9 @@ def split_start(graph: TaskGraph, path: list[str], leg: int) -> int:
 
 def _span_ahead(graph: TaskGraph, path: list[str], leg: int, span: int) -> int:
     """How many vertices past ``leg``'s end (at most ``span``) a chain from its start may end at: each skipped vertex a
-    waypoint of the leg's split, and the end within the judge's window (path[leg + 3] at most)."""
+    waypoint of the leg's split, and the end within the judge's window."""
     ahead = 0
-    while ahead < span and leg + 2 + ahead <= min(leg + 3, len(path) - 1) and one_split(graph, path, leg + ahead):
+    while ahead < span and leg + 2 + ahead <= window_end(path, leg) and one_split(graph, path, leg + ahead):
         ahead += 1
     return ahead
 
@@ -412,7 +418,7 @@ class _State:
         the path (and the path is checked again from the window on) when it wins. -> (what was judged, the kind
         accepted or None)."""
         graph, path, check = self.graph, self.path, self.check
-        e = min(leg + 3, len(path) - 1)  # the window: legs s .. e-1, path[s] to path[e], from where an option departs
+        e = window_end(path, leg)  # the window: legs s .. e-1, path[s] to path[e], from where an option departs
         s = min([max(leg - 1, 0)] + [_kept(path, p) for _, _, p in options])
         start = self.start_of_leg(s)
         current = self.score(Check(results=check.results[s:e]))

@@ -29,12 +29,13 @@ def any_study(root: Path = ROOT) -> dict | None:
     if not any(r["method"] == FINE for r in rows):
         return None
     oracle_rows = load(GRIDS[ORACLE_GRID].tables, root) + rows
-    mazes = tuple(table_name(m) for m in g.parts[0].mazes + RANDOM_CHECK_MAZES)
+    mazes, new = (tuple(table_name(m) for m in g.parts[0].mazes + RANDOM_CHECK_MAZES),
+                  {table_name(m) for m in RANDOM_CHECK_MAZES})
     entries = []
     for maze in mazes:
         runs = [float(r["success_rate"]) for r in rows if (r["maze"], r["method"], r["proposer"]) ==
                 (maze, FINE, PROPOSER) and r["seed"] in g.seeds and cmp.is_done(r)]
-        entries.append({"maze": maze, "new": maze in {table_name(m) for m in RANDOM_CHECK_MAZES}, "runs": len(runs),
+        entries.append({"maze": maze, "new": maze in new, "runs": len(runs),
                         "success": _rate(episodes_of(rows, maze, FINE, PROPOSER, g.seeds)),
                         "ours": _rate(episodes_of(rows, maze, "ours", PROPOSER, g.seeds)),
                         "oracle": _rate(episodes_of(oracle_rows, maze, *ORACLE, g.seeds)),
