@@ -7,6 +7,7 @@ import pytest
 from test_comparison import row, write_csv
 
 from specrefine.experiments import corrector_claims as cc
+from specrefine.experiments.corrector_claims.ant import ANT_ERRING
 from specrefine.experiments.grids import GRIDS, OTHER_POINT_MAZES, SCALING_MAZES
 
 LEVELS = ("imperfect:mild", "imperfect:moderate")
@@ -396,6 +397,24 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc.ant_text(ant)) is adopted
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
+
+
+@pytest.mark.parametrize("calls, verdict", [(9, "holds"), (12, "does not hold")])
+def test_the_ants_cost_is_judged_against_ours_on_the_scaling_grids_erring_cells(tmp_path, calls, verdict):
+    """Issue 39's cap on the Ant: the corrector the Ant's rules read, its mean proposer calls and evaluations over
+    ours's on the cells both ran (ours from the scaling grid's imperfect:moderate runs, ANT_ERRING)."""
+    lay(tmp_path, rates)
+    lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9, calls_of=lambda m: calls)  # 10 evaluations a run
+    ours = [row(maze, "ours", 0.5, s) | {"agent": "ant", "proposer_calls": 3, "evaluations": 5, "sim_steps": 500}
+            for maze in SCALING_MAZES for s in (0, 1, 2)]
+    (tmp_path / ANT_ERRING).parent.mkdir(parents=True, exist_ok=True)
+    write_csv(tmp_path / ANT_ERRING, ours)
+    ant = cc.ant_study(tmp_path)
+    found = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if "cost at most" in v["rule"]
+                 and v["rule"].startswith("Ant ("))
+    assert found["rule"] == f"Ant ({cc.ANT_METHOD}), imperfect:moderate: cost at most 3.0x ours (proposer calls, " \
+                            "evaluations)"
+    assert found["value"] == f"{calls / 3:.2f}x, 2.00x over 27 pairs" and found["verdict"] == verdict
 
 
 def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path):
@@ -931,15 +950,17 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     lines = table.strip().splitlines()
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
-    # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its two candidates and each successor
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 4 + len(cc.ANT_SUCCESSORS)
+    # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its cost, its two candidates and each
+    # successor
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5 + len(cc.ANT_SUCCESSORS)
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
-    ant = rules[-4 - len(cc.ANT_SUCCESSORS):]
+    ant = rules[-5 - len(cc.ANT_SUCCESSORS):]
     assert ant[0].startswith(f"Ant ({cc.ANT_METHOD})") and ant[1].startswith(f"Ant: {cc.ANT_METHOD}")
-    assert ant[2].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
-    assert ant[3].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
-    assert [r.split(" in place of ")[0] for r in ant[4:]] == [f"Ant: {m}" for m in (cc.SPARING, cc.SPARING_FRUGAL,
+    assert ant[2] == f"Ant ({cc.ANT_METHOD}), imperfect:moderate: cost at most 3.0x ours (proposer calls, evaluations)"
+    assert ant[3].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
+    assert ant[4].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
+    assert [r.split(" in place of ")[0] for r in ant[5:]] == [f"Ant: {m}" for m in (cc.SPARING, cc.SPARING_FRUGAL,
                                                                                    cc.WIDE)]
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"

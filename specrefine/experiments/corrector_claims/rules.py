@@ -62,9 +62,21 @@ def _ant_verdicts(ant: dict) -> list[dict]:
                 + (f": {', '.join(low)}" if low else ""),
                 "verdict": _verdict(not low, complete)},
                {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
-                "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")}]
+                "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")},
+               _ant_cost_verdict(ant)]
     return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]] + \
         [_successor_verdict(s, ant["method"]) for s in ant["successors"]]
+
+
+def _ant_cost_verdict(ant: dict) -> dict:
+    """Issue 39's cap on the Ant: the read corrector's mean proposer calls and evaluations over ours's, on the cells
+    both ran (ours from the scaling grid's erring runs)."""
+    c = ant["costs"]
+    return {"rule": f"Ant ({ant['method']}), imperfect:moderate: cost at most {COST_CAP}x ours (proposer calls, "
+                    "evaluations)",
+            "value": f"{_num(c['proposer_calls_ratio'], '{:.2f}x')}, {_num(c['evaluations_ratio'], '{:.2f}x')} over "
+                     f"{c['pairs']} pairs",
+            "verdict": _cost_verdict(c)}
 
 
 def _successor_verdict(s: dict, read: str) -> dict:
