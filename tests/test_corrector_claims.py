@@ -304,7 +304,7 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
                                  f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
                                  f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet. "
                                  f"{cc.ANT_SPARING_FRUGAL} ({cc.SPARING_FRUGAL}): no cell yet. "
-                                 f"{cc.ANT_WIDE} ({cc.WIDE}): no cell yet")
+                                 f"{cc.ANT_WIDE} ({cc.WIDE}): no cell yet. {cc.ANT_SPAN} ({cc.SPAN}): no cell yet")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -441,7 +441,8 @@ def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_t
                 if " in place of " in v["rule"]}
     assert ant["method"] == "ours-corrector-wide"
     assert verdicts == {"Ant: ours-corrector-wide": "adopted", f"Ant: {cc.SPARING}": "holds; ours-corrector-wide read",
-                        f"Ant: {cc.SPARING_FRUGAL}": "undecided (0 of 27 cells)"}
+                        f"Ant: {cc.SPARING_FRUGAL}": "undecided (0 of 27 cells)",
+                        f"Ant: {cc.SPAN}": "undecided (0 of 27 cells)"}
     assert cc.ANT_SUCCESSORS[cc.ANT_WIDE].method == cc.WIDE == "ours-corrector-wide"
 
 
@@ -961,7 +962,7 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     assert ant[3].startswith(f"Ant: {cc.REAIM} - {cc.ANT_METHOD}")
     assert ant[4].startswith(f"Ant: {cc.REDRAW} - {cc.ANT_METHOD}")
     assert [r.split(" in place of ")[0] for r in ant[5:]] == [f"Ant: {m}" for m in (cc.SPARING, cc.SPARING_FRUGAL,
-                                                                                   cc.WIDE)]
+                                                                                   cc.WIDE, cc.SPAN)]
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
 

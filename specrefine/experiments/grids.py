@@ -1021,6 +1021,10 @@ GRIDS = {g.name: g for g in (
                        "and 42; fixed 2026-12-05 06:48 UTC when ant-oracle-wide-scaling's rule 2 held, before its "
                        "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
                        code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
+    ant_corrector_grid("ant-corrector-span", "docs/corrector.md, 'The point mass's corrector on the Ant' (issue 39; "
+                       "fixed 2026-12-06 01:53 UTC before its first cell ran; one pilot cell informed it): "
+                       "ant-corrector-redraw's cells with the point mass's default corrector, ours-corrector-span",
+                       "ant_span", code="ac7537b", method="ours-corrector-span", split_pick="confirmed"),
     # docs/corrector.md, "The point mass's default method: deep with the oracle" (fixed 2026-12-05 09:22 UTC)
     default_oracle_grid("corrector-deep-oracle", "The point mass's default method: deep with the oracle",
                         "ours-corrector-deep", "deep", DEEP_CODE),

@@ -11,7 +11,7 @@ from ...core.results import wilson_ci
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT, SCALING_MAZES
-from .common import METHOD, NON_INFERIORITY, as_ours, costs, episodes_of, load, paired_rows, zero_runs
+from .common import METHOD, NON_INFERIORITY, SPAN, as_ours, costs, episodes_of, load, paired_rows, zero_runs
 
 ANT_FLOOR = 0.85
 #: the Ant's rules read this grid and its method (docs/corrector.md, "The Ant with a confirmed pick")
@@ -52,13 +52,15 @@ class Successor:
 ANT_SPARING, SPARING = "ant-corrector-sparing", "ours-corrector-sparing"
 ANT_SPARING_FRUGAL, SPARING_FRUGAL = "ant-corrector-sparing-frugal", "ours-corrector-sparing-frugal"
 ANT_WIDE, WIDE = "ant-corrector-wide", "ours-corrector-wide"
+ANT_SPAN = "ant-corrector-span"  # ours-corrector-span, the point mass's default (common.SPAN)
 #: each successor by its grid (docs/corrector.md, "A gate for the Ant's corrector", "Sparing and frugal: the Ant",
-#: "The wide pass with an erring proposer")
+#: "The wide pass with an erring proposer", "The point mass's corrector on the Ant")
 ANT_SUCCESSORS = {
     ANT_SPARING: Successor(SPARING, ANT_REDRAW, "A gate for the Ant's corrector", calls=0.75),
     ANT_SPARING_FRUGAL: Successor(SPARING_FRUGAL, ANT_REDRAW, "Sparing and frugal: the Ant", calls=0.5,
                                   control=ANT_SPARING),
-    ANT_WIDE: Successor(WIDE, ANT_REDRAW, "The wide pass with an erring proposer", margin=None)}
+    ANT_WIDE: Successor(WIDE, ANT_REDRAW, "The wide pass with an erring proposer", margin=None),
+    ANT_SPAN: Successor(SPAN, ANT_REDRAW, "The point mass's corrector on the Ant", calls=0.5)}
 ANT_SEEDS = GRIDS[ANT_GRID].seeds
 ANT_ONESHOT = "data/results/ant/scaling/oneshot_centre.csv"
 ANT_ORACLE = "data/results/ant/scaling/ours_centre.csv"
