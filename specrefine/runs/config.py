@@ -34,12 +34,30 @@ from ..core.paper import PAPER
 
 
 def option(default, help, *, flags: tuple[str, ...] = (), type: Callable | None = None,
-           choices: Callable[[], Iterable[str]] | None = None, shown: str | None = None, metavar: str | None = None):
+           choices: Callable[[], Iterable[str]] | None = None, shown: str | Callable[[], str] | None = None,
+           metavar: str | None = None):
     """A documented field: ``help`` (a string, or a function returning one when the parser is built), the command
     line's ``flags`` (default ``--field-name``), its argparse ``type``, ``choices`` (a function: read when the parser
-    is built, so a registry's later entries are in it) and how the default is ``shown`` in the help."""
+    is built, so a registry's later entries are in it) and how the default is ``shown`` in the help (a string, or a
+    function returning one when the parser is built)."""
     meta = dict(help=help, flags=flags, type=type, choices=choices, shown=shown, metavar=metavar)
     return field(default=default, metadata=meta)
+
+
+def _per_agent(attr: str) -> str:
+    """Each agent's ``Agent.ATTR`` (the best measured setting), as help shows a default: one value where every agent
+    has it, else 'X for point, Y for ant'."""
+    from ..core.agents import AGENTS
+
+    values = {name: getattr(agent, attr) for name, agent in AGENTS.items()}
+    if len(set(values.values())) == 1:
+        return next(iter(values.values()))
+    return ", ".join(f"{value} for {name}" for name, value in values.items())
+
+
+def _preset_default(attr: str) -> Callable[[], str]:
+    """How help shows a setting the preset decides: the agents' ``default_ATTR`` under best, the paper's under paper."""
+    return lambda: f"the preset's: best: {_per_agent(f'default_{attr}')}; paper: {getattr(PAPER, attr)}"
 
 
 def _agents() -> list[str]:
@@ -103,8 +121,7 @@ class RunConfig:
 
     agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
     method: str | None = option(None, _methods_help, choices=_methods,
-                                shown="the preset's: best: ours-corrector-span for point, ours-corrector-redraw "
-                                      "for ant; paper: ours")
+                                shown=_preset_default("method"))
     proposer: str = option("geometric", _proposers_help)
     spec: str | None = option(None, "the task as an expression over the maze's letters: a..z its subgoal regions, G "
                                     "the goal, S implicit; '->' sequence, '|' choice (binds tighter), parentheses; "
@@ -117,8 +134,8 @@ class RunConfig:
     policy: str | None = option(None, "policy checkpoint: a path, 'shipped' (data/policies/AGENT.pt), the name of "
                                       "another shipped one (e.g. ant_stage5: data/policies/ant_stage5.pt) or "
                                       "'scripted' (the point mass's straight-line controller)", type=policy_arg,
-                                shown="the agent's adopted policy: shipped for point, ant_stage5 for ant, under "
-                                      "either preset")
+                                shown=lambda: f"the agent's adopted policy: {_per_agent('default_policy')}, "
+                                                      "under either preset")
     w: int = option(PAPER.w, "candidate edge splits per VLM query (at most 20)", flags=("-w",),
                     type=bounded_int("w"))
     d: int = option(PAPER.d, "VLM query rounds per edge split (at most 10)", flags=("-d",), type=bounded_int("d"))
@@ -128,7 +145,7 @@ class RunConfig:
                                           "adaptive: the vertex refinement's candidates in stages, stopping those "
                                           "that cannot be chosen (same full budget for what is chosen; far fewer "
                                           "simulator steps)", choices=_evaluations,
-                                    shown="the preset's: best: fixed for point, adaptive for ant; paper: fixed")
+                                    shown=_preset_default("evaluation"))
     goal_points: str | None = option(None,
                                      "where a subtask's policy aims when its goal vertex has no fixed point, in the "
                                      "search, the measurement and the calibration alike: sampled (a point drawn in "
@@ -136,7 +153,7 @@ class RunConfig:
                                      "centre in every rollout; beyond the paper) or clear (the region's point "
                                      "farthest from walls, the nearest such to its centre; beyond the paper)",
                                      choices=_goal_points,
-                                     shown="the preset's: best: centre; paper: sampled")
+                                     shown=_preset_default("goal_points"))
     switching: str = option("at-region", "when a leg's policy is fed the next goal point, in the search, the "
                                          "measurement, the calibration and the saved policy alike: at-region (on "
                                          "entering the goal region, the paper's rule) or slow-turn (a leg that starts "
@@ -147,8 +164,7 @@ class RunConfig:
                                           "Algorithm 1) or confirmed (a later round's pick kept only if it beats the "
                                           "first round's best on the same fresh rollouts; beyond the paper, "
                                           "docs/ant_experiments.md 'lever 5')", choices=_split_picks,
-                                    shown="the preset's: best: estimate for point, confirmed for ant; paper: "
-                                          "estimate")
+                                    shown=_preset_default("split_pick"))
     preset: str = option("best", "what the settings left unset default to: best (the best measured settings, per "
                                  "agent) or paper (every rule of the paper they depart from: docs/choices.md, "
                                  "'Presets')", choices=lambda: PRESETS)
@@ -221,6 +237,7 @@ def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[s
         meta = f.metadata
         text = meta["help"]() if callable(meta["help"]) else meta["help"]
         shown = meta["shown"] if meta["shown"] is not None else f.default
+        shown = shown() if callable(shown) else shown
         kwargs = dict(default=[f.default] if name in many else f.default, help=f"{text}{suffix} (default: {shown})")
         if name in many:
             kwargs["nargs"] = "+"
