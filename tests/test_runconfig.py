@@ -8,6 +8,7 @@ from dataclasses import asdict, fields
 import pytest
 
 from specrefine.cli import build_parser, main
+from specrefine.core.agents import AGENTS
 from specrefine.runs.config import DEFAULTS, RunConfig
 from specrefine.runs.pipeline import refine_maze
 
@@ -29,6 +30,21 @@ def test_every_field_is_an_option(capsys):
         agent="point", method="symbolic", proposer="random", spec="a -> G", seed=4, rollouts=8, episodes=9,
         policy="scripted", w=4, d=1, k=6, evaluation="adaptive", goal_points="centre", switching="slow-turn",
         split_pick="confirmed", preset="paper")
+
+
+def test_help_prints_every_options_text_as_written_and_its_preset_defaults_from_the_agents(capsys):
+    """A help text's '%' is a per cent sign, not argparse's formatting (a method's 'losing about 1 % and' once printed
+    argparse's own parameters there), and the preset's defaults come from the agents' registry."""
+    with pytest.raises(SystemExit):
+        main(["refine", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "finds legs losing about 1 % and their alternatives" in out and "'container'" not in out
+    assert "(default: the preset's: best: fixed for point, adaptive for ant; paper: fixed)" in out
+    assert "(default: the preset's: best: centre; paper: sampled)" in out  # one value where every agent has it
+    refine = build_parser()._subparsers._group_actions[0].choices["refine"]
+    method = next(a for a in refine._actions if a.dest == "method").help
+    assert method.endswith(f"(default: the preset's: best: {AGENTS['point'].default_method} for point, "
+                           f"{AGENTS['ant'].default_method} for ant; paper: ours)")
 
 
 def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_path, capsys):

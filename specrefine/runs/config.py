@@ -238,7 +238,8 @@ def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[s
         text = meta["help"]() if callable(meta["help"]) else meta["help"]
         shown = meta["shown"] if meta["shown"] is not None else f.default
         shown = shown() if callable(shown) else shown
-        kwargs = dict(default=[f.default] if name in many else f.default, help=f"{text}{suffix} (default: {shown})")
+        help_text = f"{text}{suffix} (default: {shown})".replace("%", "%%")  # a per cent sign, not argparse's format
+        kwargs = dict(default=[f.default] if name in many else f.default, help=help_text)
         if name in many:
             kwargs["nargs"] = "+"
         argtype = types.get(name, meta["type"])
