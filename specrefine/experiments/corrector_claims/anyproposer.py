@@ -29,8 +29,8 @@ def any_study(root: Path = ROOT) -> dict | None:
     if not any(r["method"] == FINE for r in rows):
         return None
     oracle_rows = load(GRIDS[ORACLE_GRID].tables, root) + rows
-    mazes, new = (tuple(table_name(m) for m in g.parts[0].mazes + RANDOM_CHECK_MAZES),
-                  {table_name(m) for m in RANDOM_CHECK_MAZES})
+    new = {table_name(m) for m in RANDOM_CHECK_MAZES}
+    mazes = tuple(table_name(m) for m in g.parts[0].mazes + RANDOM_CHECK_MAZES)
     entries = []
     for maze in mazes:
         runs = [float(r["success_rate"]) for r in rows if (r["maze"], r["method"], r["proposer"]) ==
