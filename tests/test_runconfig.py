@@ -47,6 +47,18 @@ def test_help_prints_every_options_text_as_written_and_its_preset_defaults_from_
                            f"{AGENTS['ant'].default_method} for ant; paper: ours)")
 
 
+def test_usage_names_the_method_and_a_wrong_one_lists_every_choice(capsys):
+    """The usage line says METHOD (the list of methods is the option's help), and a wrong name still lists them."""
+    with pytest.raises(SystemExit):
+        main(["refine", "--help"])
+    usage = capsys.readouterr().out.split("\n\n")[0]
+    assert "[--method METHOD]" in usage and "ours-corrector" not in usage
+    with pytest.raises(SystemExit):
+        main(["refine", "u_maze", "--method", "nope"])
+    err = capsys.readouterr().err
+    assert "invalid choice: 'nope'" in err and all(f"'{name}'" in err for name in ("ours", "vlm-oneshot", "dirl"))
+
+
 def test_result_json_records_the_config_and_the_keywords_build_the_same_one(tmp_path, capsys):
     assert main(["refine", "u_maze", "--method", "dirl", "--rollouts", "8", "--episodes", "16", "-k", "7",
                  "--out", str(tmp_path / "cli")]) == 0

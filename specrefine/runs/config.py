@@ -120,7 +120,7 @@ class RunConfig:
     measured settings, and ``preset="paper"`` the paper's rules."""
 
     agent: str = option("point", "point: fast point mass, 1 m cells; ant: MuJoCo Ant, 4 m cells", choices=_agents)
-    method: str | None = option(None, _methods_help, choices=_methods,
+    method: str | None = option(None, _methods_help, choices=_methods, metavar="METHOD",
                                 shown=_preset_default("method"))
     proposer: str = option("geometric", _proposers_help)
     spec: str | None = option(None, "the task as an expression over the maze's letters: a..z its subgoal regions, G "
