@@ -296,15 +296,17 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     ant = cc.ant_study(tmp_path)
     rule = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
     assert rule["verdict"] == "not run yet" and cc.ANT_GRID in rule["value"]
-    assert cc.ant_text(ant) == (f"{cc.ANT_GRID} ({cc.ANT_METHOD}): no cell yet. {cc.ANT_BEFORE} (ours-corrector, "
-                                 "stopped): u_chain_1 0.800 (3 runs), u_chain_2 0.800 (3 runs), u_chain_2_subgoals "
-                                 "0.800 (1 run); below 0.85 on 3 of 3 mazes run. Difference on the cells both ran: "
-                                 f"no cell in both yet. {cc.ANT_REAIM} ({cc.REAIM}): no cell yet; {cc.REAIM} - "
-                                 f"{cc.ANT_METHOD} on the cells both ran: no cell in both yet. {cc.ANT_REDRAW} "
-                                 f"({cc.REDRAW}): no cell yet; {cc.REDRAW} - {cc.ANT_METHOD} on the cells both ran: "
-                                 f"no cell in both yet. {cc.ANT_SPARING} ({cc.SPARING}): no cell yet. "
-                                 f"{cc.ANT_SPARING_FRUGAL} ({cc.SPARING_FRUGAL}): no cell yet. "
-                                 f"{cc.ANT_WIDE} ({cc.WIDE}): no cell yet. {cc.ANT_SPAN} ({cc.SPAN}): no cell yet")
+    rows = {r.split(" | ")[0].removeprefix("| "): r for r in cc.ant_text(ant).splitlines() if r.startswith("| ant-")}
+    assert list(rows) == [f"{g} ({m})" for g, m in [(cc.ANT_GRID, cc.ANT_METHOD), (cc.ANT_BEFORE, "ours-corrector"),
+                                                    *cc.ANT_CANDIDATES.items(),
+                                                    *((g, s.method) for g, s in cc.ANT_SUCCESSORS.items())]]
+    confirm = rows[f"{cc.ANT_GRID} ({cc.ANT_METHOD})"]
+    assert confirm.endswith(" | — | — | — (the reference) | — | read by the Ant's rules |")
+    assert rows[f"{cc.ANT_BEFORE} (ours-corrector)"].endswith(
+        "| 0.800 (3) | 0.800 (3) | 0.800 (1) | — | — | — | — | — | — | 3 of 3 | vs ours-corrector-confirm: no cell in "
+        "both yet | — | stopped |")
+    span = rows[f"{cc.ANT_SPAN} ({cc.SPAN})"]
+    assert span.endswith(f"| — | vs {cc.REDRAW}: no cell in both yet | — | 0 of 27 cells |")
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9 if maze != "u_chain_5" else 0.84)
     ant = cc.ant_study(tmp_path)
     assert [e["runs"] for e in ant["per_maze"]] == [3] * 9 and sum(e["runs"] for e in ant["before"]) == 7
@@ -316,8 +318,9 @@ def test_the_ants_rules_read_the_confirm_grid_with_ours_corrector_beside_and_the
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_5 | 3 | 0.840 [" in md and "| 1 | 0.800 |" in md and "| 0 | — |" in md
     assert f"{cc.ANT_METHOD} - ours-corrector on the cells both ran: +0.100 [" in md
-    text = cc.ant_text(ant)
-    assert "below 0.85 on 1 of 9 mazes run" in text and "over 7 cells (Newcombe 95 %, pooled). " in text
+    before = next(r for r in cc.ant_text(ant).splitlines() if r.startswith(f"| {cc.ANT_BEFORE} "))
+    assert " | 1 of 9 | — (the reference) | " in cc.ant_text(ant) and f" vs {cc.ANT_METHOD}, 7 | " in before
+    assert "| 0.900 (3) | 0.840 (3) | 0.900 (3) | 1 of 9 |" in cc.ant_text(ant)
 
 
 @pytest.mark.parametrize("grid", sorted(cc.ANT_CANDIDATES))
@@ -337,7 +340,7 @@ def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rule
     assert rules[0]["rule"].startswith(f"Ant ({cc.ANT_METHOD})")
     mine = next(v for v in rules if v["rule"].startswith(f"Ant: {method} - "))
     assert mine["verdict"] == "undecided (2 of 27 cells)"
-    assert f"{grid} ({method}): u_chain_1 {rate:.3f} (2 runs); below" in cc.ant_text(ant)
+    assert f"| {grid} ({method}) | {rate:.3f} (2) | — |" in cc.ant_text(ant)
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert "| u_chain_1 | 3 | 0.900 [" in md and f"`{cc.ANT_BEFORE}`, ours-corrector" in md
     assert f"{method} - {cc.ANT_METHOD} on the cells both ran: +{rate - 0.9:.3f} [" in md
@@ -351,7 +354,8 @@ def test_a_candidate_corrector_is_shown_beside_confirm_and_read_by_the_ants_rule
     assert mine["verdict"] == ("adopted" if adopted else "not adopted")
     assert rules[0]["verdict"] == ("holds" if adopted else "does not hold")  # 0.99 everywhere; confirm 0.84
     assert rules[0]["rule"].startswith(f"Ant ({method if adopted else cc.ANT_METHOD})")
-    assert ("(adopted: the Ant's rules read" in cc.ant_text(ant)) is adopted
+    read = next(r for r in cc.ant_text(ant).splitlines() if r.endswith("| read by the Ant's rules |"))
+    assert read.startswith(f"| {grid if adopted else cc.ANT_GRID} (")
 
 
 def test_where_both_candidates_hold_the_one_with_the_higher_pooled_success_is_read(tmp_path):
@@ -394,7 +398,8 @@ def test_a_cheaper_corrector_is_read_in_place_of_redraw_only_where_every_part_of
     assert (ant["grid"], ant["method"]) == ((cc.ANT_SPARING, cc.SPARING) if adopted else (cc.ANT_REDRAW, cc.REDRAW))
     floor = next(v for v in cc.verdicts(cc.point_study(tmp_path), ant) if v["rule"].startswith("Ant ("))
     assert floor["rule"].startswith(f"Ant ({cc.SPARING if adopted else cc.REDRAW})")
-    assert ("(adopted: the Ant's rules read ant-corrector-sparing)" in cc.ant_text(ant)) is adopted
+    read = next(r for r in cc.ant_text(ant).splitlines() if r.endswith("| read by the Ant's rules |"))
+    assert read.startswith(f"| {cc.ANT_SPARING if adopted else cc.ANT_REDRAW} (")
     md = cc.markdown(cc.point_study(tmp_path), ant)
     assert f"| u_chain_5 | 3 | {rate:.3f} [" in md and f"{cc.SPARING} - {cc.REDRAW} on the cells both ran: " in md
 

@@ -86,7 +86,7 @@ def ant_study(root: Path = ROOT) -> dict | None:
         now, grid, method = best["study"], best["grid"], best["method"]
     return now | {"grid": grid, "method": method, "confirm": confirm["per_maze"], "before": before["per_maze"],
                   "paired": _ant_paired((ANT_GRID, ANT_METHOD), (ANT_BEFORE, METHOD), root), "candidates": candidates,
-                  "successors": successors}
+                  "successors": successors, "confirm_costs": confirm["costs"], "before_costs": before["costs"]}
 
 
 def ant_fresh_study(root: Path = ROOT) -> dict | None:

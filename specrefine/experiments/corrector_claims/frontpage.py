@@ -12,7 +12,7 @@ from ...core.runfolder import locked, write_atomic
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT
-from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD
+from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD, ANT_SEEDS
 from .anyproposer import any_study, any_text
 from .common import (
     ADOPTABLE,
@@ -31,7 +31,7 @@ from .common import (
     _known,
 )
 from .default import DEFAULTS, default_marker, default_studies, default_text, default_verdict, gr_study, gr_text
-from .formats import _ant_paired_text, _cost_text, _num, _paired_text, _partial, _signed
+from .formats import _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
     _adoption_rows,
@@ -217,25 +217,58 @@ def reported(variants: dict) -> str:
 
 
 def ant_text(ant: dict) -> str:
-    """The Ant's cells per maze in ANT_GRID, ANT_BEFORE and each of ANT_CANDIDATES, with their pooled differences
-    from ANT_GRID."""
-    def cells(per_maze):
+    """The Ant's grids as one markdown table (README's front page): success per maze pooled over the seeds run (runs
+    in brackets), mazes below ANT_FLOOR, the pooled difference from the corrector each grid was judged against
+    (ANT_METHOD for ANT_BEFORE and the candidates, the followed one for a successor), the mean cost over ours's and
+    where the grid stands."""
+    rows = [(ANT_GRID, ANT_METHOD, ant["confirm"], None, None, ant["confirm_costs"], None),
+            (ANT_BEFORE, METHOD, ant["before"], ant["paired"], ANT_METHOD, ant["before_costs"], "stopped")]
+    rows += [(c["grid"], c["method"], c["per_maze"], c["paired"], ANT_METHOD, c["cost_vs_ours"], None)
+             for c in ant["candidates"]]
+    rows += [(c["grid"], c["method"], c["per_maze"], c["paired"], c["followed_method"], c["cost_vs_ours"], None)
+             for c in ant["successors"]]
+    mazes = [e["maze"] for e in ant["confirm"]]
+    head = (["grid (method)"] + [_maze_label(m) for m in mazes]
+            + [f"below {ANT_FLOOR}", "difference [95 % CI], cells", "proposer calls, evaluations over ours", "status"])
+    table = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for grid, method, per_maze, paired, against, cost, status in rows:
         ran = [e for e in per_maze if e["runs"]]
         low = sum(e["success"] < ANT_FLOOR for e in ran)
-        return (", ".join(f"{e['maze']} {e['success']:.3f} ({e['runs']} run{'s' * (e['runs'] > 1)})" for e in ran)
-                + f"; below {ANT_FLOOR} on {low} of {len(ran)} mazes run") if ran else "no cell yet"
-    return (f"{ANT_GRID} ({ANT_METHOD}): {cells(ant['confirm'])}. {ANT_BEFORE} (ours-corrector, stopped): "
-            f"{cells(ant['before'])}. Difference on the cells both ran: {_ant_paired_text(ant['paired'])}. "
-            + ". ".join(f"{c['grid']} ({c['method']}): {cells(c['per_maze'])}; {c['method']} - {ANT_METHOD} on the "
-                        f"cells both ran: {_ant_paired_text(c['paired'])}"
-                        + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
-                        for c in ant["candidates"])
-            + "".join(f". {c['grid']} ({c['method']}): {cells(c['per_maze'])}" + (
-                          f"; {c['method']} - {c['followed_method']} on the cells both ran: "
-                          f"{_ant_paired_text(c['paired'])}; its mean cost over {c['followed_method']}'s: "
-                          f"{_cost_text(c['cost_vs_followed'])}" if c["paired"]["cells"] else "")
-                      + (f" (adopted: the Ant's rules read {c['grid']})" if c["grid"] == ant["grid"] else "")
-                      for c in ant["successors"]))
+        cells = [f"{e['success']:.3f} ({e['runs']})" if e["runs"] else "—" for e in per_maze]
+        table.append("| " + " | ".join(
+            [f"{grid} ({method})", *cells, f"{low} of {len(ran)}" if ran else "—",
+             _against(paired, against), _cost_pair(cost),
+             "read by the Ant's rules" if grid == ant["grid"] else status or _cells_run(per_maze)]) + " |")
+    return ("\n" + f"Success per maze pooled over seeds {min(ANT_SEEDS)}-{max(ANT_SEEDS)} (runs in brackets; Un: U-chain of n rooms, "
+            "s: with subgoals), `imperfect:moderate`, stage 5:\n\n" + "\n".join(table) + "\n\n")
+
+
+def _maze_label(maze: str) -> str:
+    """u_chain_3_subgoals -> U3s (another name as it is)."""
+    m = re.fullmatch(r"u_chain_(\d+)(_subgoals)?", maze)
+    return f"U{m.group(1)}{'s' * bool(m.group(2))}" if m else maze
+
+
+def _against(paired: dict | None, against: str | None) -> str:
+    if paired is None:
+        return "— (the reference)"
+    if not paired["cells"]:
+        return f"vs {against}: no cell in both yet"
+    lo, hi = paired["ci"]
+    return f"{paired['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] vs {against}, {paired['cells']}"
+
+
+def _cost_pair(cost: dict) -> str:
+    if not cost["pairs"]:
+        return "—"
+    return (f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, {_num(cost['evaluations_ratio'], '{:.2f}x')} "
+            f"({cost['pairs']} pairs)")
+
+
+def _cells_run(per_maze: list[dict]) -> str:
+    done = sum(e["runs"] for e in per_maze)
+    expected = len(per_maze) * len(ANT_SEEDS)
+    return "complete" if done >= expected else f"{done} of {expected} cells"
 
 
 def _levers_text(lv: dict) -> str:
