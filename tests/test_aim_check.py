@@ -41,15 +41,15 @@ def test_a_json_beside_the_report_that_is_a_link_is_refused_before_any_work(tmp_
     assert (tmp_path / "target.json").read_text() == "keep" and not (tmp_path / "aim.md").exists()
 
 
-def test_readme_and_the_corrector_doc_quote_the_shipped_check():
+def test_the_corrector_doc_quotes_the_shipped_check():
     check = json.loads((ROOT / "data/results/corrector/diagnosis/aim.json").read_text())
     lost, bins = check["lost"], check["bins"]
     (stop,) = {f"{d * 1000:.1f} mm" for d in check["stop_offset"]}  # the same rest offset at every point
-    readme = " ".join((ROOT / "README.md").read_text().split())
     doc = " ".join((ROOT / "docs/corrector.md").read_text().split())
-    assert f"{lost['timeout']} of the {sum(lost.values())} episodes" in readme
-    assert f"{lost['timeout']} of their {sum(lost.values())} lost episodes" in doc
-    for text in (readme, doc):
+    moved, section = doc.split("The point mass's corrector, step by step (moved from README")[1], doc  # README's, once
+    assert f"{lost['timeout']} of the {sum(lost.values())} episodes" in moved
+    assert f"{lost['timeout']} of their {sum(lost.values())} lost episodes" in section
+    for text in (moved, section):
         assert f"rest {stop} from the point it aims at" in text
         assert f"{bins[0]['loss'] * 100:.2f} %" in text and f"{bins[2]['loss'] * 100:.2f} %" in text
     assert f"by a median of {np.median(check['gaps']) * 1000:.1f} mm" in doc

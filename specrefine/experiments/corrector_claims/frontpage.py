@@ -239,8 +239,9 @@ def ant_text(ant: dict) -> str:
             [f"{grid} ({method})", *cells, f"{low} of {len(ran)}" if ran else "—",
              _against(paired, against), _cost_pair(cost),
              "read by the Ant's rules" if grid == ant["grid"] else status or _cells_run(per_maze)]) + " |")
-    return ("\n" + f"Success per maze pooled over seeds {min(ANT_SEEDS)}-{max(ANT_SEEDS)} (runs in brackets; Un: U-chain of n rooms, "
-            "s: with subgoals), `imperfect:moderate`, stage 5:\n\n" + "\n".join(table) + "\n\n")
+    seeds = f"{min(ANT_SEEDS)}-{max(ANT_SEEDS)}"
+    return ("\n" + f"Success per maze pooled over seeds {seeds} (runs in brackets; Un: U-chain of n rooms, s: with "
+            "subgoals), `imperfect:moderate`, stage 5:\n\n" + "\n".join(table) + "\n\n")
 
 
 def _maze_label(maze: str) -> str:
