@@ -173,3 +173,11 @@ def test_a_confirmed_split_pick_runs_ours_as_the_method_ours_confirm_does(tmp_pa
     assert by_setting.data["split_pick"] == "confirmed" and by_method.data["split_pick"] == "estimate"
     steps = (tmp_path / "setting" / "steps.jsonl").read_text()
     assert '"confirm": {' in steps  # a later round's pick was confirmed here: the setting reached the split
+
+
+def test_readme_names_each_agents_default_method_and_the_papers():
+    """README's Command line says which method a run uses by default: the agents' registry, not a copy that ages."""
+    text = " ".join((ROOT / "README.md").read_text().split())
+    point, ant = AGENTS["point"].default_method, AGENTS["ant"].default_method
+    assert f"By default a run uses the corrector (`{point}` for the point mass, `{ant}` for the Ant)" in text
+    assert f"With `--preset paper` it runs the paper's `{PAPER.method}`" in text
