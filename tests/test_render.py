@@ -80,3 +80,26 @@ def test_the_roadmap_picture_shows_replies_probes_and_the_legs_its_searches_buil
     assert colours.count(PATH) == 1
     img = decode(to_png(fig))
     assert max(img.shape[:2]) == 400
+
+
+def test_the_search_slider_redraws_its_picture_from_the_step_log():
+    """notebook 05's slider: the last step shown first, another step's picture (PNG bytes of an Image widget, no Output
+    widget for nbclient to hang on) when the slider moves."""
+    from ipywidgets import Image, IntSlider
+
+    from specrefine.runs.explore import search_slider, step_png
+
+    maze = load_maze("u_maze").for_agent("point")
+    graph = maze_task(maze)
+    steps = [{"step": 0, "event": "expand", "vertex": "S", "cost": 0.0, "open": ["G"], "closed": ["S"]},
+             {"step": 1, "event": "done", "path": ["S", "G"], "predicted_success": 0.5, "open": [],
+              "closed": ["S", "G"]}]
+    box = search_slider(maze, steps, graph, size_px=200)
+    slider, image = box.children
+    assert isinstance(slider, IntSlider) and isinstance(image, Image)
+    assert (slider.min, slider.max, slider.value) == (0, 1, 1)
+    last = bytes(image.value)  # the widget holds a memoryview
+    assert last == step_png(maze, steps, graph, 1, 200) and last.startswith(b"\x89PNG")
+    assert imread(io.BytesIO(last)).shape[:2] == (200, 200)
+    slider.value = 0
+    assert bytes(image.value) == step_png(maze, steps, graph, 0, 200) != last

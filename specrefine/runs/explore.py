@@ -75,24 +75,32 @@ def draw_step(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: 
     return fig
 
 
+def step_png(maze, steps: list[dict], input_graph: TaskGraph, i: int, size_px: int = 640) -> bytes:
+    """Step ``i`` of the search drawn as PNG bytes (``draw_step``'s figure)."""
+    from ..pictures.render import to_png
+
+    return to_png(draw_step(maze, steps, input_graph, i, size_px))
+
+
 def search_slider(maze, steps: list[dict], input_graph: TaskGraph, size_px: int = 640):
-    """An ipywidgets slider that redraws the search at each recorded step."""
+    """An ipywidgets slider that redraws the search at each recorded step.
+
+    The picture is an ``Image`` widget whose bytes the slider replaces, not an ``Output`` widget redrawn in place:
+    executed headless (papermill, the notebook tests), an ``Output`` widget makes nbclient send the captured display
+    back to the kernel while it waits for the cell's reply, and that exchange hung about one run in ten here
+    (jupyter/nbclient#312)."""
     import ipywidgets as widgets
-    from IPython.display import display
 
-    out = widgets.Output()
-    slider = widgets.IntSlider(value=len(steps) - 1, min=0, max=len(steps) - 1, description="step",
-                               continuous_update=False, layout=widgets.Layout(width="90%"))
+    last = len(steps) - 1
+    image = widgets.Image(value=step_png(maze, steps, input_graph, last, size_px), format="png")
+    slider = widgets.IntSlider(value=last, min=0, max=last, description="step", continuous_update=False,
+                               layout=widgets.Layout(width="90%"))
 
-    def show(change=None):
-        with out:
-            out.clear_output(wait=True)
-            fig = draw_step(maze, steps, input_graph, slider.value, size_px)
-            display(fig)
+    def show(change):
+        image.value = step_png(maze, steps, input_graph, change["new"], size_px)
 
     slider.observe(show, names="value")
-    show()
-    return widgets.VBox([slider, out])
+    return widgets.VBox([slider, image])
 
 
 def _nearer(tried: dict) -> str:
