@@ -22,16 +22,37 @@ def _paired_text(e: dict) -> str:
     return f"difference {e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}] over {e['n_cells']} cells"
 
 
+def _ant_interval(e: dict) -> str:
+    """An Ant paired difference (``paired_rows``) with its interval."""
+    lo, hi = e["ci"]
+    return f"{e['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+
+
 def _ant_paired_text(e: dict) -> str:
     if not e["cells"]:
         return "no cell in both yet"
-    lo, hi = e["ci"]
-    return (f"{e['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] over {e['cells']} "
-            f"cell{'s' * (e['cells'] > 1)} (Newcombe 95 %, pooled)")
+    return f"{_ant_interval(e)} over {e['cells']} cell{'s' * (e['cells'] > 1)} (Newcombe 95 %, pooled)"
+
+
+def _ant_against(e: dict | None, against: str | None) -> str:
+    """The Ant table's cell for a grid's difference from the corrector it was judged against (None: the reference)."""
+    if e is None:
+        return "— (the reference)"
+    if not e["cells"]:
+        return f"vs {against}: no cell in both yet"
+    return f"{_ant_interval(e)} vs {against}, {e['cells']}"
 
 
 def _signed(e: dict) -> str:
     return "—" if math.isnan(e["estimate"]) else f"{e['estimate']:+.3f} [{e['ci_low']:+.3f}, {e['ci_high']:+.3f}]"
+
+
+def _cost_pair(c: dict) -> str:
+    """Proposer calls and evaluations over another method's, as the Ant table's cell."""
+    if not c["pairs"]:
+        return "—"
+    return (f"{_num(c['proposer_calls_ratio'], '{:.2f}x')}, {_num(c['evaluations_ratio'], '{:.2f}x')} "
+            f"({c['pairs']} pairs)")
 
 
 def _cost_text(c: dict) -> str:

@@ -31,7 +31,7 @@ from .common import (
     _known,
 )
 from .default import DEFAULTS, default_marker, default_studies, default_text, default_verdict, gr_study, gr_text
-from .formats import _cost_text, _num, _paired_text, _partial, _signed
+from .formats import _ant_against, _cost_pair, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
 from .rules import (
     _adoption_rows,
@@ -237,7 +237,7 @@ def ant_text(ant: dict) -> str:
         cells = [f"{e['success']:.3f} ({e['runs']})" if e["runs"] else "—" for e in per_maze]
         table.append("| " + " | ".join(
             [f"{grid} ({method})", *cells, f"{low} of {len(ran)}" if ran else "—",
-             _against(paired, against), _cost_pair(cost),
+             _ant_against(paired, against), _cost_pair(cost),
              "read by the Ant's rules" if grid == ant["grid"] else status or _cells_run(per_maze)]) + " |")
     seeds = f"{min(ANT_SEEDS)}-{max(ANT_SEEDS)}"
     return ("\n" + f"Success per maze pooled over seeds {seeds} (runs in brackets; Un: U-chain of n rooms, s: with "
@@ -248,22 +248,6 @@ def _maze_label(maze: str) -> str:
     """u_chain_3_subgoals -> U3s (another name as it is)."""
     m = re.fullmatch(r"u_chain_(\d+)(_subgoals)?", maze)
     return f"U{m.group(1)}{'s' * bool(m.group(2))}" if m else maze
-
-
-def _against(paired: dict | None, against: str | None) -> str:
-    if paired is None:
-        return "— (the reference)"
-    if not paired["cells"]:
-        return f"vs {against}: no cell in both yet"
-    lo, hi = paired["ci"]
-    return f"{paired['difference']:+.3f} [{lo:+.3f}, {hi:+.3f}] vs {against}, {paired['cells']}"
-
-
-def _cost_pair(cost: dict) -> str:
-    if not cost["pairs"]:
-        return "—"
-    return (f"{_num(cost['proposer_calls_ratio'], '{:.2f}x')}, {_num(cost['evaluations_ratio'], '{:.2f}x')} "
-            f"({cost['pairs']} pairs)")
 
 
 def _cells_run(per_maze: list[dict]) -> str:
