@@ -8,6 +8,7 @@ import csv
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -240,3 +241,16 @@ def test_seed_cache_copies_entries_whole_and_keeps_existing_ones(tmp_path):
     assert (kept / "ab01.npz").read_bytes() == b"source one"
     assert (kept / "ab02.npz").read_bytes() == b"already here"
     assert sorted(p.name for p in dest.rglob("*") if p.is_file()) == ["ab01.npz", "ab02.npz"]  # no .part left
+
+
+def test_the_paper_preset_grid_runs_what_preset_paper_resolves_to_for_the_ant(tmp_path):
+    """Issue 42's `--preset paper` grid passes its settings explicitly (pinned code); they must be the preset's."""
+    from specrefine.runs.config import RunConfig
+
+    paper = RunConfig(agent="ant", proposer=grids.GEOMETRIC_48, preset="paper").resolved()
+    cells = grids.cells(grids.GRIDS["ant-oracle-paper"], root=tmp_path)
+    assert len(cells) == 27 and {c.maze for c in cells} == set(grids.SCALING_MAZES)
+    for c in cells:
+        assert Path(c.config.policy).name == f"{paper.policy}.pt"
+        # every setting equal; the preset itself is not recorded (run.json records what it decided)
+        assert replace(c.config, policy=paper.policy, seed=paper.seed, preset="paper") == paper, c.id

@@ -1121,6 +1121,14 @@ GRIDS = {g.name: g for g in (
                     "into its table, not run again", "ours-corrector-wide", "oracle_wide_scaling", code="adda718",
                     split_pick="confirmed"),
     ExperimentGrid(
+        "ant-oracle-paper", "docs/ant_experiments.md, 'The paper's rule as --preset paper' (issue 42; fixed "
+        "2026-12-06 07:40 UTC before its first cell ran): the oracle under every rule of the paper, as `--preset "
+        "paper` resolves them for the Ant, on the nine U-chains", "ant",
+        parts=(Part((PAPER.method,), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
+        policy="data/policies/ant_stage5.pt", evaluation=PAPER.evaluation, goal_points=PAPER.goal_points,
+        split_pick=PAPER.split_pick, workers=2, code="e22cff8", table="data/results/ant/oracle_paper.csv",
+        out="runs/ant_oracle_paper"),
+    ExperimentGrid(
         "ant-corrector-fresh", "docs/corrector.md, 'Fresh layouts for the Ant' (issue 39; fixed 2026-12-04 before it "
         "ran): ours-corrector-redraw and its control confirm on layouts and a mix no run had used, and the oracle",
         "ant", parts=(Part(("ours-corrector-redraw", "ours-corrector-confirm"), ANT_FRESH_MIXES, split="proposers"),
