@@ -114,3 +114,12 @@ def test_failure_reports_pool_flips_contacts_and_timeouts_by_kind_of_leg(tmp_pat
     assert "| turning | 1 | 97 |" in capsys.readouterr().out
     assert legs.main(["--failures", str(tmp_path / "bad.json")]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_a_u_chains_name_gives_its_rooms_and_subgoals_and_nothing_else_does():
+    from specrefine.core.mazes import benchmark_mazes, u_chain
+
+    assert u_chain("u_chain_3_subgoals") == (3, True) and u_chain("u_chain_12") == (12, False)
+    assert all(u_chain(bad) is None for bad in ("u_chain_", "u_chain_3_sub", "xu_chain_3", "u_chain_3 ", "u_maze"))
+    chains = {n: c for n in benchmark_mazes() if (c := u_chain(n))}
+    assert sorted(chains.values()) == sorted([(n, False) for n in range(1, 6)] + [(n, True) for n in range(2, 6)])

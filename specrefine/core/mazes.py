@@ -390,3 +390,9 @@ def _random_from_text(text: str, cell_size: float) -> Maze:
 def benchmark_mazes() -> dict[str, Path]:
     """The shipped benchmark suite, name -> file."""
     return {p.stem: p for p in sorted(MAZE_DIR.glob("*.maze"))}
+
+
+def u_chain(name: str) -> tuple[int, bool] | None:
+    """(rooms, with subgoals) of a shipped U-chain's name (``u_chain_3_subgoals`` -> (3, True)); None for any other."""
+    m = re.fullmatch(r"u_chain_(\d+)(_subgoals)?", name)
+    return (int(m.group(1)), bool(m.group(2))) if m else None

@@ -8,10 +8,9 @@ are labelled as such and never as a VLM's. Runs whose legs aimed at the goal set
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
+from ..core.mazes import u_chain
 from ..core.paper import PAPER
 from ..core.runfolder import save_figure, write_atomic
 from ..core.tables import goal_points_of
@@ -22,7 +21,6 @@ from ..runs.sweep import summarise
 METHOD_ORDER = ["dirl", "symbolic", "vlm-oneshot", "ours"]
 CORE_TASKS = ["split_doorway", "or_maze", "u_maze", "x_maze", "xx_maze_h", "xx_maze_v"]
 EXTRA_TASKS = ["two_doors", "hazard_pool"]  # beyond the paper: a choice in the spec, a hazard pool
-_UCHAIN = re.compile(r"u_chain_(\d+)(_subgoals)?$")
 
 
 def proposer_label(proposer: str, rows=()) -> str:
@@ -153,10 +151,10 @@ def figure5(rows, methods=METHOD_ORDER, proposers=None, legend_outside=False):
 def _rooms(summary, method, proposer, subgoals, rule=PAPER.goal_points):
     out = []
     for s in summary:
-        m = _UCHAIN.match(s["maze"])
-        if (m and bool(m.group(2)) == subgoals and (s["method"], s["proposer"], s["goal_points"])
-                == (method, proposer, rule)):
-            out.append((int(m.group(1)), s["success_mean"], s["success_std"]))
+        chain = u_chain(s["maze"])
+        same = (s["method"], s["proposer"], s["goal_points"]) == (method, proposer, rule)
+        if chain and chain[1] == subgoals and same:
+            out.append((chain[0], s["success_mean"], s["success_std"]))
     return out
 
 

@@ -17,12 +17,12 @@ flips, wall contacts (avoid) and timeouts per kind of leg (first, straight, turn
 the files, with the walls (``kind_table``).
 """
 import json
-import re
 import sys
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.graph import TaskGraph
+from ..core.mazes import u_chain
 from ..core.results import wilson_ci
 from ..core.runfolder import output_file, read_result, write_atomic
 from ..runs.sweep import is_done, read_checked_table
@@ -32,8 +32,7 @@ HEADER = ("| maze | method | proposer | policy | seeds | success [95 % CI] | leg
 
 
 def rooms(maze: str) -> int | None:
-    m = re.fullmatch(r"u_chain_(\d+)(_subgoals)?", maze)
-    return int(m.group(1)) if m else None
+    return chain[0] if (chain := u_chain(maze)) else None
 
 
 def pooled(runs) -> tuple[int, int]:

@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 from ...core.errors import SpecrefineError
+from ...core.mazes import u_chain
 from ...core.runfolder import locked, write_atomic
 from .. import ant_fresh
 from .. import comparison as cmp
@@ -246,8 +247,8 @@ def ant_text(ant: dict) -> str:
 
 def _maze_label(maze: str) -> str:
     """u_chain_3_subgoals -> U3s (another name as it is)."""
-    m = re.fullmatch(r"u_chain_(\d+)(_subgoals)?", maze)
-    return f"U{m.group(1)}{'s' * bool(m.group(2))}" if m else maze
+    chain = u_chain(maze)
+    return f"U{chain[0]}{'s' * chain[1]}" if chain else maze
 
 
 def _cells_run(per_maze: list[dict]) -> str:
