@@ -425,3 +425,26 @@ def test_readme_states_issue_42s_targets_as_the_checks_count_them():
     assert wide == ("2", "u_chain_4, u_chain_5_subgoals") and "on two, U-chain 4 and U-chain 5 with subgoals" in readme
     sampled = re.search(r"(\d+) of the 9 mazes below 0.90", front("sampled grid")).group(1)
     assert f"is below 0.90 on {sampled} of its 9 mazes" in readme
+
+
+def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, monkeypatch):
+    """README's `--preset paper` item: the cells run, the mazes below 0.90 and each maze's pooled success, as
+    data/results/ant/oracle_paper_check.md gives them; that check regenerates from its table by the command that
+    data/results/README.md names."""
+    from specrefine.experiments import oracle_check
+
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "check.md"
+    assert oracle_check.main(["data/results/ant/oracle_paper.csv", "--method", "ours", "--level", "0.90",
+                              "--tolerance", "0.05", "--out", str(out)]) == 0
+    check = (ROOT / "data" / "results" / "ant" / "oracle_paper_check.md").read_text()
+    assert out.read_text() == check
+    cells, below, run = re.search(r"Summary: (\d+) of 27 cells; below the level on (\d+) of (\d+) mazes run",
+                                  check).groups()
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    item = readme[readme.index("**The paper's rule, at least 0.90"):]
+    item = item[:item.index(" - **")]
+    status = "so far, " if int(cells) < 27 else ""
+    assert f"{cells} of 27 cells {status}below 0.90 on {below} of the {run} mazes run" in item, item
+    for rate in re.findall(r"^\| u_chain_\w+ \| \d \| (\d\.\d{3}) ", check, re.M):
+        assert rate in item, rate

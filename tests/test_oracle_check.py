@@ -84,3 +84,13 @@ def test_a_described_comparison_has_no_rule(tmp_path):
     assert "**Against ours before the fix on the same 21 cells (described, no rule).** Pooled 0.900" in text
     assert "adopted" not in text and "against ours before the fix on the same 21 cells -0.050 [" in text
     assert "| ours before the fix (baseline) |" in text
+
+
+def test_a_partial_grids_change_says_which_u_chains_it_extrapolates_over(tmp_path):
+    rows = [r for r in _grid("ours", lambda m, s: 0.99 - 0.02 * scaling.rooms(m)) if scaling.rooms(r["maze"]) <= 2]
+    out = tmp_path / "check.md"
+    assert oracle_check.main([_write(tmp_path / "t.csv", rows), "--level", "0.90", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "(extrapolated: no run yet of U-chain 3, U-chain 4, U-chain 5)." in text  # the summary's change
+    assert "from 1 to 5 rooms: partial (" in text and "; extrapolated: no run yet of U-chain 3" in text
+    assert scaling.flat_claim(_grid("ours", 0.95))["rooms_not_run"] == []

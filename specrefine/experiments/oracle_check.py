@@ -58,22 +58,30 @@ def summary(flat: dict, vs: dict | None, base_method: str) -> str:
     """One line: the cells run, the mazes below the level, the change; against the baseline, the pooled difference
     (README quotes it)."""
     cells = sum(m["seeds"] for m in flat["per_maze"].values())
-    lo, hi = flat["change_ci"]
     below = flat["below_level"]
     text = (f"{cells} of {len(MAZES) * len(SEEDS)} cells; below the level on {len(below)} of "
             f"{len(flat['per_maze'])} mazes run{': ' + ', '.join(below) if below else ''}; change from 1 to 5 rooms "
-            f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]")
+            f"{change_text(flat)}")
     if vs and vs["total"]:
         text += f"; against {base_method} on the same {vs['total']['cells']} cells {_diff_text(vs['total'])}"
     return text
 
 
-def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
+def change_text(flat: dict, verdict: bool = False) -> str:
+    """The 1-5 room change with its interval (and ``verdict``); a partial grid's says which U-chains it has no run of
+    yet (its slope is then fitted to the others and extrapolated)."""
     lo, hi = flat["change_ci"]
+    notes = [flat["change_verdict"]] if verdict else []
+    if missing := flat.get("rooms_not_run"):
+        notes.append(f"extrapolated: no run yet of {', '.join(f'U-chain {r}' for r in missing)}")
+    return f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]" + (f" ({'; '.join(notes)})" if notes else "")
+
+
+def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
     lines = ["Every proposer here is offline, NOT a VLM (geometric: a planner on the map). Ant, pooled over seeds "
              f"{', '.join(map(str, SEEDS))}, 200 fresh episodes per run; Wilson 95 % intervals.", "",
-             f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {flat['change_1_to_5']:+.3f} "
-             f"[{lo:+.3f}, {hi:+.3f}] ({flat['change_verdict']}); below the level: "
+             f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {change_text(flat, verdict=True)}"
+             "; below the level: "
              f"{', '.join(flat['below_level']) or 'none'}.", "", f"Summary: {summary(flat, vs, base_method)}.", ""]
     header = "| maze | seeds | " + method + " |" + (f" {base_method} (baseline) | difference |" if vs else "")
     lines += [header, "|---" * (header.count("|") - 1) + "|"]
