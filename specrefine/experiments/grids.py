@@ -1122,7 +1122,7 @@ GRIDS = {g.name: g for g in (
                     split_pick="confirmed"),
     ExperimentGrid(
         "ant-oracle-paper", "docs/ant_experiments.md, 'The paper's rule as --preset paper' (issue 42; fixed "
-        "2026-12-06 07:40 UTC before its first cell ran): the oracle under every rule of the paper, as `--preset "
+        "2026-12-06 07:07 UTC before its first cell ran): the oracle under every rule of the paper, as `--preset "
         "paper` resolves them for the Ant, on the nine U-chains", "ant",
         parts=(Part((PAPER.method,), (GEOMETRIC_48,), split="seeds"),), seeds=(0, 1, 2), mazes=SCALING_MAZES,
         policy="data/policies/ant_stage5.pt", evaluation=PAPER.evaluation, goal_points=PAPER.goal_points,
