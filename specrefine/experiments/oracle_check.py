@@ -18,6 +18,7 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, rate_text
 from ..core.runfolder import write_atomic, writing_into
+from .comparison import U_CHAIN_ROOMS
 from .legs import pooled
 from .scaling import MAZES, ORACLE, SEEDS, _runs, flat_claim, read_rows
 
@@ -72,7 +73,7 @@ def change_text(flat: dict, verdict: bool = False) -> str:
     yet (its slope is then fitted to the others and extrapolated)."""
     lo, hi = flat["change_ci"]
     notes = [flat["change_verdict"]] if verdict else []
-    if missing := flat.get("rooms_not_run"):
+    if missing := [rooms for rooms, maze in U_CHAIN_ROOMS.items() if maze not in flat["per_maze"]]:
         notes.append(f"extrapolated: no run yet of {', '.join(f'U-chain {r}' for r in missing)}")
     return f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]" + (f" ({'; '.join(notes)})" if notes else "")
 

@@ -78,8 +78,7 @@ def flat_claim(rows, method: str = "ours", level: float = LEVEL, tolerance: floa
             "verdict": verdict if complete else f"partial ({verdict} so far)", "complete": complete,
             "per_maze": per_maze, "below_level": sorted(m for m, v in per_maze.items() if v["success"] < level),
             "change_1_to_5": change["estimate"], "change_ci": [change["ci_low"], change["ci_high"]],
-            "change_verdict": change_verdict,
-            "rooms_not_run": [r for r, maze in cmp.U_CHAIN_ROOMS.items() if maze not in per_maze]}
+            "change_verdict": change_verdict}
 
 
 def _mean(runs) -> float | None:
