@@ -448,3 +448,6 @@ def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, mo
     assert f"{cells} of 27 cells {status}below 0.90 on {below} of the {run} mazes run" in item, item
     for rate in re.findall(r"^\| u_chain_\w+ \| \d \| (\d\.\d{3}) ", check, re.M):
         assert rate in item, rate
+    complete_below = [m for m, rate in re.findall(r"^\| (u_chain_\w+) \| 3 \| (\d\.\d{3}) ", check, re.M)
+                      if float(rate) < 0.90]
+    assert ("**the rule cannot be met**" in item) == bool(complete_below), complete_below
