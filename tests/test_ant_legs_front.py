@@ -211,6 +211,22 @@ def test_stage9_checks_table_regenerates():
     assert out.getvalue() == (STAGE9 / "checks.md").read_text()
 
 
+def test_stage10_rule_read_on_stage8s_files_fails_only_its_aim(tmp_path):
+    """Stage 10's rule (lever 9) applied to a policy judged before, stage 8: above 811 with sampled points fails
+    (792), the other four hold; with no files, every check is listed as not yet run."""
+    spec = importlib.util.spec_from_file_location("ant_stage10_summary", ROOT / "scripts" / "ant_stage10_summary.py")
+    summary = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(summary)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        summary.main(ROOT / "data" / "results" / "ant" / "stage8_checks", "stage8", "stage5")
+        summary.main(tmp_path, "stage10", "stage5")
+    verdicts = re.findall(r"^\| (\d)\. .*: (holds|fails)\b", out.getvalue(), flags=re.M)
+    assert dict(verdicts) == {"1": "holds", "2": "holds", "3": "fails", "4": "holds", "5": "holds"}
+    assert "put forward by the rule: no" in out.getvalue()
+    assert out.getvalue().rstrip().endswith("checks not yet run: [1, 2, 3, 4, 5]")
+
+
 SCALE = ROOT / "data" / "results" / "ant" / "switching_scale"
 _spec = importlib.util.spec_from_file_location("switching_scale_table", ROOT / "scripts" / "switching_scale_table.py")
 switching_scale_table = importlib.util.module_from_spec(_spec)

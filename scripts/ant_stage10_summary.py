@@ -1,0 +1,59 @@
+"""The table of stage 10's checks (goals near walls) against stage 5 (docs/ant_experiments.md, "Issue 42, lever 9"),
+from the JSON files of scripts/ant_stage8_checks.sh, with the verdict of each check's rule fixed there.
+
+    .venv/bin/python scripts/ant_stage10_summary.py [OUT_DIR [NEW_TAG [BASE_TAG]]]
+"""
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ant_stage7_summary import chain_cell, held_out_rows, load, open_floor_row  # noqa: E402
+
+from specrefine.core.results import newcombe_ci, wilson_ci  # noqa: E402
+
+CHECKS = (1, 2, 3, 4, 5)
+
+
+def overlap_rows(folder: Path, base: str, new: str, verdicts: dict) -> list[str]:
+    """Checks 2 and 4: the new policy's interval overlaps stage 5's or lies above it."""
+    rows = []
+    for number, name, label in ((2, "chain8", "eight goals in a row (planned), 200"),
+                                (4, "turn_chain8", "eight turning goals (90-180 deg, planned), 500")):
+        d = {t: load(folder, f"{name}_{t}.json") for t in (base, new)}
+        if not all(d.values()):
+            continue
+        kb, nb, kn, nn = d[base]["reached"][-1], d[base]["episodes"], d[new]["reached"][-1], d[new]["episodes"]
+        verdicts[number] = wilson_ci(kn, nn)[1] >= wilson_ci(kb, nb)[0]
+        lo, hi = newcombe_ci(kn, nn, kb, nb)
+        rule = (f"overlap or above: {'holds' if verdicts[number] else 'fails'}; difference {kn / nn - kb / nb:+.3f} "
+                f"[{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+        rows.append(f"| {number}. {label} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
+    return rows
+
+
+def count_rule(verdicts: dict, number: int, above: bool):
+    """The pooled held-out row's rule: ``above`` stage 5's count (the aim) or not below it (the guard)."""
+    def rule(kb, nb, kn, nn):
+        verdicts[number] = kn > kb if above else kn >= kb
+        lo, hi = newcombe_ci(kn, nn, kb, nb)
+        return (f"{'above' if above else 'not below'} {kb}: {'holds' if verdicts[number] else 'fails'}; difference "
+                f"{kn / nn - kb / nb:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+    return rule
+
+
+def main(folder="data/results/ant/stage10_checks", new="stage10", base="stage5") -> None:
+    folder, verdicts = Path(folder), {}
+    rows = [f"| check | {base} | {new} | rule |", "| --- | --- | --- | --- |"]
+    rows += open_floor_row(folder, base, new, verdicts)
+    rows += overlap_rows(folder, base, new, verdicts)
+    rows += held_out_rows(folder, base, new, "", "3. held out U-chain 2, sampled points", count_rule(verdicts, 3, True))
+    rows += held_out_rows(folder, base, new, "centre_", "5. held out U-chain 2, centre points",
+                          count_rule(verdicts, 5, False))
+    missing = [c for c in CHECKS if c not in verdicts]
+    print("\n".join(rows))
+    print("\n" + (f"checks not yet run: {missing}" if missing else
+                  f"put forward by the rule: {'yes' if all(verdicts.values()) else 'no'}"))
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:])
