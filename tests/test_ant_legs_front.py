@@ -467,3 +467,7 @@ def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, mo
     complete_below = [m for m, rate in re.findall(r"^\| (u_chain_\w+) \| 3 \| (\d\.\d{3}) ", check, re.M)
                       if float(rate) < 0.90]
     assert ("**the rule cannot be met**" in item) == bool(complete_below), complete_below
+    change = re.search(r"Summary: .*change from 1 to 5 rooms ([+-]\d\.\d{3}) \[([+-]\d\.\d{3}), ([+-]\d\.\d{3})\]"
+                       r"( \(extrapolated)?", check)
+    if not change.group(4):  # every room count has a run: README gives the change as the check computes it
+        assert f"{change.group(1)} [{change.group(2)}, {change.group(3)}]" in item, change.group(0)
