@@ -227,6 +227,27 @@ def test_stage10_rule_read_on_stage8s_files_fails_only_its_aim(tmp_path):
     assert out.getvalue().rstrip().endswith("checks not yet run: [1, 2, 3, 4, 5]")
 
 
+def test_stage10_checks_regenerate_into_its_table_and_readme():
+    """stage10_checks/checks.md from its JSON files, the same table in docs/ant_experiments.md, and README's aim
+    check (the held-out paths with sampled goal points) from the same files."""
+    folder = ROOT / "data" / "results" / "ant" / "stage10_checks"
+    spec = importlib.util.spec_from_file_location("ant_stage10_summary", ROOT / "scripts" / "ant_stage10_summary.py")
+    summary = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(summary)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        summary.main(folder, "stage10", "stage5")
+    assert out.getvalue() == (folder / "checks.md").read_text()
+    table = out.getvalue().split("\n\n")[0]
+    assert f"<!-- stage 10 checks -->\n{table}\n" in (ROOT / "docs" / "ant_experiments.md").read_text()
+    held = {tag: [json.loads((folder / f"u_chain_2_s{s}_{tag}.json").read_text()) for s in range(3)]
+            for tag in ("stage10", "stage5")}
+    k = {tag: (sum(r["walls"]["success"] for r in runs), sum(r["episodes"] for r in runs))
+         for tag, runs in held.items()}
+    assert front("stage10") == (f"{k['stage10'][0]} of {k['stage10'][1]} against {k['stage5'][0]} of {k['stage5'][1]}, "
+                                f"{difference_text(*k['stage10'], *k['stage5'])}")
+
+
 SCALE = ROOT / "data" / "results" / "ant" / "switching_scale"
 _spec = importlib.util.spec_from_file_location("switching_scale_table", ROOT / "scripts" / "switching_scale_table.py")
 switching_scale_table = importlib.util.module_from_spec(_spec)
