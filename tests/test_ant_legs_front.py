@@ -15,9 +15,17 @@ from specrefine.experiments.legs import kind_table
 
 ROOT = Path(__file__).resolve().parents[1]
 CHECKS = ROOT / "data" / "results" / "ant" / "switching_checks"
-_spec = importlib.util.spec_from_file_location("switching_table", ROOT / "scripts" / "switching_table.py")
-switching_table = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(switching_table)
+
+
+def script(name: str):
+    """scripts/NAME.py as a module (the scripts folder is not a package)."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+switching_table = script("switching_table")
 
 
 def pages() -> str:
@@ -202,9 +210,7 @@ def test_front_stage9_recomputes():
 
 
 def test_stage9_checks_table_regenerates():
-    spec = importlib.util.spec_from_file_location("ant_stage8_summary", ROOT / "scripts" / "ant_stage8_summary.py")
-    summary = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(summary)
+    summary = script("ant_stage8_summary")
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         summary.main(STAGE9, "stage9", "stage5")
@@ -214,9 +220,7 @@ def test_stage9_checks_table_regenerates():
 def test_stage10_rule_read_on_stage8s_files_fails_only_its_aim(tmp_path):
     """Stage 10's rule (lever 9) applied to a policy judged before, stage 8: above 811 with sampled points fails
     (792), the other four hold; with no files, every check is listed as not yet run."""
-    spec = importlib.util.spec_from_file_location("ant_stage10_summary", ROOT / "scripts" / "ant_stage10_summary.py")
-    summary = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(summary)
+    summary = script("ant_stage10_summary")
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         summary.main(ROOT / "data" / "results" / "ant" / "stage8_checks", "stage8", "stage5")
@@ -231,9 +235,7 @@ def test_stage10_checks_regenerate_into_its_table_and_readme():
     """stage10_checks/checks.md from its JSON files, the same table in docs/ant_experiments.md, and README's aim
     check (the held-out paths with sampled goal points) from the same files."""
     folder = ROOT / "data" / "results" / "ant" / "stage10_checks"
-    spec = importlib.util.spec_from_file_location("ant_stage10_summary", ROOT / "scripts" / "ant_stage10_summary.py")
-    summary = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(summary)
+    summary = script("ant_stage10_summary")
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         summary.main(folder, "stage10", "stage5")
@@ -249,9 +251,7 @@ def test_stage10_checks_regenerate_into_its_table_and_readme():
 
 
 SCALE = ROOT / "data" / "results" / "ant" / "switching_scale"
-_spec = importlib.util.spec_from_file_location("switching_scale_table", ROOT / "scripts" / "switching_scale_table.py")
-switching_scale_table = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(switching_scale_table)
+switching_scale_table = script("switching_scale_table")
 
 
 def test_switching_scale_table_regenerates(tmp_path):
