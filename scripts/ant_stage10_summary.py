@@ -9,7 +9,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ant_stage7_summary import chain_cell, held_out_rows, load, open_floor_row  # noqa: E402
 
-from specrefine.core.results import newcombe_ci, wilson_ci  # noqa: E402
+from specrefine.core.results import difference_text, wilson_ci  # noqa: E402
 
 CHECKS = (1, 2, 3, 4, 5)
 
@@ -24,9 +24,8 @@ def overlap_rows(folder: Path, base: str, new: str, verdicts: dict) -> list[str]
             continue
         kb, nb, kn, nn = d[base]["reached"][-1], d[base]["episodes"], d[new]["reached"][-1], d[new]["episodes"]
         verdicts[number] = wilson_ci(kn, nn)[1] >= wilson_ci(kb, nb)[0]
-        lo, hi = newcombe_ci(kn, nn, kb, nb)
-        rule = (f"overlap or above: {'holds' if verdicts[number] else 'fails'}; difference {kn / nn - kb / nb:+.3f} "
-                f"[{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+        rule = (f"overlap or above: {'holds' if verdicts[number] else 'fails'}; difference "
+                f"{difference_text(kn, nn, kb, nb)} (Newcombe)")
         rows.append(f"| {number}. {label} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
     return rows
 
@@ -35,9 +34,8 @@ def count_rule(verdicts: dict, number: int, above: bool):
     """The pooled held-out row's rule: ``above`` stage 5's count (the aim) or not below it (the guard)."""
     def rule(kb, nb, kn, nn):
         verdicts[number] = kn > kb if above else kn >= kb
-        lo, hi = newcombe_ci(kn, nn, kb, nb)
         return (f"{'above' if above else 'not below'} {kb}: {'holds' if verdicts[number] else 'fails'}; difference "
-                f"{kn / nn - kb / nb:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+                f"{difference_text(kn, nn, kb, nb)} (Newcombe)")
     return rule
 
 
