@@ -105,6 +105,39 @@ def test_a_device_as_out_is_refused_and_stays_a_device(run, tmp_path, capsys, co
     assert "a device" in err and stat.S_ISCHR(null.lstat().st_mode)
 
 
+@pytest.mark.parametrize("kind", ["link", "device"])
+def test_train_evaluate_plot_is_checked_before_any_episode(tmp_path, capsys, kind):
+    victim = tmp_path / "victim"
+    victim.write_text("precious\n")
+    plot = tmp_path / "plot.png"
+    if kind == "link":
+        plot.symlink_to(victim)
+    else:
+        device(plot)
+    err = one_line_2(cli_main, ["train", "--agent", "point", "--evaluate", "point", "--episodes", "2",
+                                "--no-progress", "--plot", str(plot)], capsys)
+    assert f"--plot {plot}: a {kind}" in err and victim.read_text() == "precious\n"
+    assert (plot.is_symlink() if kind == "link" else stat.S_ISCHR(plot.lstat().st_mode))
+
+
+def test_train_evaluate_plot_is_written_whole(tmp_path, capsys):
+    plot = tmp_path / "plot.png"
+    assert cli_main(["train", "--agent", "point", "--evaluate", "point", "--episodes", "2", "--no-progress",
+                     "--plot", str(plot)]) == 0, capsys.readouterr().err
+    assert plot.read_bytes().startswith(b"\x89PNG") and sorted(p.name for p in tmp_path.iterdir()) == ["plot.png"]
+
+
+def test_notebook_executed_refuses_a_linked_copy_before_any_notebook_runs(tmp_path, capsys):
+    pytest.importorskip("papermill")
+    victim, out = tmp_path / "victim", tmp_path / "executed"
+    victim.write_text("precious\n")
+    out.mkdir()
+    (out / "05_astar_refinement.ipynb").symlink_to(victim)
+    err = one_line_2(cli_main, ["notebook", "executed", "05", "--out", str(out)], capsys)
+    assert "05_astar_refinement.ipynb: a link" in err and victim.read_text() == "precious\n"
+    assert "zz" in one_line_2(cli_main, ["notebook", "executed", "zz", "--out", str(out)], capsys)  # matches none
+
+
 # --- 3. a run's own files are no output of another command ----------------------------------------------
 @pytest.mark.parametrize("name", ["result.json", "policy.json", "steps.jsonl", "run.json"])
 def test_official_refuses_the_run_folders_own_files_as_out(run, capsys, name):

@@ -281,6 +281,22 @@ def for_readers(nb):
 
 def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
     """Executed copies of the notebooks (outputs and figures) for readers; 0 when all ran."""
+    from ..core.errors import SpecrefineError
+    from ..core.runfolder import ensure_dir, locked, output_file
+
+    numbered = sorted(NB_DIR.glob("[0-9][0-9]_*.ipynb"))
+    if unmatched := [s for s in stems or () if not any(nb.stem.startswith(s) for nb in numbered)]:
+        raise SpecrefineError(f"no numbered notebook matches {', '.join(map(repr, unmatched))} "
+                              f"(have: {', '.join(nb.stem for nb in numbered)})")
+    chosen = [nb for nb in numbered if not stems or any(nb.stem.startswith(s) for s in stems)]
+    out_dir = ensure_dir(out_dir)
+    outs = [output_file(out_dir / nb.name) for nb in chosen]  # all checked before the first notebook runs
+    runs = ensure_dir(NB_DIR.parent / "runs" / "executed")
+    with locked(runs):  # another `notebook executed` would delete these folders under this one
+        return _execute_all(chosen, outs, tier, runs)
+
+
+def _execute_all(notebooks: list[Path], outs: list[Path], tier: str, runs: Path) -> int:
     import shutil
     import tempfile
     import time
@@ -288,32 +304,32 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
     import nbformat
     from nbformat.v4 import new_markdown_cell
 
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    from ..core.runfolder import write_atomic
+
     commit = _git("rev-parse", "--short=12", "HEAD") or "unknown"
     dirty = bool(_git("status", "--porcelain", "--untracked-files=no", "--", "specrefine", "notebooks", "data"))
     failed = 0
     with tempfile.TemporaryDirectory() as tmp:
         env = kernel_env(Path(tmp), mpl_backend=None)  # the inline backend, as a reader's kernel has it
         env["PYTHONPATH"] = os.pathsep.join([str(NB_DIR.parent), *filter(None, [env.get("PYTHONPATH")])])
-        for nb in sorted(NB_DIR.glob("[0-9][0-9]_*.ipynb")):
-            if stems and not any(nb.stem.startswith(s) for s in stems):
-                continue
+        for nb, out in zip(notebooks, outs):
             params, harness = tier_settings(nb, tier)
-            run_dir = NB_DIR.parent / "runs" / "executed" / nb.stem  # fresh: no evaluation cache from earlier runs
+            run_dir = runs / nb.stem  # fresh: no evaluation cache from earlier runs
+            if run_dir.is_symlink():
+                run_dir.unlink()  # the link only: what it points at is not this command's
             shutil.rmtree(run_dir, ignore_errors=True)
             params = {**params, "OUT_DIR": f"../runs/executed/{nb.stem}"}
-            out = out_dir / nb.name
+            ran = Path(tmp) / nb.name  # papermill's own output; the copy for readers is written whole below
             t0 = time.time()
-            code, log = execute(nb, out, params, env=env, timeout=int(harness.get("timeout_s", DEFAULT_TIMEOUT_S)))
+            code, log = execute(nb, ran, params, env=env, timeout=int(harness.get("timeout_s", DEFAULT_TIMEOUT_S)))
             wall = time.time() - t0
             print(f"{nb.name}: {'ok' if code == 0 else 'FAILED'} in {wall:.0f} s -> {out}", flush=True)
             if code != 0:
                 failed += 1
                 print(log[-3000:])
-                if not out.exists():
+                if not ran.exists():
                     continue
-            copy = for_readers(nbformat.read(out, as_version=4))
+            copy = for_readers(nbformat.read(ran, as_version=4))
             shown = ", ".join(f"{k}={v!r}" for k, v in params.items() if k != "OUT_DIR") or "the notebook's defaults"
             note = harness.get("note", "")
             header = (f"> **Executed copy** of [`notebooks/{nb.name}`](../{nb.name}) for reading: produced by "
@@ -327,10 +343,7 @@ def write_executed(stems: list[str] | None, tier: str, out_dir: Path) -> int:
             copy.metadata["specrefine"] = {"executed_copy_of": f"notebooks/{nb.name}", "commit": commit,
                                            "uncommitted_changes": dirty, "tier": tier, "parameters": params,
                                            "ok": code == 0, "wall_s": round(wall)}
-            from ..core.runfolder import write_atomic
-
             write_atomic(out, nbformat.writes(copy) + "\n")
-            out.with_suffix(".params.json").unlink(missing_ok=True)
     return 1 if failed else 0
 
 

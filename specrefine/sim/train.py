@@ -34,7 +34,7 @@ from tqdm.auto import tqdm
 from ..core.agents import AGENTS, get_agent
 from ..core.argtypes import bounded_int, out_path
 from ..core.errors import SpecrefineError
-from ..core.runfolder import open_append
+from ..core.runfolder import open_append, output_file, save_figure, writing_into
 from .collect import BatchCollector
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy, widened
@@ -444,10 +444,13 @@ def run(args, ap) -> int:
             if args.turn_goals is not None:
                 raise SpecrefineError("--turn-goals with --evaluate needs --chain K (a turn needs a goal before it)")
             lo, hi = args.goal_range or (None, None)
+            if args.plot:
+                output_file(args.plot, "--plot")  # before any episode: no link, device or missing folder
             res = evaluate_reach(load_policy(args.evaluate), args.episodes, lo, hi, seed=seed)
             print(json.dumps(summary(res)))
             if args.plot:
-                plot_success_by_distance(res).savefig(args.plot, dpi=90)
+                with writing_into(args.plot, "--plot") as path:
+                    save_figure(plot_success_by_distance(res), path, dpi=90)
             return 0
         if not args.out:
             raise SpecrefineError("--out DIR is required for training")
