@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import tempfile
 from pathlib import Path
 
@@ -50,12 +49,14 @@ def gap_table(record: dict) -> str:
 
 def main() -> None:
     from specrefine.cli import main as cli
+    from specrefine.core.runfolder import writable_parent, write_atomic
     from specrefine.runs.official import run_official
 
     p = argparse.ArgumentParser()
     p.add_argument("--episodes", type=int, default=1000)
     p.add_argument("--out", default="data/official/point_gap.json")
     args = p.parse_args()
+    out = writable_parent(args.out)  # before any run: no link, device or folder
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for maze in MAZES:
@@ -69,11 +70,7 @@ def main() -> None:
                          "official": {k: official[k] for k in ("success_rate", "success_ci", "episodes", "outcomes")}})
     record = {"command": f"PYTHONPATH=$PWD python scripts/official_gap.py --episodes {args.episodes}",
               "agent": "point", "method": "ours", "proposer": "geometric", "seed": 0, "rows": rows}
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp_out = out.with_name(f".{out.name}.{os.getpid()}.tmp")
-    tmp_out.write_text(json.dumps(record, indent=1) + "\n")
-    os.replace(tmp_out, out)
+    write_atomic(out, json.dumps(record, indent=1) + "\n")
     print(gap_table(record))
 
 

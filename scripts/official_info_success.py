@@ -47,11 +47,13 @@ def count(run: Path, episodes: int) -> dict:
 
 def main() -> None:
     from specrefine.cli import main as cli
+    from specrefine.core.runfolder import writable_parent, write_atomic
 
     p = argparse.ArgumentParser()
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--out", default="data/official/info_success.json")
     args = p.parse_args()
+    out = writable_parent(args.out)  # before any run: no link, device or folder
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for method in METHODS:
@@ -64,7 +66,7 @@ def main() -> None:
             print(json.dumps(rows[-1]), flush=True)
     record = {"script": "scripts/official_info_success.py", "episodes": args.episodes, "seed": 0, "rows": rows,
               "success_radius_m": 0.45}
-    Path(args.out).write_text(json.dumps(record, indent=2) + "\n")
+    write_atomic(out, json.dumps(record, indent=2) + "\n")
 
 
 if __name__ == "__main__":
