@@ -12,8 +12,9 @@ Refuses to run twice (the table would hold two ours-novertex definitions).
 from __future__ import annotations
 
 import csv
-import os
 import sys
+
+from specrefine.core.runfolder import replacing
 
 
 def main(table: str, controls: str) -> int:
@@ -29,12 +30,10 @@ def main(table: str, controls: str) -> int:
             r["cell"] = r["cell"].replace("__ours-novertex__", "__ours-nosearchvertex__")
     with open(controls, newline="") as fh:
         new = [{k: r.get(k, "") for k in header} for r in csv.DictReader(fh)]
-    tmp = table + ".tmp"
-    with open(tmp, "w", newline="") as fh:
+    with replacing(table, "w", newline="") as fh:  # whole, never through a link
         writer = csv.DictWriter(fh, header)
         writer.writeheader()
         writer.writerows(rows + new)
-    os.replace(tmp, table)
     print(f"{table}: {len(rows)} rows ({sum(r['method'] == 'ours-nosearchvertex' for r in rows)} renamed) "
           f"+ {len(new)} from {controls}")
     return 0

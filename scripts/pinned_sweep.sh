@@ -11,7 +11,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 code=${CODE:?CODE=COMMIT: the code the grid runs}
 out=$(realpath -m "${OUT:?OUT=folder of the sweep}")  # absolute: the sweep runs from the worktree
-shipped=$(realpath -m "${SHIPPED:?SHIPPED=the table in data/results}")
+shipped=$(realpath -ms "${SHIPPED:?SHIPPED=the table in data/results}")  # -s: a link there is replaced, not followed
 py=${PYTHON:-$root/.venv/bin/python}
 tree=${TREE:-$root/runs/code_$code}
 [ -d "$tree" ] || git -C "$root" worktree add -q --detach "$tree" "$code"
@@ -26,18 +26,21 @@ mkdir -p "$out" "$(dirname "$shipped")"
 
 ship() {  # the table's done rows only (a row being appended is never half-copied)
     "$py" -P - "$out/results.csv" "$shipped" "$sweep" <<'PY'  # -P: the tree's code, not the cwd's
-import csv, importlib, sys
+import csv, importlib, os, sys
 src, dst, sweep = sys.argv[1:]
 _typed, is_done = (getattr(importlib.import_module(sweep), name) for name in ("_typed", "is_done"))
 with open(src, newline="") as fh:
     reader = csv.DictReader(fh)
     rows = [r for r in reader if None not in r and None not in r.values() and is_done(_typed(r))]
-with open(dst + ".tmp", "w", newline="") as fh:
+tmp = dst + ".tmp"
+if os.path.lexists(tmp):
+    os.unlink(tmp)  # a killed copy's, or a planted link: removed, never followed
+with os.fdopen(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644), "w", newline="") as fh:
     w = csv.DictWriter(fh, reader.fieldnames)
     w.writeheader()
     w.writerows(rows)
+os.replace(tmp, dst)  # a link at the table is replaced, never written through
 PY
-    mv "$shipped.tmp" "$shipped"
 }
 # the sleep holds none of our output streams: a caller reading them sees their end when the sweep ends
 ( while sleep 120 </dev/null >/dev/null 2>&1; do [ -s "$out/results.csv" ] && ship || true; done ) &

@@ -190,6 +190,22 @@ def test_a_vlm_recording_linked_outside_the_run_is_refused(fake_vlm, tmp_path, c
     assert victim.read_text() == "" and not fake_vlm.requests  # refused before the first call
 
 
+def test_pinned_sweep_ships_its_table_whole_past_a_planted_link(tmp_path):
+    victim, shipped, tree = tmp_path / "victim", tmp_path / "table.csv", tmp_path / "tree"
+    victim.write_text("precious\n")
+    (tmp_path / "table.csv.tmp").symlink_to(victim)  # where the copy is written before its rename
+    env = {**os.environ, "CODE": "HEAD", "TREE": str(tree), "OUT": str(tmp_path / "sweep"), "SHIPPED": str(shipped),
+           "PYTHON": sys.executable}
+    try:
+        done = subprocess.run(["bash", str(ROOT / "scripts" / "pinned_sweep.sh"), *SWEEP], env=env, cwd=ROOT,
+                              capture_output=True, text=True, timeout=600)
+    finally:
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert victim.read_text() == "precious\n" and not shipped.is_symlink()
+    assert [r["status"] for r in csv.DictReader(shipped.open())] == ["ok"]
+
+
 # --- 5. scripts/run_grid.sh runs no value as code ---------------------------------------------------------
 @pytest.fixture
 def grid_root(tmp_path) -> Path:
