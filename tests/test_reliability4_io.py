@@ -263,6 +263,17 @@ def test_official_is_refused_while_another_process_holds_the_run_folder(run):
     assert json.loads((run / "official.json").read_text())["episodes"] == 2 and not (run / ".lock").exists()
 
 
+def test_train_is_refused_while_another_holds_its_folder(tmp_path, capsys):
+    from specrefine.core.runfolder import locked
+
+    out = tmp_path / "train"
+    out.mkdir()
+    with locked(out):  # another trainer's (an OS lock: a second open of the file conflicts in one process too)
+        err = one_line_2(cli_main, ["train", "--agent", "point", "--frames", "64", "--num-envs", "2",
+                                    "--steps-per-env", "4", "--no-progress", "--out", str(out)], capsys)
+    assert "in use by another run" in err and not any(out.iterdir())  # no log, checkpoint or policy
+
+
 # --- 7. a FIFO among the inputs is refused, never opened -------------------------------------------------
 @pytest.mark.parametrize("name", ["result.json", "policy.json"])
 def test_a_fifo_in_the_run_folder_is_one_line_not_a_hang(run, name):

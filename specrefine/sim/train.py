@@ -34,7 +34,7 @@ from tqdm.auto import tqdm
 from ..core.agents import AGENTS, get_agent
 from ..core.argtypes import bounded_int, out_path
 from ..core.errors import SpecrefineError
-from ..core.runfolder import open_append, output_file, save_figure, writing_into
+from ..core.runfolder import ensure_dir, locked, open_append, output_file, save_figure, writing_into
 from .collect import BatchCollector
 from .curves import plot_curve, plot_rollouts, plot_success_by_distance, read_log
 from .policy import GoalPolicy, load_policy, mlp, safe_load, save_policy, widened
@@ -227,8 +227,7 @@ class Trainer:
     def __init__(self, cfg: Config, out: str | Path, resume: bool = False, progress: bool = True):
         from torchrl.objectives import ClipPPOLoss
 
-        self.cfg, self.out, self.progress = cfg, Path(out), progress
-        self.out.mkdir(parents=True, exist_ok=True)
+        self.cfg, self.out, self.progress = cfg, ensure_dir(out), progress
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         optional = {k: v for k in ("tilt_cost", "flip_penalty", "lateral_cost", "wall_penalty")
@@ -360,6 +359,10 @@ class Trainer:
                 "return": float(np.mean(returns)) if returns else float("nan")}
 
     def train(self) -> Path:
+        with locked(self.out):  # a second trainer here would interleave its log and checkpoints with this one's
+            return self._train()
+
+    def _train(self) -> Path:
         cfg = self.cfg
         bar = tqdm(total=cfg.frames, initial=min(self.frames, cfg.frames), unit="frames",
                    disable=not self.progress, dynamic_ncols=True)
@@ -457,9 +460,7 @@ def run(args, ap) -> int:
         overrides = {f.name: getattr(args, f.name) for f in fields(Config)
                      if f.name != "agent" and getattr(args, f.name) is not None}
         cfg = make_config(args.agent, **overrides)
-        from ..core.runfolder import ensure_dir
-
-        path = Trainer(cfg, ensure_dir(args.out), args.resume, progress=not args.no_progress).train()
+        path = Trainer(cfg, args.out, args.resume, progress=not args.no_progress).train()
         print(f"policy written to {path}")
         return 0
     except SpecrefineError as e:
