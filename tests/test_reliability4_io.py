@@ -274,6 +274,17 @@ def test_train_is_refused_while_another_holds_its_folder(tmp_path, capsys):
     assert "in use by another run" in err and not any(out.iterdir())  # no log, checkpoint or policy
 
 
+def test_a_sweep_is_refused_while_another_holds_its_folder(tmp_path, capsys):
+    from specrefine.core.runfolder import locked
+
+    out = tmp_path / "s"
+    out.mkdir()
+    with locked(out):  # another sweep's
+        err = one_line_2(sweep.main, [*SWEEP, "--out", str(out)], capsys)
+    assert "in use by another run" in err and not any(out.iterdir())  # no table, record or cell
+    assert sweep.main([*SWEEP, "--out", str(out)]) == 0 and not (out / ".lock").exists()
+
+
 # --- 7. a FIFO among the inputs is refused, never opened -------------------------------------------------
 @pytest.mark.parametrize("name", ["result.json", "policy.json"])
 def test_a_fifo_in_the_run_folder_is_one_line_not_a_hang(run, name):

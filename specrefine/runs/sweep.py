@@ -465,9 +465,14 @@ def run_sweep(cells: list[Cell], out_root, *, backend: str = "local", workers: i
     Raises :class:`SweepError` (before any cell runs) when ``OUT`` holds a cell run with other parameters, or its
     ``sweep.json`` or ``results.csv`` cannot be read back or written (``check_table``).
     """
-    from ..core.runfolder import ensure_dir
+    from ..core.runfolder import ensure_dir, locked
 
     out_root = ensure_dir(out_root)
+    with locked(out_root):  # a second sweep here would race this one's rows and compaction of the table
+        return _run_locked(cells, out_root, backend, workers, address, retries)
+
+
+def _run_locked(cells: list[Cell], out_root: Path, backend: str, workers, address, retries: int) -> Path:
     table = out_root / "results.csv"
     check_table(table, cells)
     check_params(cells, out_root)
