@@ -285,6 +285,45 @@ def test_a_sweep_is_refused_while_another_holds_its_folder(tmp_path, capsys):
     assert sweep.main([*SWEEP, "--out", str(out)]) == 0 and not (out / ".lock").exists()
 
 
+def test_figures_are_refused_while_a_sweep_holds_their_folder(tmp_path, capsys):
+    from specrefine.core.runfolder import locked
+
+    out = tmp_path / "s"
+    assert sweep.main([*SWEEP, "--out", str(out)]) == 0
+    capsys.readouterr()
+    before = snapshot(out)
+    with locked(out):  # the sweep still running there: figures' default --out is the table's folder
+        err = one_line_2(cli_main, ["figures", str(out / "results.csv")], capsys)
+    assert "in use by another run" in err and snapshot(out) == before
+    assert cli_main(["figures", str(out / "results.csv")]) == 0
+    assert {"figure4.png", "summary.md"} <= {p.name for p in out.iterdir()} and not (out / ".lock").exists()
+
+
+def test_calibrate_is_refused_while_another_appends_its_table(finished, tmp_path, capsys):
+    from specrefine.core.runfolder import appending_alone
+
+    table = tmp_path / "predictions.csv"
+    table.write_text("cell,success_rate\nolder,0.5\n")
+    with appending_alone(table) as fh:  # another calibrate resuming the same table
+        err = one_line_2(cli_main, ["calibrate", str(finished), "--table", str(table)], capsys)
+        assert "another command is appending" in err and table.read_text() == "cell,success_rate\nolder,0.5\n"
+        fh.write("other,0.25\n")
+    cli_main(["calibrate", str(finished), "--table", str(table)])
+    cells = [r["cell"] for r in csv.DictReader(table.open())]
+    assert cells == ["older", "other", finished.name]  # its row appended once, after the other's
+
+
+def test_bench_refine_is_refused_while_another_appends_its_table(tmp_path, capsys):
+    from specrefine.bench.__main__ import main as bench_main
+    from specrefine.core.runfolder import appending_alone
+
+    table = tmp_path / "bench.csv"
+    with appending_alone(table):
+        err = one_line_2(bench_main, ["refine", "--agent", "point", "--mazes", "u_maze", "--seeds", "0",
+                                      "--episodes", "2", "--table", str(table)], capsys)
+    assert "another command is appending" in err and table.read_text() == ""
+
+
 # --- 7. a FIFO among the inputs is refused, never opened -------------------------------------------------
 @pytest.mark.parametrize("name", ["result.json", "policy.json"])
 def test_a_fifo_in_the_run_folder_is_one_line_not_a_hang(run, name):

@@ -12,6 +12,7 @@ so a long Ant benchmark can be interrupted and resumed.
 from __future__ import annotations
 
 import csv
+import os
 import shutil
 import tempfile
 import time
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
-from ..core.runfolder import open_append
+from ..core.runfolder import appending_alone
 from ..runs.config import DEFAULTS
 
 COLUMNS = ["maze", "agent", "method", "proposer", "seed", "evaluation", "success_rate", "success_ci_low",
@@ -30,17 +31,28 @@ EVALUATIONS = ("fixed", "adaptive")
 
 def bench_refinement(mazes, seeds, agent: str = "ant", method: str = "ours", proposer: str = "geometric",
                      table=None, episodes: int = DEFAULTS.episodes) -> dict:
-    """Run the grid (resuming ``table``) and return totals and ratios per maze and overall."""
-    rows = _read(table) if table else []
+    """Run the grid (resuming ``table``, held by this run alone) and return totals and ratios per maze and overall."""
+    if not table:
+        return _bench(mazes, seeds, agent, method, proposer, episodes, [], None)
+    Path(table).parent.mkdir(parents=True, exist_ok=True)
+    with appending_alone(table, "table") as fh:  # never through a link; a second bench on this table is refused
+        return _bench(mazes, seeds, agent, method, proposer, episodes, _read(table), fh)
+
+
+def _bench(mazes, seeds, agent, method, proposer, episodes, rows: list[dict], fh) -> dict:
     done = {(r["maze"], int(r["seed"]), r["evaluation"]) for r in rows}
     todo = [(m, s, e) for m in mazes for s in seeds for e in _order(s) if (m, s, e) not in done]
     if todo:  # untimed: imports, policy, simulator builds, so that neither side pays them
         _run(todo[0][0], 0, "fixed", agent, "dirl", proposer, 8)
+    writer = csv.DictWriter(fh, fieldnames=COLUMNS) if fh else None
+    if writer and os.fstat(fh.fileno()).st_size == 0:
+        writer.writeheader()
     for maze, seed, evaluation in tqdm(todo, desc=f"bench refinement ({agent})"):
         row = _run(maze, seed, evaluation, agent, method, proposer, episodes)
         rows.append(row)
-        if table:
-            _append(table, row)
+        if writer:  # flushed row by row: an interrupted bench keeps what it measured
+            writer.writerow(row)
+            fh.flush()
     return summary([r for r in rows if r["maze"] in mazes and int(r["seed"]) in seeds])
 
 
@@ -124,14 +136,3 @@ def _read(path) -> list[dict]:
         return []
     with path.open(newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-def _append(path, row: dict) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    new = not path.exists() or path.stat().st_size == 0
-    with open_append(path, "table") as fh:  # never through a link
-        writer = csv.DictWriter(fh, fieldnames=COLUMNS)
-        if new:
-            writer.writeheader()
-        writer.writerow(row)

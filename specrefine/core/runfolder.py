@@ -18,7 +18,8 @@
   is replaced, never written through), not where the run appends (``APPENDED``).  Temporary files a killed
   run left (``.NAME.PID.tmp``, in the folder and its cache) are removed once the lock is held.
 
-Every file a command writes is opened without following a link (:func:`replacing`, :func:`open_append`), and an
+Every file a command writes is opened without following a link (:func:`replacing`, :func:`open_append`; a table
+that a command resumes row by row is held by it alone: :func:`appending_alone`), and an
 output named by the user (``--out FILE``) is checked before any work by :func:`output_file`: a regular file or a
 new path, in a folder this process can write, never a run folder's own file; writing into a run folder takes that
 folder's lock, as a run does.
@@ -264,6 +265,23 @@ def open_append(path, what: str = "file"):
         raise RunFolderError(f"{path}: cannot append to the {what} ({file_kind(mode)})")
     os.set_blocking(fd, True)
     return os.fdopen(fd, "a", encoding="utf-8", newline="")
+
+
+@contextmanager
+def appending_alone(path, what: str = "table"):
+    """``with appending_alone(path) as fh:``: ``path`` opened by :func:`open_append` and held by this process alone
+    for the block (``flock`` on the file itself): a second command resuming the same table is refused with one
+    line, instead of both appending the rows neither had when it began."""
+    fh = open_append(path, what)
+    try:
+        try:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise RunFolderError(f"{path}: another command is appending to this {what}: wait for it to finish or "
+                                 f"name another file") from None
+        yield fh
+    finally:
+        fh.close()
 
 
 def write_error(path, exc: OSError, doing: str = "cannot write") -> SpecrefineError:

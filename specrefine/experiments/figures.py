@@ -12,7 +12,7 @@ import numpy as np
 
 from ..core.mazes import u_chain
 from ..core.paper import PAPER
-from ..core.runfolder import save_figure, write_atomic
+from ..core.runfolder import locked, save_figure, write_atomic
 from ..core.tables import goal_points_of
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS  # colours: each method's registry entry
@@ -227,12 +227,12 @@ def run(args, p) -> int:
     try:
         rows = read_checked_table(args.table)
         out = ensure_dir(args.out or Path(args.table).parent)
+        with locked(out):  # a live sweep there (the default --out) is refused: draw it elsewhere or when it ends
+            for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
+                save_figure(make(rows), out / f"{name}.png", dpi=110)
+            write_atomic(out / "summary.md", markdown_table(rows) + "\n")
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
-    for name, make in (("figure4", figure4), ("figure5", figure5), ("figure6", figure6)):
-        fig = make(rows)
-        save_figure(fig, out / f"{name}.png", dpi=110)
-    write_atomic(out / "summary.md", markdown_table(rows) + "\n")
     print(f"{len(rows)} rows -> {out}/figure4.png, figure5.png, figure6.png, summary.md")
     return 0
 

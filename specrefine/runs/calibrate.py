@@ -22,6 +22,7 @@ The held-out episodes run on a copy of the evaluator, so the run's own counters 
 
 from __future__ import annotations
 
+import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -241,6 +242,16 @@ def _covered(inside: int, total: int, words: bool = True) -> str:
         f"{share} ({inside / max(total, 1):.1%})"
 
 
+def _done_cells(table) -> set[str]:
+    """The cells ``table`` has rows for; none where it is no regular file (a link, a FIFO: refused when appended)."""
+    import csv
+
+    if table.is_symlink() or not table.is_file():
+        return set()
+    with table.open(newline="") as fh:
+        return {r["cell"] for r in csv.DictReader(fh)}
+
+
 def _predict_into(table, runs, maze_dir=None) -> int:
     """Append one row per run not yet in ``table`` (resumable, flushed row by row); the number of runs that
     failed (each named on one line; the others go on)."""
@@ -249,27 +260,24 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     from tqdm.auto import tqdm
 
     from ..core.errors import SpecrefineError
-    from ..core.runfolder import open_append
+    from ..core.runfolder import appending_alone
 
     fields = ["cell", "success_rate", "predicted_success", "predicted_ci_low", "predicted_ci_high",
               "prediction_successes", "prediction_episodes", "prediction_sim_steps"]
-    done = set()
-    if table.exists():
-        with table.open(newline="") as fh:
-            done = {r["cell"] for r in csv.DictReader(fh)}
     missing = [r for r in runs if not result_file(r).exists()]
     if missing:  # e.g. the folders of failed sweep cells in a glob
         print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
-    todo = [r for r in runs if r not in missing and run_name(r) not in done]
-    for run in todo:  # every run checked before any is simulated: a bad one is one line, exit 2
-        try:
+    done = _done_cells(table)
+    for run in [r for r in runs if r not in missing and run_name(r) not in done]:  # every run checked before any
+        try:  # is simulated: a bad one is one line, exit 2
             checked_run(run, maze_dir)
         except SpecrefineError as exc:
             raise SpecrefineError(f"{run}: {exc}" if not str(exc).startswith(str(run)) else str(exc)) from None
-    new = not table.exists()
-    with open_append(table, "table") as fh:  # never through a link
+    with appending_alone(table, "table") as fh:  # never through a link; a second calibrate here is refused
+        done = _done_cells(table)  # what was appended before the table was ours
+        todo = [r for r in runs if r not in missing and run_name(r) not in done]
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
-        if new:
+        if os.fstat(fh.fileno()).st_size == 0:
             writer.writeheader()
         failed = 0
         for run in tqdm(todo, desc="predictions"):
