@@ -11,6 +11,7 @@ Refuses to run twice (the table would hold two ours-novertex definitions).
 
 from __future__ import annotations
 
+import argparse
 import csv
 import sys
 
@@ -40,4 +41,10 @@ def main(table: str, controls: str) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main(*sys.argv[1:]))
+    from specrefine.core.argtypes import script_exit_code
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("table", help="the offline comparison's results.csv (rewritten whole)")
+    ap.add_argument("controls", help="the controls' results.csv (its rows appended)")
+    args = ap.parse_args()
+    raise SystemExit(script_exit_code(main, args.table, args.controls))

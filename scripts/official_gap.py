@@ -75,4 +75,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from specrefine.core.argtypes import script_exit_code
+
+    raise SystemExit(script_exit_code(main))

@@ -73,14 +73,16 @@ def gap_table(record: dict) -> str:
 
 
 def main() -> None:
-    from specrefine.core.runfolder import write_atomic
+    from specrefine.core.records import read_json
+    from specrefine.core.runfolder import writable_parent, write_atomic
     from specrefine.runs.official import run_official
 
     p = argparse.ArgumentParser()
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--out", type=Path, default=Path("data/official/ant_gap.json"))
     args = p.parse_args()
-    record = json.loads(args.out.read_text()) if args.out.exists() else {
+    writable_parent(args.out)  # before any run: no link, device or folder
+    record = read_json(args.out, "gap record") if args.out.exists() else {
         "command": f"PYTHONPATH=$PWD python scripts/official_gap_ant.py --episodes {args.episodes}",
         "episodes": args.episodes, "seed": 0, "note": NOTE, "runs": {}}
     for (start, noise), proposers in VARIANTS:
@@ -105,4 +107,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from specrefine.core.argtypes import script_exit_code
+
+    raise SystemExit(script_exit_code(main))

@@ -22,6 +22,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from specrefine.core.runfolder import ensure_dir, locked  # noqa: E402
 from specrefine.runs.pipeline import refine_maze  # noqa: E402
 from specrefine.runs.sweep import Cell, _append, pending, result_row  # noqa: E402
 
@@ -38,25 +39,27 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="runs/unseen")
     args = p.parse_args(argv)
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    table = out / "results.csv"
-    files = {Path(m).stem: Path(m) for m in args.mazes}
-    cells = [Cell.of(name, args.agent, args.method, args.proposer, seed, rollouts=args.rollouts,
-                     episodes=args.episodes)
-             for name in files for seed in args.seeds]
-    for cell in pending(cells, table):
-        result = refine_maze(files[cell.maze], agent=cell.agent, method=cell.method, proposer=cell.proposer,
-                             seed=cell.seed, out=out / "cells" / cell.id, rollouts=cell.rollouts,
-                             episodes=cell.episodes)
-        d = result.data
-        # the row as specrefine.runs.sweep.run_cell builds it
-        _append(table, result_row(d, {**asdict(cell), "cell": cell.id}) | {"proposer_is_vlm": d["proposer_is_vlm"]})
-        lo, hi = d["success_ci"]
-        print(f"{cell.id}: {d['success_rate']:.3f} [{lo:.3f}, {hi:.3f}] over {d['episodes']} episodes, "
-              f"{d['evaluations']} evaluations, {d['wall_seconds']:.0f} s", flush=True)
+    out = ensure_dir(Path(args.out))
+    with locked(out):  # a second run_unseen (or a sweep) on OUT would race its table
+        table = out / "results.csv"
+        files = {Path(m).stem: Path(m) for m in args.mazes}
+        cells = [Cell.of(name, args.agent, args.method, args.proposer, seed, rollouts=args.rollouts,
+                         episodes=args.episodes)
+                 for name in files for seed in args.seeds]
+        for cell in pending(cells, table):
+            result = refine_maze(files[cell.maze], agent=cell.agent, method=cell.method, proposer=cell.proposer,
+                                 seed=cell.seed, out=out / "cells" / cell.id, rollouts=cell.rollouts,
+                                 episodes=cell.episodes)
+            d = result.data
+            # the row as specrefine.runs.sweep.run_cell builds it
+            _append(table, result_row(d, {**asdict(cell), "cell": cell.id}) | {"proposer_is_vlm": d["proposer_is_vlm"]})
+            lo, hi = d["success_ci"]
+            print(f"{cell.id}: {d['success_rate']:.3f} [{lo:.3f}, {hi:.3f}] over {d['episodes']} episodes, "
+                  f"{d['evaluations']} evaluations, {d['wall_seconds']:.0f} s", flush=True)
     return 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from specrefine.core.argtypes import script_exit_code
+
+    raise SystemExit(script_exit_code(main))

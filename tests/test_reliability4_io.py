@@ -324,6 +324,26 @@ def test_bench_refine_is_refused_while_another_appends_its_table(tmp_path, capsy
     assert "another command is appending" in err and table.read_text() == ""
 
 
+@pytest.mark.parametrize("script", [["official_gap.py"], ["official_gap_ant.py"], ["official_info_success.py"],
+                                    ["run_unseen.py"], ["rerun_table_rows.py", "data/results/ant/oracle_paper.csv",
+                                                        "--rows", "1"]])
+def test_a_maintainers_script_refuses_a_device_as_out_in_one_line(script):
+    proc = subprocess.run([sys.executable, str(ROOT / "scripts" / script[0]), *script[1:], "--out", os.devnull],
+                          cwd=ROOT, capture_output=True, text=True, env=os.environ | {"PYTHONPATH": str(ROOT)})
+    err = assert_one_line_2(proc, os.devnull)
+    assert err.startswith(f"{script[0]}: error: ") and stat.S_ISCHR(os.stat(os.devnull).st_mode)
+
+
+def test_run_unseen_is_refused_while_another_holds_its_folder(tmp_path):
+    from specrefine.core.runfolder import locked
+
+    with locked(tmp_path):
+        proc = subprocess.run([sys.executable, str(ROOT / "scripts" / "run_unseen.py"), "--out", str(tmp_path)],
+                              capture_output=True, text=True, env=os.environ | {"PYTHONPATH": str(ROOT)})
+    assert_one_line_2(proc, "in use by another run")
+    assert not (tmp_path / "results.csv").exists()
+
+
 # --- 7. a FIFO among the inputs is refused, never opened -------------------------------------------------
 @pytest.mark.parametrize("name", ["result.json", "policy.json"])
 def test_a_fifo_in_the_run_folder_is_one_line_not_a_hang(run, name):

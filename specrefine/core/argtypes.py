@@ -67,6 +67,20 @@ def exit_code_quiet_on_broken_pipe(main, *args) -> int:
         return 1
 
 
+def script_exit_code(main, *args) -> int:
+    """A maintainer's script's exit code (``scripts/``): bad input it meets (a :class:`SpecrefineError`: an
+    ``--out`` it cannot use, an unreadable record, a folder in use; a file it cannot open) is one line on stderr,
+    exit 2, never a traceback; a closed stdout as :func:`exit_code_quiet_on_broken_pipe`."""
+    from .errors import SpecrefineError
+
+    try:
+        return exit_code_quiet_on_broken_pipe(main, *args)
+    except (SpecrefineError, OSError) as exc:
+        text = f"{exc.filename}: {exc.strerror}" if isinstance(exc, OSError) and exc.filename else str(exc)
+        print(f"{Path(sys.argv[0]).name}: error: {text}", file=sys.stderr)
+        return 2
+
+
 def silence_stdout() -> None:
     """Point stdout at /dev/null, so that the interpreter's last flush after a broken pipe does not raise."""
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
