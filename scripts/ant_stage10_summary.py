@@ -7,27 +7,17 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ant_stage7_summary import chain_cell, held_out_rows, load, open_floor_row  # noqa: E402
+from ant_stage7_summary import chain_rows, held_out_rows, open_floor_row, overlap_rule  # noqa: E402
 
-from specrefine.core.results import difference_text, wilson_ci  # noqa: E402
+from specrefine.core.results import difference_text  # noqa: E402
 
 CHECKS = (1, 2, 3, 4, 5)
 
 
-def overlap_rows(folder: Path, base: str, new: str, verdicts: dict) -> list[str]:
+def overlap_with_difference(kb, nb, kn, nn, base: dict, new: dict) -> tuple[bool, str]:
     """Checks 2 and 4: the new policy's interval overlaps stage 5's or lies above it."""
-    rows = []
-    for number, name, label in ((2, "chain8", "eight goals in a row (planned), 200"),
-                                (4, "turn_chain8", "eight turning goals (90-180 deg, planned), 500")):
-        d = {t: load(folder, f"{name}_{t}.json") for t in (base, new)}
-        if not all(d.values()):
-            continue
-        kb, nb, kn, nn = d[base]["reached"][-1], d[base]["episodes"], d[new]["reached"][-1], d[new]["episodes"]
-        verdicts[number] = wilson_ci(kn, nn)[1] >= wilson_ci(kb, nb)[0]
-        rule = (f"overlap or above: {'holds' if verdicts[number] else 'fails'}; difference "
-                f"{difference_text(kn, nn, kb, nb)} (Newcombe)")
-        rows.append(f"| {number}. {label} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
-    return rows
+    ok, text = overlap_rule(kb, nb, kn, nn, base, new)
+    return ok, f"{text}; difference {difference_text(kn, nn, kb, nb)} (Newcombe)"
 
 
 def count_rule(verdicts: dict, number: int, above: bool):
@@ -43,7 +33,9 @@ def main(folder="data/results/ant/stage10_checks", new="stage10", base="stage5")
     folder, verdicts = Path(folder), {}
     rows = [f"| check | {base} | {new} | rule |", "| --- | --- | --- | --- |"]
     rows += open_floor_row(folder, base, new, verdicts)
-    rows += overlap_rows(folder, base, new, verdicts)
+    rows += chain_rows(folder, base, new, {2: "eight goals in a row (planned), 200",
+                                           4: "eight turning goals (90-180 deg, planned), 500"}, verdicts,
+                       {2: overlap_with_difference, 4: overlap_with_difference})
     rows += held_out_rows(folder, base, new, "", "3. held out U-chain 2, sampled points", count_rule(verdicts, 3, True))
     rows += held_out_rows(folder, base, new, "centre_", "5. held out U-chain 2, centre points",
                           count_rule(verdicts, 5, False))

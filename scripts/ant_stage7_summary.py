@@ -53,23 +53,33 @@ def open_floor_row(folder: Path, base: str, new: str, verdicts: dict) -> list[st
             f"{'holds' if verdicts[1] else 'fails'} |"]
 
 
-def chain_rows(folder: Path, base: str, new: str, labels: dict, verdicts: dict) -> list[str]:
-    """Checks 2 (eight goals: the intervals overlap or the new one lies above) and 4 (turning goals: success not
-    below, flips not above); ``labels``: check number -> its label in the table."""
+def overlap_rule(kb, nb, kn, nn, base: dict, new: dict) -> tuple[bool, str]:
+    """Check 2's rule: the new policy's interval overlaps the base's or lies above it."""
+    ok = wilson_ci(kn, nn)[1] >= wilson_ci(kb, nb)[0]
+    return ok, f"overlap or above: {'holds' if ok else 'fails'}"
+
+
+def turn_rule(kb, nb, kn, nn, base: dict, new: dict) -> tuple[bool, str]:
+    """Check 4's rule: success not below the base's, flips not above."""
+    ok = kn >= kb and sum(new["flipped"]) <= sum(base["flipped"])
+    lo, hi = newcombe_ci(kn, nn, kb, nb)
+    return ok, (f"success not below, flips not above: {'holds' if ok else 'fails'}; difference "
+                f"{kn / nn - kb / nb:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+
+
+def chain_rows(folder: Path, base: str, new: str, labels: dict, verdicts: dict,
+               rules: dict | None = None) -> list[str]:
+    """Checks 2 (eight goals) and 4 (turning goals), each judged by ``rules[number](kb, nb, kn, nn, base_json,
+    new_json) -> (holds, text)`` (default: :func:`overlap_rule`, :func:`turn_rule`); ``labels``: check number ->
+    its label in the table."""
+    rules = rules or {2: overlap_rule, 4: turn_rule}
     rows = []
     for number, name in ((2, "chain8"), (4, "turn_chain8")):
         d = {t: load(folder, f"{name}_{t}.json") for t in (base, new)}
         if not all(d.values()):
             continue
         kb, nb, kn, nn = d[base]["reached"][-1], d[base]["episodes"], d[new]["reached"][-1], d[new]["episodes"]
-        if number == 2:
-            verdicts[2] = wilson_ci(kn, nn)[1] >= wilson_ci(kb, nb)[0]
-            rule = f"overlap or above: {'holds' if verdicts[2] else 'fails'}"
-        else:
-            verdicts[4] = kn >= kb and sum(d[new]["flipped"]) <= sum(d[base]["flipped"])
-            lo, hi = newcombe_ci(kn, nn, kb, nb)
-            rule = (f"success not below, flips not above: {'holds' if verdicts[4] else 'fails'}; difference "
-                    f"{kn / nn - kb / nb:+.3f} [{lo:+.3f}, {hi:+.3f}] (Newcombe)")
+        verdicts[number], rule = rules[number](kb, nb, kn, nn, d[base], d[new])
         rows.append(f"| {number}. {labels[number]} | {chain_cell(d[base])} | {chain_cell(d[new])} | {rule} |")
     return rows
 
