@@ -101,3 +101,19 @@ def test_official_episodes_on_each_runs_own_seed_with_seed_run(tmp_path, monkeyp
     with pytest.raises(SystemExit) as exit_:
         antmaze.main([str(tmp_path), "--seed", "first", "--out", str(tmp_path / "out3")])
     assert exit_.value.code == 2 and "an integer or 'run'" in capsys.readouterr().err
+
+
+def test_an_out_it_cannot_use_is_refused_before_any_official_episode(tmp_path, monkeypatch, capsys):
+    from specrefine.core.runfolder import locked
+
+    monkeypatch.setattr(antmaze, "run_official", lambda *a: pytest.fail("an official episode ran"))
+    _run(tmp_path, "a", "ours", "geometric", 0, 0.9)
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(SystemExit) as exit_:
+        antmaze.main([str(tmp_path), "--official", "10", "--out", str(tmp_path / "file")])
+    assert exit_.value.code == 2 and "not a directory" in capsys.readouterr().err
+    out = tmp_path / "out"
+    out.mkdir()
+    with locked(out), pytest.raises(SystemExit) as exit_:  # another command writing the same table
+        antmaze.main([str(tmp_path), "--out", str(out)])
+    assert exit_.value.code == 2 and "in use" in capsys.readouterr().err and not any(out.iterdir())

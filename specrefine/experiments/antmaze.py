@@ -24,7 +24,7 @@ from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
 from ..core.results import difference_text, rate_text, wilson_ci
-from ..core.runfolder import ensure_dir, read_result, save_figure, write_atomic
+from ..core.runfolder import ensure_dir, locked, read_result, save_figure, write_atomic
 from ..core.tables import csv_text, goal_points_of
 from ..pictures.render import subplots
 from ..runs.methods import METHOD_COLOURS, PROPOSER_METHODS
@@ -160,13 +160,14 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
     try:
+        out = ensure_dir(args.out)  # before minutes of official episodes
         rows = run_rows(args.sweep_dirs, args.official, args.seed)
-        out = ensure_dir(args.out)
+        with locked(out):
+            write_atomic(out / "official.csv", csv_text(rows, FIELDS))
+            write_atomic(out / "table.md", table(rows) + "\n")
+            save_figure(figure(rows), out / "figure.png", dpi=110)
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
-    write_atomic(out / "official.csv", csv_text(rows, FIELDS))
-    write_atomic(out / "table.md", table(rows) + "\n")
-    save_figure(figure(rows), out / "figure.png", dpi=110)
     print(f"{len(rows)} runs -> {out}: official.csv, table.md, figure.png")
     return 0
 
