@@ -2,8 +2,9 @@
 
     specrefine [--plugin MODULE] COMMAND [options]        specrefine COMMAND --help: its options and defaults
 
-Commands: refine, official, sweep, grids, train, calibrate, failures, figures, bench, notebook, show (:data:`COMMANDS`;
-the machinery is :mod:`specrefine.core.commands`). Bad input exits 2 with one line on stderr, never a traceback.
+Commands: :data:`COMMANDS` (refine, official, sweep, grids, train, calibrate, failures, taxonomy, the corrector's
+reports, figures, bench, notebook, show; the machinery is :mod:`specrefine.core.commands`). Bad input exits 2 with one
+line on stderr, never a traceback.
 """
 
 from __future__ import annotations
