@@ -63,8 +63,21 @@ def test_a_run_records_its_preset_and_official_prints_it(tmp_path, capsys):
     assert json.loads((out / "result.json").read_text())["preset"] == "paper"
     capsys.readouterr()
     assert main(["official", str(out), "--episodes", "2"]) == 0
-    assert "the run's preset: paper" in capsys.readouterr().out
+    assert ("the run's preset: paper with method=ours-corrector-span, goal_points=centre (the best preset's "
+            "settings)") in capsys.readouterr().out
     assert json.loads((out / "official.json").read_text())["preset"] == "paper"
+
+
+def test_a_run_given_the_other_presets_settings_is_named_by_both():
+    """The pinned grids give the paper's rules one by one under the default preset: the summary says so."""
+    from specrefine.runs.config import preset_text
+
+    paper_by_flags = replace(RunConfig(agent="ant", preset="paper").resolved(), preset="best").to_dict()
+    assert preset_text(paper_by_flags) == ("best with method=ours, evaluation=fixed, goal_points=sampled, "
+                                           "split_pick=estimate (the paper preset's settings)")
+    assert preset_text(RunConfig(agent="ant").resolved().to_dict()) == "best"
+    assert preset_text(RunConfig(agent="point", method="dirl").resolved().to_dict()) == "best with method=dirl"
+    assert preset_text({"preset": "paper"}) == "paper"  # a result from before its config was recorded
 
 
 def test_an_ant_folder_from_before_the_new_defaults_refuses_them(tmp_path, capsys):

@@ -220,6 +220,29 @@ class RunConfig:
 
 PRESETS = ("best", "paper")
 DEFAULTS = RunConfig()  # the defaults (w, d, k, rollouts, episodes: the paper's): read them here, not written again
+#: the settings a preset decides where they are left unset (the policy is the agent's adopted one under either)
+PRESET_DECIDED = ("method", "evaluation", "goal_points", "split_pick")
+
+
+def preset_text(config: dict) -> str:
+    """A run's preset as its summary names it, from its resolved ``config`` (result.json's): the preset alone where
+    every setting it decides is its own; else the settings given in its place, and the other preset where they are
+    that one's (a run given each of the paper's rules under ``best`` is the paper's: "best with method=ours, ...
+    (the paper preset's settings)")."""
+    preset, agent = config.get("preset"), config.get("agent")
+    if preset not in PRESETS or agent is None:
+        return str(preset or "?")
+
+    def decided(name: str) -> dict:
+        resolved = RunConfig(agent=agent, preset=name).resolved()
+        return {k: getattr(resolved, k) for k in PRESET_DECIDED}
+
+    given = {k: config.get(k) for k, v in decided(preset).items() if config.get(k) != v}
+    if not given:
+        return preset
+    same = [p for p in PRESETS if p != preset and all(config.get(k) == v for k, v in decided(p).items())]
+    return (f"{preset} with {', '.join(f'{k}={v}' for k, v in given.items())}"
+            + (f" (the {same[0]} preset's settings)" if same else ""))
 
 
 def add_run_options(parser, names: Iterable[str] | None = None, *, types: dict[str, Callable] | None = None,

@@ -52,6 +52,7 @@ from ..core.runfolder import output_file, write_atomic, writing_into
 from ..core.standard_maps import to_gymnasium
 from ..evaluation.compositional import CompositionalPolicy
 from ..evaluation.gym_wrapper import TaskJudge
+from .config import preset_text
 from .progress import counted
 
 OFFICIAL_JSON = "official.json"
@@ -169,6 +170,7 @@ def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, rese
     data = {"env_id": env_id(maze, policy.agent), "episodes": n, "success_rate": k / n if n else 0.0,
             "success_ci": list(wilson_ci(k, n)), **sim, "outcomes": outcomes, "seed": seed, "agent": policy.agent,
             "maze": maze.name, "preset": _run_preset(result),
+            "preset_text": preset_text(result.get("config") or {"preset": _run_preset(result)}),
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,
@@ -262,7 +264,8 @@ def _run_preset(result: dict) -> str:
 def summary(data: dict) -> str:
     lo, hi = data["success_ci"]
     line = (f"official {data['env_id']}: success on the original task {data['success_rate']:.3f} "
-            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: {data.get('preset', '?')}")
+            f"(95% CI {lo:.3f}-{hi:.3f}, {data['episodes']} episodes; the run's preset: "
+            f"{data.get('preset_text', data.get('preset', '?'))}")
     rule = (data.get("settings") or {}).get("switching", "at-region")
     line += ")" if rule == "at-region" else f"; switching: {rule})"
     if data.get("sim_success_rate") is not None:

@@ -25,7 +25,7 @@ from ..evaluation.compositional import save_run_policy
 from ..evaluation.monitor import measure
 from ..refine.search import EVALUATIONS
 from .calibrate import predict
-from .config import RunConfig
+from .config import RunConfig, preset_text
 from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
 from .progress import RunProgress
 from .queries import candidate_picture, edge_query_builder  # noqa: F401 (notebooks 03 and 04 import them here)
@@ -43,7 +43,7 @@ class RunResult:
         d = self.data
         lo, hi = d["success_ci"]
         return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
-                f"seed={d['seed']} preset={d.get('preset', '?')}\n"
+                f"seed={d['seed']} preset={preset_text(d.get('config') or {'preset': d.get('preset')})}\n"
                 f"  success on the original task: {_before(d, 'success_rate')}{d['success_rate']:.3f} "
                 f"(95% CI {lo:.3f}-{hi:.3f}, {d['episodes']} episodes)\n"
                 f"  estimated: {_before(d, 'estimate')}{d['search_estimate']:.3f} (the search's own); "
