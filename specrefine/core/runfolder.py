@@ -276,9 +276,11 @@ def appending_alone(path, what: str = "table"):
     try:
         try:
             fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        except BlockingIOError:
             raise RunFolderError(f"{path}: another command is appending to this {what}: wait for it to finish or "
                                  f"name another file") from None
+        except OSError as exc:  # a file system without locks
+            raise write_error(path, exc, f"cannot lock the {what}") from None
         yield fh
     finally:
         fh.close()
