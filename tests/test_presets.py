@@ -73,10 +73,11 @@ def test_a_run_given_the_other_presets_settings_is_named_by_both():
     from specrefine.runs.config import preset_text
 
     paper_by_flags = replace(RunConfig(agent="ant", preset="paper").resolved(), preset="best").to_dict()
-    assert preset_text(paper_by_flags) == ("best with method=ours, evaluation=fixed, goal_points=sampled, "
+    assert preset_text({"config": paper_by_flags}) == ("best with method=ours, evaluation=fixed, goal_points=sampled, "
                                            "split_pick=estimate (the paper preset's settings)")
-    assert preset_text(RunConfig(agent="ant").resolved().to_dict()) == "best"
-    assert preset_text(RunConfig(agent="point", method="dirl").resolved().to_dict()) == "best with method=dirl"
+    assert preset_text({"config": RunConfig(agent="ant").resolved().to_dict()}) == "best"
+    assert preset_text({"config": RunConfig(agent="point", method="dirl").resolved().to_dict()}) == \
+        "best with method=dirl"
     assert preset_text({"preset": "paper"}) == "paper"  # a result from before its config was recorded
 
 

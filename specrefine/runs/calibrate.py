@@ -267,15 +267,16 @@ def _predict_into(table, runs, maze_dir=None) -> int:
     missing = [r for r in runs if not result_file(r).exists()]
     if missing:  # e.g. the folders of failed sweep cells in a glob
         print(f"skipped {len(missing)} run(s) without a result.json, e.g. {missing[0]}")
+    runs = [r for r in runs if r not in missing]
     done = _done_cells(table)
-    for run in [r for r in runs if r not in missing and run_name(r) not in done]:  # every run checked before any
-        try:  # is simulated: a bad one is one line, exit 2
+    for run in [r for r in runs if run_name(r) not in done]:  # every run checked before any is simulated: a bad
+        try:  # one is one line, exit 2
             checked_run(run, maze_dir)
         except SpecrefineError as exc:
             raise SpecrefineError(f"{run}: {exc}" if not str(exc).startswith(str(run)) else str(exc)) from None
     with appending_alone(table, "table") as fh:  # never through a link; a second calibrate here is refused
         done = _done_cells(table)  # what was appended before the table was ours
-        todo = [r for r in runs if r not in missing and run_name(r) not in done]
+        todo = [r for r in runs if run_name(r) not in done]
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         if os.fstat(fh.fileno()).st_size == 0:
             writer.writeheader()

@@ -224,12 +224,13 @@ DEFAULTS = RunConfig()  # the defaults (w, d, k, rollouts, episodes: the paper's
 PRESET_DECIDED = ("method", "evaluation", "goal_points", "split_pick")
 
 
-def preset_text(config: dict) -> str:
-    """A run's preset as its summary names it, from its resolved ``config`` (result.json's): the preset alone where
+def preset_text(result: dict) -> str:
+    """A run's preset as its summary names it, from its result.json's resolved ``config``: the preset alone where
     every setting it decides is its own; else the settings given in its place, and the other preset where they are
     that one's (a run given each of the paper's rules under ``best`` is the paper's: "best with method=ours, ...
-    (the paper preset's settings)")."""
-    preset, agent = config.get("preset"), config.get("agent")
+    (the paper preset's settings)"). A result from before its config was recorded: its ``preset`` as it is."""
+    config = result.get("config") or {}
+    preset, agent = config.get("preset", result.get("preset")), config.get("agent")
     if preset not in PRESETS or agent is None:
         return str(preset or "?")
 

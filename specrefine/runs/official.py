@@ -170,7 +170,7 @@ def _run(run_dir: Path, result: dict, episodes: int, seed: int, start: str, rese
     data = {"env_id": env_id(maze, policy.agent), "episodes": n, "success_rate": k / n if n else 0.0,
             "success_ci": list(wilson_ci(k, n)), **sim, "outcomes": outcomes, "seed": seed, "agent": policy.agent,
             "maze": maze.name, "preset": _run_preset(result),
-            "preset_text": preset_text(result.get("config") or {"preset": _run_preset(result)}),
+            "preset_text": preset_text(result | {"preset": _run_preset(result)}),
             "settings": {"env_dt": policy.env_dt, "hold": policy.hold, "control_period": policy.control_period,
                          "horizon_per_leg": policy.horizon, "legs": len(policy.legs),
                          "max_episode_steps": episode_steps(policy), "continuing_task": True, "reset_target": False,

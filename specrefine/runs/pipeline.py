@@ -43,7 +43,7 @@ class RunResult:
         d = self.data
         lo, hi = d["success_ci"]
         return (f"{d['maze']} [{d['spec']}] | {d['agent']} | method={d['method']} proposer={d['proposer']} "
-                f"seed={d['seed']} preset={preset_text(d.get('config') or {'preset': d.get('preset')})}\n"
+                f"seed={d['seed']} preset={preset_text(d)}\n"
                 f"  success on the original task: {_before(d, 'success_rate')}{d['success_rate']:.3f} "
                 f"(95% CI {lo:.3f}-{hi:.3f}, {d['episodes']} episodes)\n"
                 f"  estimated: {_before(d, 'estimate')}{d['search_estimate']:.3f} (the search's own); "
