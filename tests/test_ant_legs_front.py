@@ -7,6 +7,7 @@ import importlib.util
 import io
 import json
 import re
+import shlex
 import shutil
 from pathlib import Path
 
@@ -459,6 +460,29 @@ def test_readme_states_issue_42s_targets_as_the_checks_count_them():
     assert wide == ("2", "u_chain_4, u_chain_5_subgoals") and "on two, U-chain 4 and U-chain 5 with subgoals" in readme
     sampled = re.search(r"(\d+) of the 9 mazes below 0.90", front("sampled grid")).group(1)
     assert f"is below 0.90 on {sampled} of its 9 mazes" in readme
+
+
+def test_the_paper_preset_grid_beside_the_nearest_grid_regenerates(tmp_path, monkeypatch):
+    """data/results/ant/oracle_paper_vs_scaling.md by the command data/results/README.md names, and the docs' section
+    quotes its pooled difference and costs."""
+    from specrefine.experiments import oracle_check
+
+    monkeypatch.chdir(ROOT)
+    readme = " ".join((ROOT / "data" / "results" / "README.md").read_text().split())
+    command = re.search(r"the same command with `(--baseline .*? --out data/results/ant/oracle_paper_vs_scaling\.md)`",
+                        readme).group(1)
+    out = tmp_path / "vs.md"
+    args = shlex.split(command.removesuffix("data/results/ant/oracle_paper_vs_scaling.md") + str(out))
+    assert oracle_check.main(["data/results/ant/oracle_paper.csv", "--method", "ours", "--level", "0.90",
+                              "--tolerance", "0.05", *args]) == 0
+    shipped = (ROOT / "data" / "results" / "ant" / "oracle_paper_vs_scaling.md").read_text()
+    assert out.read_text() == shipped
+    pooled = re.search(r"difference ([+-]\d\.\d{3} \[[^]]+\]) \(Newcombe 95 %\)\. It spent ([\d.]+x) / ([\d.]+x) / "
+                       r"([\d.]+x) the baseline's", shipped).groups()
+    section = " ".join((ROOT / "docs" / "ant_experiments.md").read_text().split())
+    section = section[section.index("## The paper's rule as `--preset paper`"):]
+    for number in pooled:
+        assert number in section, number
 
 
 def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, monkeypatch):

@@ -94,3 +94,30 @@ def test_a_partial_grids_change_says_which_u_chains_it_extrapolates_over(tmp_pat
     assert "(extrapolated: no run yet of U-chain 3, U-chain 4, U-chain 5)." in text  # the summary's change
     assert "from 1 to 5 rooms: partial (" in text and "; extrapolated: no run yet of U-chain 3" in text
     assert "extrapolated" not in oracle_check.change_text(scaling.flat_claim(_grid("ours", 0.95)), verdict=True)
+
+
+def test_costs_give_each_mazes_spending_as_a_multiple_of_the_baselines(tmp_path):
+    def spending(rows, calls, evaluations, steps):
+        return [r | {"proposer_calls": calls, "evaluations": evaluations, "sim_steps": steps} for r in rows]
+
+    lever = _write(tmp_path / "paper.csv", spending(_grid("ours", 0.90), 3, 40, 500))
+    base = _write(tmp_path / "nearest.csv", spending(_grid("ours", 0.92), 4, 10, 100))
+    out = tmp_path / "check.md"
+    assert oracle_check.main([lever, "--baseline", base, "--describe", "--costs", "--level", "0.90", "--out",
+                              str(out)]) == 0
+    text = out.read_text()
+    assert "| difference | calls / evaluations / simulator steps (x baseline) |" in text
+    assert "| u_chain_5 | 3 | 0.900 [0.873, 0.922] (600) | 0.920 [0.896, 0.939] (600) | -0.020 [" in text
+    assert text.count("| 0.75x / 4.00x / 5.00x |") == len(scaling.MAZES)
+    assert "It spent 0.75x / 4.00x / 5.00x the baseline's calls / evaluations / simulator steps.\n" in text
+    plain = tmp_path / "plain.md"
+    assert oracle_check.main([lever, "--baseline", base, "--describe", "--level", "0.90", "--out", str(plain)]) == 0
+    assert "x baseline" not in plain.read_text() and "It spent" not in plain.read_text()
+
+
+def test_costs_without_a_baseline_is_one_line(tmp_path, capsys):
+    table = _write(tmp_path / "t.csv", _grid("ours", 0.98))
+    with pytest.raises(SystemExit) as exit_:
+        oracle_check.main([table, "--costs", "--out", str(tmp_path / "check.md")])
+    assert exit_.value.code == 2 and "--baseline" in capsys.readouterr().err
+    assert not (tmp_path / "check.md").exists()

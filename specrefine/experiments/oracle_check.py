@@ -7,7 +7,9 @@
 The rule: at least ``--level`` (0.97) on every maze pooled over seeds 0-2 and the change from 1 to 5 rooms within
 +-``--tolerance`` (0.03). Against a baseline (``ours`` on the same cells): the pooled difference over the cells both
 ran with Newcombe's 95 % interval, per maze too; the lever is adopted if, complete, the pooled difference is above 0
-and no maze is more than ``--margin`` (0.03) below. Every proposer here is offline, NOT a VLM.
+and no maze is more than ``--margin`` (0.03) below. ``--costs`` adds, per maze and pooled, the grid's proposer calls,
+subtask evaluations and simulator steps as multiples of the baseline's on the same cells (described, no rule). Every
+proposer here is offline, NOT a VLM.
 """
 
 from __future__ import annotations
@@ -21,6 +23,9 @@ from ..core.runfolder import write_atomic, writing_into
 from .comparison import U_CHAIN_ROOMS
 from .legs import pooled
 from .scaling import MAZES, ORACLE, SEEDS, _runs, flat_claim, read_rows
+
+#: what a run spends, as result.json and the sweep's table name it, and as the check's column names it
+COSTS = {"proposer_calls": "calls", "evaluations": "evaluations", "sim_steps": "simulator steps"}
 
 
 def _cells(rows, method: str) -> dict[tuple[str, int], dict]:
@@ -36,7 +41,7 @@ def against(rows, base_rows, method: str, base_method: str, margin: float | None
     def diff(keys):
         (k1, n1), (k2, n2) = pooled([mine[c] for c in keys]), pooled([base[c] for c in keys])
         return {"cells": len(keys), "lever": (k1, n1), "base": (k2, n2), "difference": k1 / n1 - k2 / n2,
-                "ci": newcombe_ci(k1, n1, k2, n2)}
+                "ci": newcombe_ci(k1, n1, k2, n2), "costs": {k: _ratio(mine, base, keys, k) for k in COSTS}}
 
     per_maze = {m: diff([c for c in common if c[0] == m]) for m in MAZES if any(c[0] == m for c in common)}
     total = diff(common) if common else None
@@ -48,6 +53,16 @@ def against(rows, base_rows, method: str, base_method: str, margin: float | None
     verdict = ("adopted" if adopted else "not adopted") if complete else \
         f"partial ({'adopted' if adopted else 'not adopted'} so far, {len(common)} of {len(MAZES) * len(SEEDS)} cells)"
     return {"total": total, "per_maze": per_maze, "verdict": verdict, "margin": margin}
+
+
+def _ratio(mine: dict, base: dict, keys, field: str) -> float | None:
+    """The grid's total ``field`` over the baseline's on the same cells (None where the baseline spent none)."""
+    spent = sum(float(base[c].get(field) or 0) for c in keys)
+    return sum(float(mine[c].get(field) or 0) for c in keys) / spent if spent else None
+
+
+def _costs_text(d) -> str:
+    return " / ".join("—" if r is None else f"{r:.2f}x" for r in d["costs"].values())
 
 
 def _diff_text(d) -> str:
@@ -78,13 +93,15 @@ def change_text(flat: dict, verdict: bool = False) -> str:
     return f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]" + (f" ({'; '.join(notes)})" if notes else "")
 
 
-def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
+def markdown(flat: dict, vs: dict | None, method: str, base_method: str, costs: bool = False) -> str:
     lines = ["Every proposer here is offline, NOT a VLM (geometric: a planner on the map). Ant, pooled over seeds "
              f"{', '.join(map(str, SEEDS))}, 200 fresh episodes per run; Wilson 95 % intervals.", "",
              f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {change_text(flat, verdict=True)}"
              "; below the level: "
              f"{', '.join(flat['below_level']) or 'none'}.", "", f"Summary: {summary(flat, vs, base_method)}.", ""]
     header = "| maze | seeds | " + method + " |" + (f" {base_method} (baseline) | difference |" if vs else "")
+    costs = costs and vs is not None
+    header += f" {' / '.join(COSTS.values())} (x baseline) |" if costs else ""
     lines += [header, "|---" * (header.count("|") - 1) + "|"]
     for maze, m in flat["per_maze"].items():
         k, n = round(m["success"] * m["episodes"]), m["episodes"]
@@ -92,6 +109,7 @@ def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
         if vs:
             d = vs["per_maze"].get(maze)
             row += (f" {rate_text(*d['base'])} | {_diff_text(d)} |" if d else " — | — |")
+            row += (f" {_costs_text(d)} |" if d else " — |") if costs else ""
         lines.append(row)
     if vs and vs["total"]:
         t = vs["total"]
@@ -99,7 +117,8 @@ def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
                 f"{vs['margin']:.2f} below)." if vs["verdict"] else " (described, no rule).**")
         lines += ["", f"**Against {base_method} on the same {t['cells']} cells{rule} "
                   f"Pooled {rate_text(*t['lever'])} against {rate_text(*t['base'])}: difference {_diff_text(t)} "
-                  "(Newcombe 95 %)."]
+                  "(Newcombe 95 %)." + (f" It spent {_costs_text(t)} the baseline's {' / '.join(COSTS.values())}."
+                                         if costs else "")]
     return "\n".join(lines) + "\n"
 
 
@@ -115,8 +134,12 @@ def main(argv=None) -> int:
     p.add_argument("--margin", type=float, default=0.03)
     p.add_argument("--describe", action="store_true", help="the comparison with the baseline only, no adoption rule "
                                                            "(e.g. the same cells before a fix)")
+    p.add_argument("--costs", action="store_true", help="with --baseline: proposer calls, evaluations and simulator "
+                                                        "steps as multiples of the baseline's (described, no rule)")
     p.add_argument("--out", type=Path, required=True)
     args = p.parse_args(argv)
+    if args.costs and not args.baseline:
+        p.error("--costs compares with a baseline: give --baseline TABLE")
     try:
         with writing_into(args.out) as out:  # checked before any work; a run folder's lock held while writing there
             rows = read_rows([args.table])
@@ -124,7 +147,8 @@ def main(argv=None) -> int:
             flat = flat_claim(rows, args.method, args.level, args.tolerance)
             margin = None if args.describe else args.margin
             vs = against(rows, base, args.method, args.baseline_method, margin) if base is not None else None
-            write_atomic(out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method))
+            write_atomic(out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method,
+                                       costs=args.costs))
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict'] or 'described'}"
