@@ -485,6 +485,26 @@ def test_the_paper_preset_grid_beside_the_nearest_grid_regenerates(tmp_path, mon
         assert number in section, number
 
 
+def test_the_paper_preset_legs_recompute_from_the_shipped_profiles():
+    """docs/ant_experiments.md's per-kind losses of the paper-preset grid's 27 paths against the centre rule's on the
+    same cells, the lost episodes by outcome and the search's estimates, from the shipped JSONs."""
+    paper = json.loads((ANT / "oracle_paper_legs.json").read_text())
+    centre = json.loads((ANT / "scaling_centre" / "leg_profiles.json").read_text())
+    assert {(p["maze"], p["seed"]) for p in paper} == {(p["maze"], p["seed"]) for p in centre} and len(paper) == 27
+    assert docs_marker("paper preset legs") == kinds_line(leg_kinds(paper), leg_kinds(centre), "the centre rule's ")
+    lost = {k: sum(p["episode_outcomes"].get(k, 0) for p in paper) for k in ("flipped", "avoid", "timeout")}
+    estimates = [e for p in paper for e in p["search_estimate"]]
+    others = sorted(e for e in estimates if e < 1)
+    docs = " ".join((ROOT / "docs" / "ant_experiments.md").read_text().split())
+    assert (f"Of the {sum(lost.values()):,} episodes lost, {lost['flipped']} flipped, {lost['avoid']} touched a wall "
+            f"and {lost['timeout']} timed out") in docs
+    count = ["no", "one", "two", "three", "four", "five"][len(others)]
+    assert (f"{len(estimates) - len(others)} of the paths' {len(estimates)} legs have a search estimate of 1.000 (the "
+            f"other {count} {others[0]:.3f}-{others[-1]:.3f})") in docs
+    legs = [len(p["leg_failure"]) for p in paper]
+    assert f"a path's {min(legs)}-{max(legs)} legs" in docs
+
+
 def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, monkeypatch):
     """README's `--preset paper` item: the cells run, the mazes below 0.90 and each maze's pooled success, as
     data/results/ant/oracle_paper_check.md gives them; that check regenerates from its table by the command that
