@@ -14,6 +14,7 @@ import networkx as nx
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_refine_search import _Query
 
 from specrefine.core.graph import TaskGraph, check_refines
 from specrefine.core.regions import Box, Disc
@@ -142,21 +143,6 @@ class MidpointProposer:
         for parts in range(1, w + 1):
             proposals.append([Disc(*(a + (b - a) * t / (parts + 1)), 0.5) for t in range(1, parts + 1)])
         return proposals
-
-
-@dataclass
-class _Query:
-    graph: TaskGraph
-    u: str
-    v: str
-
-    @property
-    def goal(self):
-        return self.graph.region(self.v)
-
-    @property
-    def avoid(self):
-        return self.graph.avoid(self.u, self.v)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
