@@ -503,6 +503,11 @@ def test_the_paper_preset_legs_recompute_from_the_shipped_profiles():
             f"other {count} {others[0]:.3f}-{others[-1]:.3f})") in docs
     legs = [len(p["leg_failure"]) for p in paper]
     assert f"a path's {min(legs)}-{max(legs)} legs" in docs
+    kinds = {name: leg_kinds(side) for name, side in (("paper", paper), ("centre", centre))}
+    rate = {(name, kind): float(row[kind][3].split()[0]) for name, row in kinds.items() for kind in row}
+    for kind in ("straight", "turning"):  # "four to five times more per straight or turning leg"
+        assert 4 <= round(rate["paper", kind] / rate["centre", kind], 1) <= 5, kind
+    assert f"the first leg {rate['paper', 'first leg']:.4f} against {rate['centre', 'first leg']:.4f}" in docs
 
 
 def test_readme_states_the_paper_preset_grid_as_its_check_counts_it(tmp_path, monkeypatch):
