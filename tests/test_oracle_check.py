@@ -121,3 +121,13 @@ def test_costs_without_a_baseline_is_one_line(tmp_path, capsys):
         oracle_check.main([table, "--costs", "--out", str(tmp_path / "check.md")])
     assert exit_.value.code == 2 and "--baseline" in capsys.readouterr().err
     assert not (tmp_path / "check.md").exists()
+
+
+def test_costs_on_a_table_without_them_is_one_line(tmp_path, capsys):
+    lever = _write(tmp_path / "lever.csv", _grid("ours", 0.90))  # no proposer_calls recorded
+    base = _write(tmp_path / "base.csv", _grid("ours", 0.92))
+    with pytest.raises(SystemExit) as exit_:
+        oracle_check.main([lever, "--baseline", base, "--costs", "--out", str(tmp_path / "check.md")])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and len(err.strip().splitlines()) == 1 and "no proposer_calls" in err
+    assert not (tmp_path / "check.md").exists()

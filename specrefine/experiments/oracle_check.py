@@ -14,13 +14,16 @@ proposer here is offline, NOT a VLM.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+
+import numpy as np
 
 from ..core.argtypes import OneLineParser, exit_code_quiet_on_broken_pipe
 from ..core.errors import SpecrefineError
 from ..core.results import newcombe_ci, rate_text
 from ..core.runfolder import write_atomic, writing_into
-from .comparison import U_CHAIN_ROOMS
+from .comparison import U_CHAIN_ROOMS, mean_ratio
 from .legs import pooled
 from .scaling import MAZES, ORACLE, SEEDS, _runs, flat_claim, read_rows
 
@@ -32,16 +35,20 @@ def _cells(rows, method: str) -> dict[tuple[str, int], dict]:
     return {(maze, int(r["seed"])): r for maze in MAZES for r in _runs(rows, maze, method, ORACLE)}
 
 
-def against(rows, base_rows, method: str, base_method: str, margin: float | None) -> dict:
-    """``method`` - ``base_method`` on the cells both ran: pooled and per maze (Newcombe 95 %), and the verdict
-    (None with ``margin`` None: described, no rule)."""
+def against(rows, base_rows, method: str, base_method: str, margin: float | None, costs: bool = False) -> dict:
+    """``method`` - ``base_method`` on the cells both ran: pooled and per maze (Newcombe 95 %), with ``costs`` each
+    side's spending as a multiple of the baseline's, and the verdict (None with ``margin`` None: described, no
+    rule)."""
     mine, base = _cells(rows, method), _cells(base_rows, base_method)
     common = sorted(set(mine) & set(base))
 
     def diff(keys):
         (k1, n1), (k2, n2) = pooled([mine[c] for c in keys]), pooled([base[c] for c in keys])
-        return {"cells": len(keys), "lever": (k1, n1), "base": (k2, n2), "difference": k1 / n1 - k2 / n2,
-                "ci": newcombe_ci(k1, n1, k2, n2), "costs": {k: _ratio(mine, base, keys, k) for k in COSTS}}
+        d = {"cells": len(keys), "lever": (k1, n1), "base": (k2, n2), "difference": k1 / n1 - k2 / n2,
+             "ci": newcombe_ci(k1, n1, k2, n2)}
+        if costs:
+            d["costs"] = {k: _ratio([(mine[c], base[c]) for c in keys], k) for k in COSTS}
+        return d
 
     per_maze = {m: diff([c for c in common if c[0] == m]) for m in MAZES if any(c[0] == m for c in common)}
     total = diff(common) if common else None
@@ -55,10 +62,14 @@ def against(rows, base_rows, method: str, base_method: str, margin: float | None
     return {"total": total, "per_maze": per_maze, "verdict": verdict, "margin": margin}
 
 
-def _ratio(mine: dict, base: dict, keys, field: str) -> float | None:
-    """The grid's total ``field`` over the baseline's on the same cells (None where the baseline spent none)."""
-    spent = sum(float(base[c].get(field) or 0) for c in keys)
-    return sum(float(mine[c].get(field) or 0) for c in keys) / spent if spent else None
+def _ratio(pairs, field: str) -> float | None:
+    """``comparison.mean_ratio`` of ``field`` over the paired cells (None where the baseline spent none)."""
+    try:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = mean_ratio(pairs, field)
+    except (KeyError, TypeError, ValueError):
+        raise SpecrefineError(f"--costs: a cell has no {field} (a table from before it was recorded?)") from None
+    return ratio if math.isfinite(ratio) else None
 
 
 def _costs_text(d) -> str:
@@ -93,14 +104,14 @@ def change_text(flat: dict, verdict: bool = False) -> str:
     return f"{flat['change_1_to_5']:+.3f} [{lo:+.3f}, {hi:+.3f}]" + (f" ({'; '.join(notes)})" if notes else "")
 
 
-def markdown(flat: dict, vs: dict | None, method: str, base_method: str, costs: bool = False) -> str:
+def markdown(flat: dict, vs: dict | None, method: str, base_method: str) -> str:
     lines = ["Every proposer here is offline, NOT a VLM (geometric: a planner on the map). Ant, pooled over seeds "
              f"{', '.join(map(str, SEEDS))}, 200 fresh episodes per run; Wilson 95 % intervals.", "",
              f"**{flat['claim']}: {flat['verdict']}.** Change from 1 to 5 rooms {change_text(flat, verdict=True)}"
              "; below the level: "
              f"{', '.join(flat['below_level']) or 'none'}.", "", f"Summary: {summary(flat, vs, base_method)}.", ""]
     header = "| maze | seeds | " + method + " |" + (f" {base_method} (baseline) | difference |" if vs else "")
-    costs = costs and vs is not None
+    costs = bool(vs and vs["total"] and "costs" in vs["total"])
     header += f" {' / '.join(COSTS.values())} (x baseline) |" if costs else ""
     lines += [header, "|---" * (header.count("|") - 1) + "|"]
     for maze, m in flat["per_maze"].items():
@@ -146,9 +157,9 @@ def main(argv=None) -> int:
             base = read_rows([args.baseline]) if args.baseline else None
             flat = flat_claim(rows, args.method, args.level, args.tolerance)
             margin = None if args.describe else args.margin
-            vs = against(rows, base, args.method, args.baseline_method, margin) if base is not None else None
-            write_atomic(out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method,
-                                       costs=args.costs))
+            vs = against(rows, base, args.method, args.baseline_method, margin, args.costs) if base is not None \
+                else None
+            write_atomic(out, markdown(flat, vs, args.method, args.baseline_label or args.baseline_method))
     except SpecrefineError as exc:
         p.exit(2, f"{p.prog}: error: {exc}\n")
     print(f"{args.out}: {flat['verdict']}" + (f"; against {args.baseline_method}: {vs['verdict'] or 'described'}"
