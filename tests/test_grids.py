@@ -200,9 +200,9 @@ def test_run_grid_runs_the_subset_named_by_mazes_and_seeds():
     assert done.returncode == 2 and done.stdout == "" and "has no mazes u_chain_*" in done.stderr
 
 
-def test_status_counts_each_parts_done_rows_and_names_the_rest(tmp_path, capsys):
+def test_status_counts_done_rows_names_the_rest_and_the_started_ones(tmp_path, capsys, monkeypatch):
     for name in sorted(COMPLETE):  # every cell of a finished grid is done
-        assert all(done == total and not missing for _, done, total, missing in grids.status(grids.get(name)))
+        assert all(st.done == st.total and not st.missing for st in grids.status(grids.get(name)))
     g = grids.get("ant-scaling")  # a table cut short: its done rows are counted, the rest named in run order
     (tmp_path / "data/results/ant/scaling").mkdir(parents=True)
     first = [c.id for c in grids.part_cells(g, 0)]
@@ -214,11 +214,26 @@ def test_status_counts_each_parts_done_rows_and_names_the_rest(tmp_path, capsys)
         writer.writeheader()
         writer.writerows(rows)
     report = grids.status(g, root=tmp_path)
-    assert report[0][1:3] == (3, len(first)) and report[0][3] == first[3:]
-    assert all(done == 0 for _, done, _, _ in report[1:])
+    assert report[0][1:3] == (3, len(first)) and report[0].missing == first[3:] and report[0].started == {}
+    assert all(st.done == 0 for st in report[1:])
     grids.main(["status", "ant-scaling"])
     out = capsys.readouterr().out.splitlines()
     assert len(out) == len(g.parts) and out[0].startswith("part 0: ours x geometric:max_waypoints=48: ")
+    # a cell cut midway (its folder, two evaluations cached) is named with them; a done cell's folder is not
+    sweep = tmp_path / "sweep"
+    cells = Path(g.part_out(0, str(sweep))) / "cells"  # a part's sub-folder of the sweep folder
+    for cell, n in ((first[3], 2), (first[4], 0), (first[0], 5)):
+        (cells / cell / "cache" / "ab").mkdir(parents=True)
+        for k in range(n):
+            (cells / cell / "cache" / "ab" / f"ab{k}.npz").write_bytes(b"x")
+    report = grids.status(g, root=tmp_path, out=str(sweep))
+    assert report[0].started == {first[3]: 2, first[4]: 0} and report[0].done == 3
+    monkeypatch.setattr(grids, "ROOT", tmp_path)  # the command reads the table cut short above
+    grids.main(["status", "ant-scaling", "--out", str(sweep)])
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith(f"done, 2 started ({g.part_table(0)})")
+    assert out[1:3] == [f"  {first[3]}  (started: 2 evaluations cached)",
+                        f"  {first[4]}  (started: 0 evaluations cached)"]
 
 
 def test_seed_cache_copies_entries_whole_and_keeps_existing_ones(tmp_path):

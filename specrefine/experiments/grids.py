@@ -11,7 +11,7 @@ ids and parameters (``OUT/sweep.json`` refuses a cell run with another policy, r
     python -m specrefine.experiments.grids show ant-comparison       # the pinned_sweep.sh commands, in order
     python -m specrefine.experiments.grids args repair --part 0 --step 1    # one step's arguments, shell-quoted
     python -m specrefine.experiments.grids plan repair               # what run_grid.sh reads
-    python -m specrefine.experiments.grids status ant-scaling        # done cells per part, from the shipped tables
+    python -m specrefine.experiments.grids status ant-scaling        # done cells per part (shipped tables), started
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from __future__ import annotations
 import shlex
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from ..core.errors import SpecrefineError
 from ..core.paper import PAPER
@@ -1184,18 +1185,36 @@ def plan(g: ExperimentGrid, out: str | None = None, shipped: str | None = None, 
     return lines
 
 
-def status(g: ExperimentGrid, root: Path = ROOT) -> list[tuple[int, int, int, list[str]]]:
-    """Per part: (part, cells done in its shipped table, cells, the ids still to run, in run order)."""
+class PartStatus(NamedTuple):
+    part: int
+    done: int  #: cells done in the part's shipped table
+    total: int
+    missing: list[str]  #: the ids still to run, in run order
+    started: dict[str, int]  #: of those, the ones with a folder in the sweep folder: evaluations in its cache
+
+
+def status(g: ExperimentGrid, root: Path | None = None, out: str | None = None) -> list[PartStatus]:
+    """Per part: the cells done in its shipped table, the rest, and which of the rest have started in the sweep
+    folder (the grid's, or ``out``; relative paths from ``root``, by default the checkout): a cut cell resumes from
+    its evaluation cache."""
     from ..runs.sweep import is_done, read_checked_table
 
-    out = []
+    root = ROOT if root is None else root
+    report = []
     for i in range(len(g.parts)):
         table = root / g.part_table(i)
         done = {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
         ids = [c.id for c in part_cells(g, i, root=root)]
         missing = [c for c in ids if c not in done]
-        out.append((i, len(ids) - len(missing), len(ids), missing))
-    return out
+        folder = root / g.part_out(i, out) / "cells"
+        started = {c: _cached(folder / c) for c in missing if (folder / c).is_dir()}
+        report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started))
+    return report
+
+
+def _cached(cell: Path) -> int:
+    """Evaluations in a cell folder's cache (one ``.npz`` each)."""
+    return sum(1 for _ in (cell / "cache").rglob("*.npz"))
 
 
 def add_arguments(p) -> None:
@@ -1207,7 +1226,8 @@ def add_arguments(p) -> None:
     for name, what in (("show", "the pinned_sweep.sh commands of a grid, in order"),
                        ("args", "one step's sweep arguments, shell-quoted on one line"),
                        ("plan", "the code and steps run_grid.sh runs"),
-                       ("status", "cells done per part, from the shipped tables (--missing: which are not)")):
+                       ("status", "cells done per part, from the shipped tables, and those started in the sweep folder "
+                                  "(--missing: every cell not done)")):
         sp = sub.add_parser(name, help=what, description=what)
         sp.add_argument("grid", help="a grid's name (specrefine grids list)")
         if name == "args":
@@ -1223,6 +1243,8 @@ def add_arguments(p) -> None:
                             help="only these of the grid's seeds (default: all)")
         if name == "status":
             sp.add_argument("--missing", action="store_true", help="list the cells still to run")
+            sp.add_argument("--out", default=None, help="the sweep folder to look for started cells in (parts: "
+                                                        "under it) (default: the grid's)")
         if name == "plan":
             sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it) "
                                                         "(default: the grid's)")
@@ -1250,12 +1272,13 @@ def run(args, p) -> int:
         if args.grids_command == "show":
             print("\n".join(show(g)))
         elif args.grids_command == "status":
-            for i, done, total, missing in status(g):
-                part = g.parts[i]
-                print(f"part {i}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {done}/{total} done "
-                      f"({g.part_table(i)})")
-                if args.missing:
-                    print("".join(f"  {cell}\n" for cell in missing), end="")
+            for st in status(g, out=args.out):
+                part = g.parts[st.part]
+                print(f"part {st.part}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {st.done}/{st.total} "
+                      f"done, {len(st.started)} started ({g.part_table(st.part)})")
+                for cell in st.missing if args.missing else st.started:
+                    cached = st.started.get(cell)
+                    print(f"  {cell}" + ("" if cached is None else f"  (started: {cached} evaluations cached)"))
         elif args.grids_command == "plan":
             print("\n".join(plan(g, args.out, args.shipped, _subset(args))))
         else:

@@ -104,8 +104,8 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
     """(cells done in the shipped tables, cells) of grid ``name``."""
     from ..grids import status
 
-    done = [(d, total) for _, d, total, _ in status(GRIDS[name], root)]
-    return sum(d for d, _ in done), sum(t for _, t in done)
+    parts = status(GRIDS[name], root)
+    return sum(p.done for p in parts), sum(p.total for p in parts)
 
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
