@@ -13,7 +13,7 @@ from ...core.runfolder import locked, write_atomic
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT
-from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD, ANT_SEEDS
+from .ant import ANT_BEFORE, ANT_CANDIDATES, ANT_FIRST, ANT_FLOOR, ANT_GRID, ANT_METHOD, ANT_SEEDS, ANT_SUCCESSORS
 from .anyproposer import any_study, any_text
 from .common import (
     ADOPTABLE,
@@ -117,7 +117,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
-             ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES)
+             ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES, *ANT_SUCCESSORS)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
