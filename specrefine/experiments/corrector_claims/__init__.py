@@ -105,6 +105,7 @@ from .frontpage import (
     adoption_text,
     ant_text,
     fill,
+    forecast_text,
     fresh_text,
     front,
     gated_text,
@@ -136,5 +137,5 @@ __all__ = [
     "fresh_study", "front", "held_out_study", "levers_markdown", "levers_study", "load", "main", "markdown",
     "new_study", "point_study", "reference_of", "reported", "rules_table", "run", "table_name", "unseen",
     "variant_markdown", "variant_studies", "variant_study", "variant_verdicts", "verdicts", "adoption_text",
-    "ant_text", "fresh_text", "gated_text", "helps_word", "new_text", "unseen_text", "variant_text",
+    "ant_text", "forecast_text", "fresh_text", "gated_text", "helps_word", "new_text", "unseen_text", "variant_text",
 ]

@@ -122,11 +122,28 @@ def _ant_successor(grid: str, root: Path) -> dict:
     control = (ANT_SUCCESSORS[s.control].method, _ant_paired((grid, s.method), (s.control,
                                                                              ANT_SUCCESSORS[s.control].method), root)
                ) if s.control else None
+    ours_rows = load((ANT_ERRING,), root)
     return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
-            "control": control,
+            "control": control, "calls_forecast": calls_forecast(rows + ours_rows, s.method, base),
             "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
             "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": _pooled_success(study["per_maze"]),
             "adopted": paired["complete"] and all(parts.values())}
+
+
+def calls_forecast(rows: list[dict], method: str, followed: str, proposer: str = "imperfect:moderate") -> dict:
+    """``method``'s proposer calls over ours's on the cells ``followed`` and ours ran (the cost cap's ratio), were the
+    cells ``method`` ran to keep their ratio to ``followed``'s calls on the cells it has not: a forecast while its
+    grid runs, not a result. ``forecast`` NaN before its first such cell."""
+    by = {(r["maze"], r["method"], r["seed"]): float(r["proposer_calls"]) for r in rows
+          if r["proposer"] == proposer and cmp.is_done(r)}
+    cells = [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS if (m, followed, s) in by and (m, "ours", s) in by]
+    run = [(m, s) for m, s in cells if (m, method, s) in by]
+    spent, theirs = (sum(by[(m, who, s)] for m, s in run) for who in (method, followed))
+    rest = sum(by[(m, followed, s)] for m, s in cells if (m, s) not in run)
+    ours = sum(by[(m, "ours", s)] for m, s in cells)
+    ratio = spent / theirs if theirs else math.nan
+    return {"cells": len(cells), "run": len(run), "ratio_to_followed": ratio,
+            "forecast": (spent + ratio * rest) / ours if run and ours else math.nan}
 
 
 def _pooled_success(per_maze: list[dict]) -> float:

@@ -164,6 +164,7 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         for part in INFORMED_PARTS.get(VARIANTS[name], ()):
             out[f"{name}-{part}"] = new_text(study[part]) if study and study.get(part) else "not run yet"
     out["ant"] = ant_text(ant) if ant else "not run yet"
+    out["ant-forecast"] = forecast_text(ant) if ant else "not run yet"
     out["unseen"] = unseen_text(unseen(root))
     defaults = default_studies(root) if defaults is None else defaults
     out["table"] = rules_table(variants.get(reported(variants)), point, ant, defaults)
@@ -243,6 +244,19 @@ def ant_text(ant: dict) -> str:
     seeds = f"{min(ANT_SEEDS)}-{max(ANT_SEEDS)}"
     return ("\n" + f"Success per maze pooled over seeds {seeds} (runs in brackets; Un: U-chain of n rooms, s: with "
             "subgoals), `imperfect:moderate`, stage 5:\n\n" + "\n".join(table) + "\n\n")
+
+
+def forecast_text(ant: dict) -> str:
+    """Each Ant successor still running: its proposer calls over ours's forecast for its whole grid
+    (``ant.calls_forecast``)."""
+    parts = []
+    for c in ant["successors"]:
+        f = c["calls_forecast"]
+        if 0 < f["run"] < f["cells"]:
+            parts.append(f"{c['method']} {f['forecast']:.2f}x `ours`'s proposer calls over the {f['cells']} cells (its "
+                         f"{f['run']} cells run at {f['ratio_to_followed']:.2f}x {c['followed_method']}'s calls, that "
+                         f"ratio carried to the other {f['cells'] - f['run']})")
+    return "; ".join(parts) or "no successor running"
 
 
 def _maze_label(maze: str) -> str:
