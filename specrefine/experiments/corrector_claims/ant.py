@@ -11,7 +11,7 @@ from ...core.results import wilson_ci
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT, SCALING_MAZES
-from .common import METHOD, NON_INFERIORITY, SPAN, as_ours, costs, episodes_of, load, paired_rows, zero_runs
+from .common import METHOD, NON_INFERIORITY, SPAN, as_ours, costs, done_cells, episodes_of, load, paired_rows, zero_runs
 
 ANT_FLOOR = 0.85
 #: the Ant's rules read this grid and its method (docs/corrector.md, "The Ant with a confirmed pick")
@@ -111,7 +111,7 @@ def _ant_successor(grid: str, root: Path) -> dict:
     s = ANT_SUCCESSORS[grid]
     base = ANT_CANDIDATES[s.follows]
     study = _ant_grid_study(grid, s.method, root)
-    rows = load(GRIDS[grid].tables + GRIDS[s.follows].tables, root)
+    rows = load(GRIDS[grid].tables + GRIDS[s.follows].tables + (ANT_ERRING,), root)  # ours's rows: the forecast's
     paired = _ant_paired_rows(rows, s.method, base)
     cost = costs(rows, "imperfect:moderate", SCALING_MAZES, ANT_SEEDS, s.method, base)
     bounded = bool(paired["cells"]) and (paired["ci"][0] >= -s.margin if s.margin is not None else paired["ci"][1] >= 0)
@@ -122,9 +122,8 @@ def _ant_successor(grid: str, root: Path) -> dict:
     control = (ANT_SUCCESSORS[s.control].method, _ant_paired((grid, s.method), (s.control,
                                                                              ANT_SUCCESSORS[s.control].method), root)
                ) if s.control else None
-    ours_rows = load((ANT_ERRING,), root)
     return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
-            "control": control, "calls_forecast": calls_forecast(rows + ours_rows, s.method, base),
+            "control": control, "calls_forecast": calls_forecast(rows, s.method, base),
             "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
             "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": _pooled_success(study["per_maze"]),
             "adopted": paired["complete"] and all(parts.values())}
@@ -134,8 +133,7 @@ def calls_forecast(rows: list[dict], method: str, followed: str, proposer: str =
     """``method``'s proposer calls over ours's on the cells ``followed`` and ours ran (the cost cap's ratio), were the
     cells ``method`` ran to keep their ratio to ``followed``'s calls on the cells it has not: a forecast while its
     grid runs, not a result. ``forecast`` NaN before its first such cell."""
-    by = {(r["maze"], r["method"], r["seed"]): float(r["proposer_calls"]) for r in rows
-          if r["proposer"] == proposer and cmp.is_done(r)}
+    by = {cell: float(r["proposer_calls"]) for cell, r in done_cells(rows, proposer).items()}
     cells = [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS if (m, followed, s) in by and (m, "ours", s) in by]
     run = [(m, s) for m, s in cells if (m, method, s) in by]
     spent, theirs = (sum(by[(m, who, s)] for m, s in run) for who in (method, followed))

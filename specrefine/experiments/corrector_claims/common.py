@@ -140,9 +140,14 @@ def zero_runs(rows, method, proposer, mazes, rate: float = 0.0) -> tuple[int, in
     return sum(1 for r in done if float(r["success_rate"]) == rate), len(done)
 
 
+def done_cells(rows, proposer) -> dict:
+    """(maze, method, seed) -> the finished row of ``proposer`` (the last one, where a cell has several)."""
+    return {(r["maze"], r["method"], r["seed"]): r for r in rows if r["proposer"] == proposer and cmp.is_done(r)}
+
+
 def costs(rows, proposer, mazes, seeds, first=METHOD, second="ours") -> dict:
     """Mean evaluations and proposer calls of ``first`` over those of ``second`` on the cells where both ran."""
-    by = {(r["maze"], r["method"], r["seed"]): r for r in rows if r["proposer"] == proposer and cmp.is_done(r)}
+    by = done_cells(rows, proposer)
     pairs = [(by[(m, first, s)], by[(m, second, s)]) for m in mazes for s in seeds
              if (m, first, s) in by and (m, second, s) in by]
     return {"proposer": proposer, "pairs": len(pairs), "evaluations_ratio": cmp.mean_ratio(pairs, "evaluations"),
