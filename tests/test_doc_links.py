@@ -1,7 +1,9 @@
-"""Every relative link of the shipped markdown (README, docs/, data/ and the rest) reaches a file that exists, and a
+"""Every relative link of the shipped markdown (README, docs/, data/ and the rest, and the notebooks' markdown cells)
+reaches a file that exists, and a
 ``#fragment`` into a markdown file names one of its headings as GitHub anchors them: the front page links into long
 headings ("... (fixed 2026-11-27 before it ran)") that are edited as grids land."""
 
+import json
 import re
 from pathlib import Path
 
@@ -32,9 +34,17 @@ def anchors(path: Path) -> set[str]:
     return found
 
 
+def markdown_of(path: Path) -> str:
+    """A markdown file's text, or a notebook's markdown cells."""
+    if path.suffix != ".ipynb":
+        return path.read_text()
+    cells = json.loads(path.read_text())["cells"]
+    return "\n\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "markdown")
+
+
 def broken_links(path: Path) -> list[str]:
     broken = []
-    for target in LINK.findall(path.read_text()):
+    for target in LINK.findall(markdown_of(path)):
         if re.match(r"[a-z][a-z0-9+.-]*:", target):  # https:, mailto: ...
             continue
         file, _, fragment = target.partition("#")
@@ -52,7 +62,8 @@ def test_the_shipped_markdown_is_found():
 
 
 def test_every_relative_link_reaches_its_file_and_heading():
-    broken = {p.relative_to(ROOT).as_posix(): b for p in markdown_files() if (b := broken_links(p))}
+    pages = markdown_files() + sorted((ROOT / "notebooks").glob("*.ipynb"))
+    broken = {p.relative_to(ROOT).as_posix(): b for p in pages if (b := broken_links(p))}
     assert broken == {}
 
 
@@ -64,3 +75,11 @@ def test_a_broken_link_and_a_wrong_heading_are_caught(tmp_path):
                     "[gone](missing.md) [wrong](other.md#not-a-heading) [self](#nothing-here)\n")
     assert broken_links(page) == ["missing.md (no such file)", "other.md#not-a-heading (no such heading)",
                                   "#nothing-here (no such heading)"]
+
+
+def test_a_notebooks_links_are_its_markdown_cells(tmp_path):
+    cells = [{"cell_type": "markdown", "source": ["[gone](gone.md) ", "[ok](nb.ipynb)"]},
+             {"cell_type": "code", "source": ["x = '[code](not-a-link.md)'"]}]
+    notebook = tmp_path / "nb.ipynb"
+    notebook.write_text(json.dumps({"cells": cells}))
+    assert broken_links(notebook) == ["gone.md (no such file)"]
