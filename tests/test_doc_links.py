@@ -1,7 +1,7 @@
 """Every relative link of the shipped markdown (README, docs/, data/ and the rest, and the notebooks' markdown cells)
-reaches a file that exists, and a
-``#fragment`` into a markdown file names one of its headings as GitHub anchors them: the front page links into long
-headings ("... (fixed 2026-11-27 before it ran)") that are edited as grids land."""
+reaches a file that exists, and a ``#fragment`` into a markdown file names one of its headings as GitHub anchors
+them: the front page links into long headings ("... (fixed 2026-11-27 before it ran)") that are edited as grids
+land."""
 
 import json
 import re
