@@ -234,6 +234,25 @@ def test_status_counts_done_rows_names_the_rest_and_the_started_ones(tmp_path, c
     assert out[0].endswith(f"done, 2 started ({g.part_table(0)})")
     assert out[1:3] == [f"  {first[3]}  (started: 2 evaluations cached)",
                         f"  {first[4]}  (started: 0 evaluations cached)"]
+    # a cell held by a live run (this process, its lock naming it) is running now; a cell the sweep finished (a done
+    # row in the sweep folder's own table) is named as such until its row is copied into the shipped table; a lock
+    # left by a dead process is not a running cell
+    from specrefine.core.runfolder import locked
+
+    (cells / first[5] / "cache").mkdir(parents=True)
+    (cells / first[5] / ".lock").write_text("999999999 1\n")  # no such process
+    with (Path(g.part_out(0, str(sweep))) / "results.csv").open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, list(shipped[first[4]]))
+        writer.writeheader()
+        writer.writerow(shipped[first[4]])
+    with locked(cells / first[3]):
+        report = grids.status(g, root=tmp_path, out=str(sweep))
+        grids.main(["status", "ant-scaling", "--out", str(sweep)])
+    assert report[0].running == {first[3]} and report[0].finished == {first[4]}
+    out = capsys.readouterr().out.splitlines()
+    assert out[1:4] == [f"  {first[3]}  (started: 2 evaluations cached; running now)",
+                        f"  {first[4]}  (done in the sweep folder's table, not yet in the shipped one)",
+                        f"  {first[5]}  (started: 0 evaluations cached)"]
 
 
 def test_seed_cache_copies_entries_whole_and_keeps_existing_ones(tmp_path):

@@ -11,7 +11,7 @@ ids and parameters (``OUT/sweep.json`` refuses a cell run with another policy, r
     python -m specrefine.experiments.grids show ant-comparison       # the pinned_sweep.sh commands, in order
     python -m specrefine.experiments.grids args repair --part 0 --step 1    # one step's arguments, shell-quoted
     python -m specrefine.experiments.grids plan repair               # what run_grid.sh reads
-    python -m specrefine.experiments.grids status ant-scaling        # done cells per part (shipped tables), started
+    python -m specrefine.experiments.grids status ant-scaling        # done per part (shipped tables), started, running
 """
 
 from __future__ import annotations
@@ -1191,25 +1191,45 @@ class PartStatus(NamedTuple):
     total: int
     missing: list[str]  #: the ids still to run, in run order
     started: dict[str, int]  #: of those, the ones with a folder in the sweep folder: evaluations in its cache
+    running: frozenset = frozenset()  #: of those started, the ones a live run holds now (their folder's lock)
+    finished: frozenset = frozenset()  #: of those started, the ones done in the sweep folder's own table, not yet
+    #: copied into the shipped one
 
 
 def status(g: ExperimentGrid, root: Path | None = None, out: str | None = None) -> list[PartStatus]:
     """Per part: the cells done in its shipped table, the rest, and which of the rest have started in the sweep
     folder (the grid's, or ``out``; relative paths from ``root``, by default the checkout): a cut cell resumes from
-    its evaluation cache."""
-    from ..runs.sweep import is_done, read_checked_table
+    its evaluation cache; of those, which a live run holds now and which the sweep has finished (its own table)."""
+    from ..core.runfolder import live_holder
 
     root = ROOT if root is None else root
     report = []
     for i in range(len(g.parts)):
-        table = root / g.part_table(i)
-        done = {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
+        done = _done_cells(root / g.part_table(i))
         ids = [c.id for c in part_cells(g, i, root=root)]
         missing = [c for c in ids if c not in done]
-        folder = root / g.part_out(i, out) / "cells"
-        started = {c: _cached(folder / c) for c in missing if (folder / c).is_dir()}
-        report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started))
+        sweep = root / g.part_out(i, out)
+        started = {c: _cached(sweep / "cells" / c) for c in missing if (sweep / "cells" / c).is_dir()}
+        running = frozenset(c for c in started if live_holder(sweep / "cells" / c))
+        finished = frozenset(started) & _done_cells(sweep / "results.csv")
+        report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started, running, finished))
     return report
+
+
+def _done_cells(table: Path) -> set[str]:
+    """The ids of a sweep table's done rows (none where there is no table)."""
+    from ..runs.sweep import is_done, read_checked_table
+
+    return {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
+
+
+def _started_note(st: PartStatus, cell: str) -> str:
+    """What ``status`` says of a cell beside its id: nothing for one not started."""
+    if cell not in st.started:
+        return ""
+    if cell in st.finished:
+        return "  (done in the sweep folder's table, not yet in the shipped one)"
+    return f"  (started: {st.started[cell]} evaluations cached{'; running now' if cell in st.running else ''})"
 
 
 def _cached(cell: Path) -> int:
@@ -1277,8 +1297,7 @@ def run(args, p) -> int:
                 print(f"part {st.part}: {' '.join(part.methods)} x {' '.join(part.proposers)}: {st.done}/{st.total} "
                       f"done, {len(st.started)} started ({g.part_table(st.part)})")
                 for cell in st.missing if args.missing else st.started:
-                    cached = st.started.get(cell)
-                    print(f"  {cell}" + ("" if cached is None else f"  (started: {cached} evaluations cached)"))
+                    print(f"  {cell}{_started_note(st, cell)}")
         elif args.grids_command == "plan":
             print("\n".join(plan(g, args.out, args.shipped, _subset(args))))
         else:
