@@ -422,9 +422,10 @@ def test_the_ants_cost_is_judged_against_ours_on_the_scaling_grids_erring_cells(
     assert found["value"] == f"{calls / 3:.2f}x, 2.00x over 27 pairs" and found["verdict"] == verdict
 
 
-def test_a_running_successors_calls_are_forecast_for_its_grid_from_its_ratio_to_the_corrector_it_follows(tmp_path):
+def test_a_running_successors_costs_are_forecast_for_its_grid_from_its_ratio_to_the_corrector_it_follows(tmp_path):
     """Span's first 9 cells at 3 calls where redraw spent 10: 0.30x redraw, carried to the other 18 cells, gives
-    (9 x 3 + 0.3 x 18 x 10) / (27 x 2) = 1.50x ours's calls; a complete or unstarted successor has no forecast."""
+    (9 x 3 + 0.3 x 18 x 10) / (27 x 2) = 1.50x ours's calls; its evaluations, 10 a cell as redraw's where ours spent
+    5, give 2.00x; a complete or unstarted successor has no forecast."""
     lay(tmp_path, rates)
     lay_grid(tmp_path, cc.ANT_GRID, lambda maze, m, p: 0.9)
     lay_grid(tmp_path, cc.ANT_REDRAW, lambda maze, m, p: 0.9, calls_of=lambda m: 10)
@@ -440,8 +441,11 @@ def test_a_running_successors_calls_are_forecast_for_its_grid_from_its_ratio_to_
     assert by[cc.SPAN]["ratio_to_followed"] == pytest.approx(0.3) and by[cc.SPAN]["forecast"] == pytest.approx(1.5)
     assert by[cc.SPARING_FRUGAL]["forecast"] == pytest.approx(2.0)  # complete: what it spent
     assert by[cc.SPARING]["run"] == 0
-    assert cc.forecast_text(ant) == (f"{cc.SPAN} 1.50x `ours`'s proposer calls over the 27 cells (its 9 cells run at "
-                                     f"0.30x {cc.REDRAW}'s calls, that ratio carried to the other 18)")
+    evaluations = {c["method"]: c["evaluations_forecast"] for c in ant["successors"]}[cc.SPAN]
+    assert evaluations["ratio_to_followed"] == pytest.approx(1.0) and evaluations["forecast"] == pytest.approx(2.0)
+    assert cc.forecast_text(ant) == (f"{cc.SPAN} 1.50x `ours`'s proposer calls (within the 3.0x cap) and 2.00x its "
+                                     f"evaluations (within the 3.0x cap) over the 27 cells (its 9 cells run at 0.30x "
+                                     f"and 1.00x {cc.REDRAW}'s, those ratios carried to the other 18)")
 
 
 def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path):

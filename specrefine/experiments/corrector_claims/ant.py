@@ -123,17 +123,19 @@ def _ant_successor(grid: str, root: Path) -> dict:
                                                                              ANT_SUCCESSORS[s.control].method), root)
                ) if s.control else None
     return {"grid": grid, "method": s.method, "follows": s.follows, "followed_method": base, "rule": s.rule(),
-            "control": control, "calls_forecast": calls_forecast(rows, s.method, base),
+            "control": control, "calls_forecast": cost_forecast(rows, s.method, base),
+            "evaluations_forecast": cost_forecast(rows, s.method, base, "evaluations"),
             "section": s.section, "study": study, "per_maze": study["per_maze"], "paired": paired, "parts": parts,
             "cost_vs_followed": cost, "cost_vs_ours": study["costs"], "pooled": _pooled_success(study["per_maze"]),
             "adopted": paired["complete"] and all(parts.values())}
 
 
-def calls_forecast(rows: list[dict], method: str, followed: str, proposer: str = "imperfect:moderate") -> dict:
-    """``method``'s proposer calls over ours's on the cells ``followed`` and ours ran (the cost cap's ratio), were the
-    cells ``method`` ran to keep their ratio to ``followed``'s calls on the cells it has not: a forecast while its
-    grid runs, not a result. ``forecast`` NaN before its first such cell."""
-    by = {cell: float(r["proposer_calls"]) for cell, r in done_cells(rows, proposer).items()}
+def cost_forecast(rows: list[dict], method: str, followed: str, key: str = "proposer_calls",
+                  proposer: str = "imperfect:moderate") -> dict:
+    """``method``'s spending (``key``: proposer calls or evaluations) over ours's on the cells ``followed`` and ours
+    ran (the cost cap's ratio), were the cells ``method`` ran to keep their ratio to ``followed``'s spending on the
+    cells it has not: a forecast while its grid runs, not a result. ``forecast`` NaN before its first such cell."""
+    by = {cell: float(r[key]) for cell, r in done_cells(rows, proposer).items()}
     cells = [(m, s) for m in SCALING_MAZES for s in ANT_SEEDS if (m, followed, s) in by and (m, "ours", s) in by]
     run = [(m, s) for m, s in cells if (m, method, s) in by]
     spent, theirs = (sum(by[(m, who, s)] for m, s in run) for who in (method, followed))

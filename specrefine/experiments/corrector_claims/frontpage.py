@@ -247,16 +247,23 @@ def ant_text(ant: dict) -> str:
 
 
 def forecast_text(ant: dict) -> str:
-    """Each Ant successor still running: its proposer calls over ours's forecast for its whole grid
-    (``ant.calls_forecast``)."""
+    """Each Ant successor still running: its proposer calls and evaluations over ours's forecast for its whole grid
+    (``ant.cost_forecast``)."""
     parts = []
     for c in ant["successors"]:
-        f = c["calls_forecast"]
-        if 0 < f["run"] < f["cells"]:
-            parts.append(f"{c['method']} {f['forecast']:.2f}x `ours`'s proposer calls over the {f['cells']} cells (its "
-                         f"{f['run']} cells run at {f['ratio_to_followed']:.2f}x {c['followed_method']}'s calls, that "
-                         f"ratio carried to the other {f['cells'] - f['run']})")
+        calls, evals = c["calls_forecast"], c["evaluations_forecast"]
+        cells, run = calls["cells"], calls["run"]
+        if 0 < run < cells:
+            parts.append(f"{c['method']} {calls['forecast']:.2f}x `ours`'s proposer calls ({_cap(calls)}) and "
+                         f"{evals['forecast']:.2f}x its evaluations ({_cap(evals)}) over the {cells} cells (its {run} "
+                         f"cells run at "
+                         f"{calls['ratio_to_followed']:.2f}x and {evals['ratio_to_followed']:.2f}x "
+                         f"{c['followed_method']}'s, those ratios carried to the other {cells - run})")
     return "; ".join(parts) or "no successor running"
+
+
+def _cap(forecast: dict) -> str:
+    return f"{'within' if forecast['forecast'] <= COST_CAP else 'above'} the {COST_CAP}x cap"
 
 
 def _maze_label(maze: str) -> str:
