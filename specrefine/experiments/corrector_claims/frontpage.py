@@ -256,8 +256,7 @@ def forecast_text(ant: dict) -> str:
         if 0 < run < cells:
             parts.append(f"{c['method']} {calls['forecast']:.2f}x `ours`'s proposer calls ({_cap(calls)}) and "
                          f"{evals['forecast']:.2f}x its evaluations ({_cap(evals)}) over the {cells} cells (its {run} "
-                         f"cells run at "
-                         f"{calls['ratio_to_followed']:.2f}x and {evals['ratio_to_followed']:.2f}x "
+                         f"cells run at {calls['ratio_to_followed']:.2f}x and {evals['ratio_to_followed']:.2f}x "
                          f"{c['followed_method']}'s, those ratios carried to the other {cells - run})")
     return "; ".join(parts) or "no successor running"
 
