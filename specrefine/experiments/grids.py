@@ -1201,26 +1201,21 @@ def status(g: ExperimentGrid, root: Path | None = None, out: str | None = None) 
     folder (the grid's, or ``out``; relative paths from ``root``, by default the checkout): a cut cell resumes from
     its evaluation cache; of those, which a live run holds now and which the sweep has finished (its own table)."""
     from ..core.runfolder import live_holder
+    from ..runs.sweep import done_ids, is_done, read_checked_table
 
     root = ROOT if root is None else root
     report = []
     for i in range(len(g.parts)):
-        done = _done_cells(root / g.part_table(i))
+        table = root / g.part_table(i)
+        done = {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
         ids = [c.id for c in part_cells(g, i, root=root)]
         missing = [c for c in ids if c not in done]
         sweep = root / g.part_out(i, out)
         started = {c: _cached(sweep / "cells" / c) for c in missing if (sweep / "cells" / c).is_dir()}
         running = frozenset(c for c in started if live_holder(sweep / "cells" / c))
-        finished = frozenset(started) & _done_cells(sweep / "results.csv")
+        finished = frozenset(started) & done_ids(sweep / "results.csv")  # as the sweep reads its own table
         report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started, running, finished))
     return report
-
-
-def _done_cells(table: Path) -> set[str]:
-    """The ids of a sweep table's done rows (none where there is no table)."""
-    from ..runs.sweep import is_done, read_checked_table
-
-    return {r["cell"] for r in read_checked_table(table) if is_done(r)} if table.is_file() else set()
 
 
 def _started_note(st: PartStatus, cell: str) -> str:

@@ -390,8 +390,13 @@ def _add_columns(path: Path, columns: list[str], missing: list[str]) -> list[str
     return columns
 
 
+def done_ids(table: Path) -> set[str]:
+    """The ids of the cells ``table`` holds done rows for (none where there is no table yet)."""
+    return {r["cell"] for r in read_table(table) if is_done(r)}
+
+
 def pending(cells: list[Cell], table: Path) -> list[Cell]:
-    done = {r["cell"] for r in read_table(table) if is_done(r)}
+    done = done_ids(table)
     return [c for c in cells if c.id not in done]
 
 
