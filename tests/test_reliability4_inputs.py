@@ -31,16 +31,20 @@ CHAIN = ["refine", "u_chain_3", "--agent", "point", "--method", "ours", "--propo
 def test_sim_steps_are_the_same_after_a_rerun_and_after_a_resume_from_part_of_the_cache(tmp_path):
     out = tmp_path / "run"
     record = lambda: json.loads((out / "result.json").read_text())  # noqa: E731
+    counts = lambda: [(step["event"], step["evaluations"], step["sim_steps"])  # noqa: E731 (each step's so far)
+                      for step in map(json.loads, (out / "steps.jsonl").read_text().splitlines())]
     assert cli_main([*CHAIN, "--out", str(out)]) == 0
-    first = record()
+    first, first_counts = record(), counts()
     assert cli_main([*CHAIN, "--out", str(out)]) == 0  # a rerun into the finished folder: every evaluation cached
-    rerun = record()
+    rerun, rerun_counts = record(), counts()
     cache = sorted((out / "cache").rglob("*.npz"))
     for entry in random.Random(40).sample(cache, len(cache) // 2):  # as a kill leaves it: part of the work kept
         entry.unlink()
     (out / "result.json").unlink()
     assert cli_main([*CHAIN, "--out", str(out)]) == 0
     resumed = record()
+    assert rerun_counts == counts() == first_counts  # the step log counts each phase's work as a run in one go does
+    assert first_counts[-1][1] == first["evaluations"] and first_counts[-1][2] <= first["sim_steps"]
     assert first["sim_steps"] == first["sim_steps_simulated"]
     assert rerun["sim_steps"] == resumed["sim_steps"] == first["sim_steps"]
     assert rerun["sim_steps_simulated"] < resumed["sim_steps_simulated"] < first["sim_steps_simulated"]

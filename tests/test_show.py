@@ -80,11 +80,13 @@ def test_show_refuses_what_is_not_a_run_in_one_line(tmp_path, capsys, content):
 
 
 def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, tmp_path, capsys):
-    data = json.loads((runs / "ours" / "result.json").read_text())
+    ours = json.loads((runs / "ours" / "result.json").read_text())
     capsys.readouterr()
     assert main(["show", str(runs / "ours")]) == 0
     out = capsys.readouterr().out
-    assert f"cost: {data['proposer_calls']} proposer calls, {data['evaluations']} evaluations\n" in out  # no correction
+    assert f"cost: {ours['proposer_calls']} proposer calls, {ours['evaluations']} evaluations\n" in out  # no correction
+    assert f"\nspent: search {ours['evaluations']:,} evaluations (" in out  # the search, then the measurement
+    assert "correction" not in out.split("spent:")[1].splitlines()[0]
     run = tmp_path / "corrector"
     assert main(["refine", "u_chain_2", "--method", "ours-corrector", "--proposer", "imperfect:moderate", "--seed", "1",
                  "--out", str(run), *TINY]) == 0
@@ -93,8 +95,13 @@ def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, t
     before = next(s["proposer_calls"] for s in steps if s["event"] == "correct-check")
     capsys.readouterr()
     assert main(["show", str(run)]) == 0
-    assert (f"(proposer calls: {before} in the search, {data['proposer_calls'] - before} in the correction)"
-            in capsys.readouterr().out)
+    out = capsys.readouterr().out
+    assert f"(proposer calls: {before} in the search, {data['proposer_calls'] - before} in the correction)" in out
+    check = next(s for s in steps if s["event"] == "correct-check")
+    spent = re.search(r"spent: search ([\d,]+) evaluations \(.*\), correction ([\d,]+) evaluations", out)
+    searched, corrected = (int(n.replace(",", "")) for n in spent.groups())
+    assert searched == check["evaluations"] > 0  # the search's share ends where the correction began
+    assert searched + corrected == data["evaluations"] == steps[-1]["evaluations"]
 
 
 def unfinished(runs, tmp_path, pid: int, half_line: bool = True):

@@ -683,9 +683,20 @@ class RefinementSearch:
         calls = getattr(self.proposer, "proposer_calls", None)
         if calls is not None:  # the proposer's calls so far: what each phase of the search cost can be read off
             step["proposer_calls"] = calls
+        step.update(evaluator_counts(self.evaluator))
         self.steps.append(step)
         if self.on_step:
             self.on_step(step)
+
+
+def evaluator_counts(evaluator) -> dict:
+    """The evaluations and simulator steps so far, counted as result.json counts them (an earlier run's cached work in
+    the same folder included, so a resumed run logs what a run in one go would); {} for an evaluator without
+    counters."""
+    if not hasattr(evaluator, "evaluations"):
+        return {}
+    return {"evaluations": int(evaluator.evaluations + getattr(evaluator, "disk_hits", 0)),
+            "sim_steps": int(evaluator.sim_steps + getattr(evaluator, "cached_steps", 0))}
 
 
 def shortest_path(graph: TaskGraph, evaluator: SubtaskEvaluator, seed: int = 0) -> SearchResult:

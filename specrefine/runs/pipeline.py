@@ -23,7 +23,7 @@ from ..core.runfolder import replacing, write_atomic
 from ..core.spec import maze_spec_text
 from ..evaluation.compositional import save_run_policy
 from ..evaluation.monitor import measure
-from ..refine.search import EVALUATIONS
+from ..refine.search import EVALUATIONS, evaluator_counts
 from .calibrate import predict
 from .config import RunConfig, preset_text
 from .methods import METHODS, PROPOSER_METHODS, get_method, run_search  # noqa: F401 (names other modules know)
@@ -190,6 +190,7 @@ def _result_dict(exp, config: RunConfig, search, measured, t0) -> dict:
     n_ok, n = int(measured.success.sum()), len(measured.success)
     graph = search.graph
     path_edges = len(search.path) - 1 if search.path else 0
+    counts = evaluator_counts(evaluator)
     return {
         "maze": maze.name, "agent": config.agent, "method": config.method, "proposer": config.proposer,
         "proposer_is_vlm": bool(getattr(proposer, "is_vlm", False)), "seed": config.seed,
@@ -200,10 +201,10 @@ def _result_dict(exp, config: RunConfig, search, measured, t0) -> dict:
         "leg_success": measured.path_result.leg_success if measured.path_result else [],
         "predicted_success": search.predicted_success, "edge_probabilities": search.edge_probabilities,
         # evaluations the result rests on: simulated now, or by an earlier run of the same --out (resume)
-        "evaluations": evaluator.evaluations + getattr(evaluator, "disk_hits", 0),
+        "evaluations": counts["evaluations"],
         "evaluations_simulated": evaluator.evaluations, "cache_hits": getattr(evaluator, "cache_hits", 0),
         # environment steps the result rests on (as evaluations: cached work included), and those simulated now
-        "sim_steps": int(evaluator.sim_steps + getattr(evaluator, "cached_steps", 0)),
+        "sim_steps": counts["sim_steps"],
         "sim_steps_simulated": int(evaluator.sim_steps), "vlm_calls": int(getattr(proposer, "calls", 0) or 0),
         "proposer_calls": int(getattr(proposer, "proposer_calls", 0) or 0),
         "vlm_cost_usd": float(getattr(proposer, "cost_usd", 0.0) or 0.0), "wall_seconds": time.time() - t0,

@@ -4,9 +4,9 @@
 
 prints the run's summary (the input task beside the refined one), its path leg by leg (each subtask's estimate
 from the search's rollouts and its measured success among the episodes that started it), where the wall time
-went, what it asked of the proposer (and, for a corrector, how much of it in the correction), the official
-environment's result if ``specrefine official`` has run, and the paths of its pictures and
-files.  A run not finished yet (still going, or interrupted) is shown from its step log so far: whether a live
+went, what it asked of the proposer and the evaluator (and where: the search, a corrector's correction, the
+measurement), the official environment's result if ``specrefine official`` has run, and the paths of its pictures
+and files.  A run not finished yet (still going, or interrupted) is shown from its step log so far: whether a live
 process holds the folder, the search's steps and proposer calls, and the correction's progress; a sweep's folder,
 cell by cell.  A folder no run has started in is one line (exit 2).
 """
@@ -99,33 +99,54 @@ def time_text(data: dict) -> str:
 
 
 def cost_text(run_dir: Path, data: dict) -> str:
-    """What the run asked of the proposer and the evaluator; where the run corrected its path, the proposer calls
-    before and in the correction (read from steps.jsonl, whose steps carry the calls so far)."""
+    """What the run asked of the proposer and the evaluator, and where it spent it (:func:`spend_text`); where the run
+    corrected its path, the proposer calls before and in the correction (steps.jsonl's steps carry the counts so
+    far)."""
     calls = data.get("proposer_calls")
     if calls is None:
         return ""
     text = f"cost: {calls} proposer calls, {data.get('evaluations', '?')} evaluations"
-    before = calls_before_correction(run_dir / "steps.jsonl")
-    if before is not None:
+    marks = phase_marks(run_dir / "steps.jsonl")
+    before = marks.get("correction", {}).get("proposer_calls")
+    if isinstance(before, int):
         text += f" (proposer calls: {before} in the search, {calls - before} in the correction)"
-    return text
+    spend = spend_text(marks, data)
+    return text + (f"\n{spend}" if spend else "")
 
 
-def calls_before_correction(path: Path) -> int | None:
-    """The proposer's calls when the correction began (its first 'correct-check' step), or None: no correction, a
-    log from before steps carried the calls, or a file that is not a readable regular file."""
-    if not path.is_file():
-        return None
-    try:
-        with path.open(encoding="utf-8") as fh:
-            for line in fh:
-                step = json.loads(line)
-                if step.get("event") == "correct-check":
-                    calls = step.get("proposer_calls")
-                    return calls if isinstance(calls, int) else None
-    except (OSError, ValueError, AttributeError):
-        return None
-    return None
+def phase_marks(path: Path) -> dict[str, dict]:
+    """The steps that end a run's phases, from its step log: ``correction`` the first 'correct-check' (where the
+    correction began), ``end`` the last step (the search's end); {} for a file that is not a readable regular one."""
+    if not path.is_file() or path.is_symlink():
+        return {}
+    steps = _steps(path)
+    marks = {"end": steps[-1]} if steps else {}
+    check = next((s for s in steps if s.get("event") == "correct-check"), None)
+    return marks | ({"correction": check} if check is not None else {})
+
+
+def spend_text(marks: dict[str, dict], data: dict) -> str:
+    """Where the evaluations and simulator steps went: the search (up to the correction, where there is one), the
+    correction, then the measurement and calibration (simulator steps only); "" where the log predates the counts."""
+    end, check = marks.get("end", {}), marks.get("correction")
+    ends = [step for step in (check, end) if step is not None]
+    if not all(isinstance(step.get(key), int) for step in ends for key in ("evaluations", "sim_steps")) or not ends:
+        return ""
+    labels = ["search", "correction"][:len(ends)]
+    before = {"evaluations": 0, "sim_steps": 0}
+    parts = []
+    for label, step in zip(labels, ends):
+        parts.append(f"{label} {step['evaluations'] - before['evaluations']:,} evaluations "
+                     f"({_steps_count(step['sim_steps'] - before['sim_steps'])} simulator steps)")
+        before = step
+    total = data.get("sim_steps")
+    if isinstance(total, int) and total >= end["sim_steps"]:
+        parts.append(f"measurement and calibration {_steps_count(total - end['sim_steps'])} simulator steps")
+    return "spent: " + ", ".join(parts)
+
+
+def _steps_count(n: int) -> str:
+    return f"{n / 1e6:.1f}M" if n >= 1_000_000 else f"{n:,}"
 
 
 def unfinished_text(run_dir: Path) -> str | None:
@@ -151,8 +172,8 @@ def unfinished_text(run_dir: Path) -> str | None:
 
 
 def _progress(log: Path | None, counts: bool = True) -> list[str]:
-    """What a run's step log says so far: its steps by kind with the proposer calls (``counts``), the correction,
-    the phase."""
+    """What a run's step log says so far: its steps by kind with the proposer calls and evaluations (``counts``), the
+    correction, the phase."""
     steps = _steps(log) if log is not None else []
     if not steps:
         return ["no search step logged yet"]
@@ -161,11 +182,12 @@ def _progress(log: Path | None, counts: bool = True) -> list[str]:
 
 
 def _counts(steps: list[dict]) -> str:
-    """The steps logged by kind, with the proposer calls so far."""
+    """The steps logged by kind, with the proposer calls and evaluations so far."""
     counts = Counter(str(step.get("event", "?")) for step in steps)
-    calls = next((s["proposer_calls"] for s in reversed(steps) if isinstance(s.get("proposer_calls"), int)), None)
+    so_far = [f"{last} {noun}" for key, noun in (("proposer_calls", "proposer calls"), ("evaluations", "evaluations"))
+              if (last := next((s[key] for s in reversed(steps) if isinstance(s.get(key), int)), None)) is not None]
     return (f"so far: {len(steps)} search steps (" + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
-            + (f", {calls} proposer calls" if calls is not None else ""))
+            + "".join(f", {part}" for part in so_far))
 
 
 def sweep_text(out: Path) -> str | None:
