@@ -69,7 +69,7 @@ def test_each_command_has_help(command, capsys):
 REQUIRED = {  # the least each command's parser takes (nothing is read: the command's run is replaced)
     "refine": ["u_maze"], "official": ["x"], "grids": ["list"], "train": ["--agent", "point"], "calibrate": ["x"],
     "failures": ["x"], "taxonomy": ["x", "--oracle", "x"], "corrector-diagnosis": ["x", "--reference", "x"],
-    "correction-ledger": ["x"], "chain-agreement": ["x"], "figures": ["x"], "bench": ["evaluator"],
+    "correction-ledger": ["x"], "spend": ["x"], "chain-agreement": ["x"], "figures": ["x"], "bench": ["evaluator"],
     "notebook": ["executed"], "show": ["x"]}
 
 

@@ -97,10 +97,12 @@ def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, t
     assert main(["show", str(run)]) == 0
     out = capsys.readouterr().out
     assert f"(proposer calls: {before} in the search, {data['proposer_calls'] - before} in the correction)" in out
-    check = next(s for s in steps if s["event"] == "correct-check")
+    begin = next(i for i, s in enumerate(steps) if s["event"] == "correct-begin")
+    assert steps[begin + 1]["event"] == "correct-check"
     spent = re.search(r"spent: search ([\d,]+) evaluations \(.*\), correction ([\d,]+) evaluations", out)
     searched, corrected = (int(n.replace(",", "")) for n in spent.groups())
-    assert searched == check["evaluations"] > 0  # the search's share ends where the correction began
+    assert searched == steps[begin]["evaluations"] > 0
+    assert corrected >= len(steps[begin + 1]["path"]) - 1  # its first check estimates every leg on fresh rollouts
     assert searched + corrected == data["evaluations"] == steps[-1]["evaluations"]
 
 

@@ -297,6 +297,7 @@ class RefinementSearch:
         if path and self.cfg.polish_rollouts:
             self._polish(path)
         if path and self.cfg.correct_rollouts:
+            self._log("correct-begin", path=path)  # its counts: what the search (and polish) spent
             if before is not None and path != before[1]:
                 path = self._correct_kept(path, before)
             else:

@@ -115,14 +115,15 @@ def cost_text(run_dir: Path, data: dict) -> str:
 
 
 def phase_marks(path: Path) -> dict[str, dict]:
-    """The steps that end a run's phases, from its step log: ``correction`` the first 'correct-check' (where the
-    correction began), ``end`` the last step (the search's end); {} for a file that is not a readable regular one."""
+    """The steps that end a run's phases, from its step log: ``correction`` the 'correct-begin' step (logged as the
+    correction begins; in a log from before it, the first 'correct-check'), ``end`` the last step (the search's end);
+    {} for a file that is not a readable regular one."""
     if not path.is_file() or path.is_symlink():
         return {}
     steps = _steps(path)
     marks = {"end": steps[-1]} if steps else {}
-    check = next((s for s in steps if s.get("event") == "correct-check"), None)
-    return marks | ({"correction": check} if check is not None else {})
+    begun = [s for s in steps if s.get("event") in ("correct-begin", "correct-check")]
+    return marks | ({"correction": begun[0]} if begun else {})
 
 
 def spend_text(marks: dict[str, dict], data: dict) -> str:

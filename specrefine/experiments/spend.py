@@ -1,0 +1,132 @@
+"""Where finished runs' simulator steps went, phase by phase, read from their evaluation caches (issue 39's cost).
+
+    specrefine spend runs/ant_corrector_span --out data/results/corrector/diagnosis/spend.csv
+
+Descriptive, no rule. Each phase of a search draws its rollouts at a fixed offset from the run's seed: the search's
+own estimates (and each racing stage of adaptive evaluation, ``refine/racing.py``), polish's, the split confirmation's,
+the tuning check's, each correction pass's (its fresh check, its alternatives and its roadmap searches share the
+pass's draw) and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset names its
+phase; an offset none of them makes is counted as ``other``. Runs logged since every step carried the counts so far
+(``specrefine show`` reads those) need none of this; it serves the run folders written before (the Ant's corrector
+grids). Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator steps are
+each entry's own (the batch rows its episodes held); the run's counters also count the padding rows of batches that
+several subtasks shared, so they sum to a few per cent less than ``result.json``'s search steps.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import SpecrefineError
+from ..refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET, PASS_SEED_STEP
+from ..refine.racing import STAGE_SEED_OFFSET
+from ..refine.search import CONFIRM_SEED_OFFSET, POLISH_SEED_OFFSET, TUNE_CHECK_SEED_OFFSET
+from .taxonomy import Run, read_runs
+
+PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
+STAGES = 4  # racing stages told apart
+COLUMNS = ("cell", "maze", "method", "seed", "phase", "evaluations", "sim_steps", "share_of_steps")
+
+
+def phase_offsets(passes: int = PASSES, stages: int = STAGES) -> dict[int, str]:
+    """{seed offset from the run's seed: the phase that draws there}, racing stages included."""
+    draws = {"search": 0, "polish": POLISH_SEED_OFFSET, "confirm": CONFIRM_SEED_OFFSET,
+             "tune-check": TUNE_CHECK_SEED_OFFSET}
+    for p in range(passes):
+        draws[f"pass {p + 1}"] = CHECK_SEED_OFFSET + p * PASS_SEED_STEP
+        draws[f"pass {p + 1} second draw"] = CHECK_SEED_OFFSET + p * PASS_SEED_STEP + CROSS_SEED_OFFSET
+    offsets = {}
+    for name, offset in draws.items():
+        for stage in range(stages + 1):  # stage 0: the draw itself; stage s: racing's s-th stage of it
+            at = offset + stage * STAGE_SEED_OFFSET
+            if at in offsets:
+                raise AssertionError(f"{name} and {offsets[at]} draw at the same offset {at}")
+            offsets[at] = name
+    return offsets
+
+
+def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) -> dict[str, Counter]:
+    """{phase: Counter(evaluations=..., sim_steps=...)} over the cache entries under ``folder``; an unreadable entry
+    is skipped (the run recomputes those too)."""
+    offsets = phase_offsets() if offsets is None else offsets
+    spend: dict[str, Counter] = {}
+    for entry in sorted(folder.rglob("*.npz")):
+        try:
+            with np.load(entry, allow_pickle=False) as z:
+                key, steps = json.loads(str(z["key"])), int(z["steps"])
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        drawn = key.get("seed") if isinstance(key, dict) else None
+        phase = offsets.get(drawn - seed, "other") if isinstance(drawn, int) else "other"
+        spend.setdefault(phase, Counter()).update(evaluations=1, sim_steps=steps)
+    return spend
+
+
+def run_rows(run: Run, folder: Path) -> list[dict]:
+    """One row per phase of a finished run, most steps first."""
+    seed = int(run.result["seed"])
+    spend = cache_spend(folder / "cache", seed)
+    total = sum(c["sim_steps"] for c in spend.values())
+    return [{"cell": run.cell, "maze": run.result.get("maze", ""), "method": run.result.get("method", ""),
+             "seed": seed, "phase": phase, "evaluations": c["evaluations"], "sim_steps": c["sim_steps"],
+             "share_of_steps": round(c["sim_steps"] / total, 4) if total else 0.0}
+            for phase, c in sorted(spend.items(), key=lambda item: -item[1]["sim_steps"])]
+
+
+def spend_rows(folders: list[Path]) -> list[dict]:
+    rows = []
+    for folder in folders:
+        cells = sorted((folder / "cells").iterdir()) if (folder / "cells").is_dir() else [folder]
+        for cell in cells:
+            rows += [row for run in read_runs([cell]) for row in run_rows(run, cell)]
+    if not rows:
+        raise SpecrefineError("no finished run with an evaluation cache in the folders given")
+    return rows
+
+
+def summary(rows: list[dict]) -> str:
+    """Each run's phases as shares of its simulator steps, one line a run."""
+    lines, by_cell = [], {}
+    for row in rows:
+        by_cell.setdefault(row["cell"], []).append(row)
+    for cell, phases in by_cell.items():
+        total = sum(r["sim_steps"] for r in phases)
+        parts = ", ".join(f"{r['phase']} {r['share_of_steps']:.0%} ({r['evaluations']} entries)" for r in phases)
+        lines.append(f"{cell}: {total / 1e6:.1f}M simulator steps: {parts}")
+    return "\n".join(lines) + "\n"
+
+
+def add_arguments(p) -> None:
+    from ..core.argtypes import out_path
+
+    p.description = __doc__.split("\n\n")[0]
+    p.add_argument("runs", nargs="+", type=Path, help="sweep folders (their cells/) or run folders")
+    p.add_argument("--out", type=out_path, default=None, help="a CSV of every run's phases (default: printed only)")
+
+
+def run(args, p) -> int:
+    from ..core.runfolder import write_atomic
+    from ..core.tables import csv_text
+
+    for folder in args.runs:
+        if not folder.is_dir():
+            raise SpecrefineError(f"{folder}: not a folder")
+    rows = spend_rows(args.runs)
+    print(summary(rows), end="")
+    if args.out is not None:
+        write_atomic(args.out, csv_text(rows, COLUMNS))
+    return 0
+
+
+def main(argv=None) -> int:
+    from ..core.commands import run_command
+
+    return run_command("spend", argv, prog="python -m specrefine.experiments.spend")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

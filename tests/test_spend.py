@@ -1,0 +1,54 @@
+"""specrefine spend: a run's simulator steps phase by phase, read from its evaluation cache by each draw's seed."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from specrefine.cli import main
+from specrefine.experiments.spend import phase_offsets
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("spend") / "span"
+    assert main(["refine", "u_chain_2", "--method", "ours-corrector-span", "--proposer", "imperfect:moderate",
+                 "--seed", "1", "--rollouts", "8", "--episodes", "16", "--quiet", "--out", str(out)]) == 0
+    return out
+
+
+def test_every_phase_draws_at_its_own_offset():
+    offsets = phase_offsets()
+    assert offsets[0] == "search" and len(set(offsets.values())) == len(offsets) // 5  # five draws each: racing
+    assert {"polish", "confirm", "tune-check", "pass 1", "pass 2", "pass 1 second draw"} <= set(offsets.values())
+
+
+def test_the_phases_add_up_to_what_the_step_log_counted(run, tmp_path, capsys):
+    table = tmp_path / "spend.csv"
+    capsys.readouterr()
+    assert main(["spend", str(run), "--out", str(table)]) == 0
+    assert capsys.readouterr().out.startswith(f"{run.name}: ")
+    rows = {row["phase"]: row for row in csv.DictReader(table.open())}
+    steps = [json.loads(line) for line in (run / "steps.jsonl").read_text().splitlines()]
+    begin, done = next(s for s in steps if s["event"] == "correct-begin"), steps[-1]
+    assert "other" not in rows and {"search", "polish", "pass 1", "pass 2"} <= set(rows)
+    count = lambda key, phases: sum(int(rows[p][key]) for p in phases if p in rows)  # noqa: E731
+    passes = [p for p in rows if p.startswith("pass")]
+    assert count("evaluations", rows) == done["evaluations"]  # each cache entry simulated once, counted as it went
+    assert count("evaluations", passes) == done["evaluations"] - begin["evaluations"]  # drawn after it began
+    # an entry holds its episodes' rows; the counters also count the padding rows of batches shared by several tasks
+    assert 0.9 * done["sim_steps"] <= count("sim_steps", rows) <= done["sim_steps"]
+    assert 0.9 * (done["sim_steps"] - begin["sim_steps"]) <= count("sim_steps", passes)
+    assert sum(float(row["share_of_steps"]) for row in rows.values()) == pytest.approx(1.0, abs=1e-3)
+
+
+@pytest.mark.parametrize("make", ["missing", "empty"])
+def test_a_folder_with_no_finished_run_is_one_line(tmp_path, capsys, make):
+    folder = tmp_path / "runs"
+    if make == "empty":
+        folder.mkdir()
+    assert main(["spend", str(folder)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(folder) in err or "no finished run" in err
