@@ -31,6 +31,7 @@ def test_the_phases_add_up_to_what_the_step_log_counted(run, tmp_path, capsys):
     assert main(["spend", str(run), "--out", str(table)]) == 0
     assert capsys.readouterr().out.startswith(f"{run.name}: ")
     rows = {row["phase"]: row for row in csv.DictReader(table.open())}
+    assert {row["finished"] for row in rows.values()} == {"True"}
     steps = [json.loads(line) for line in (run / "steps.jsonl").read_text().splitlines()]
     begin, done = next(s for s in steps if s["event"] == "correct-begin"), steps[-1]
     assert "other" not in rows and {"search", "polish", "pass 1", "pass 2"} <= set(rows)
@@ -44,6 +45,27 @@ def test_the_phases_add_up_to_what_the_step_log_counted(run, tmp_path, capsys):
     assert sum(float(row["share_of_steps"]) for row in rows.values()) == pytest.approx(1.0, abs=1e-3)
 
 
+def test_a_run_not_finished_is_read_as_far_as_its_cache_goes(run, tmp_path, capsys):
+    import shutil
+
+    going = tmp_path / "going"
+    shutil.copytree(run, going)
+    (going / "result.json").unlink()
+    (going / "steps.jsonl").rename(going / ".steps.jsonl.1.tmp")
+    for entry in sorted((going / "cache").rglob("*.npz"))[::2]:  # as a kill leaves it: part of the work done
+        entry.unlink()
+    table = tmp_path / "going.csv"
+    capsys.readouterr()
+    assert main(["spend", str(going), "--out", str(table)]) == 0
+    assert "simulator steps so far (not finished): " in capsys.readouterr().out
+    rows = list(csv.DictReader(table.open()))
+    assert {row["finished"] for row in rows} == {"False"}
+    assert sum(int(row["evaluations"]) for row in rows) == len(list((going / "cache").rglob("*.npz")))
+    (going / "run.json").write_text('{"seed": "two"}')
+    assert main(["spend", str(going)]) == 2
+    assert "not a run's record" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("make", ["missing", "empty"])
 def test_a_folder_with_no_finished_run_is_one_line(tmp_path, capsys, make):
     folder = tmp_path / "runs"
@@ -51,4 +73,4 @@ def test_a_folder_with_no_finished_run_is_one_line(tmp_path, capsys, make):
         folder.mkdir()
     assert main(["spend", str(folder)]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and str(folder) in err or "no finished run" in err
+    assert len(err.splitlines()) == 1 and (str(folder) in err or "no run with an evaluation cache" in err)

@@ -48,7 +48,7 @@ COMMANDS: dict[str, Command] = {
     "correction-ledger": Command("specrefine.experiments.correction_ledger",
                                  "what each run's correction decided, and its last check against the measured success"),
     "spend": Command("specrefine.experiments.spend",
-                     "where finished runs' simulator steps went, phase by phase, read from their evaluation caches"),
+                     "where runs' simulator steps went, phase by phase, read from their evaluation caches"),
     "chain-agreement": Command("specrefine.experiments.chain_agreement",
                                "a run's path estimated leg by leg (chained) and as whole episodes, side by side"),
     "figures": Command("specrefine.experiments.figures", "the paper's Figures 4-6 from a sweep table"),

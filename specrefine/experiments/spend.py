@@ -1,4 +1,4 @@
-"""Where finished runs' simulator steps went, phase by phase, read from their evaluation caches (issue 39's cost).
+"""Where runs' simulator steps went, phase by phase, read from their evaluation caches (issue 39's cost).
 
     specrefine spend runs/ant_corrector_span --out data/results/corrector/diagnosis/spend.csv
 
@@ -8,9 +8,10 @@ the tuning check's, each correction pass's (its fresh check, its alternatives an
 pass's draw) and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset names its
 phase; an offset none of them makes is counted as ``other``. Runs logged since every step carried the counts so far
 (``specrefine show`` reads those) need none of this; it serves the run folders written before (the Ant's corrector
-grids). Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator steps are
-each entry's own (the batch rows its episodes held); the run's counters also count the padding rows of batches that
-several subtasks shared, so they sum to a few per cent less than ``result.json``'s search steps.
+grids), and reads a run still going (or interrupted) as far as its cache goes. Evaluations here are cache entries:
+each racing stage is one, as the evaluator counts it. Simulator steps are each entry's own (the batch rows its
+episodes held); the run's counters also count the padding rows of batches that several subtasks shared, so they sum
+to a few per cent less than ``result.json``'s search steps.
 """
 
 from __future__ import annotations
@@ -25,11 +26,11 @@ from ..core.errors import SpecrefineError
 from ..refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET, PASS_SEED_STEP
 from ..refine.racing import STAGE_SEED_OFFSET
 from ..refine.search import CONFIRM_SEED_OFFSET, POLISH_SEED_OFFSET, TUNE_CHECK_SEED_OFFSET
-from .taxonomy import Run, read_runs
+from .taxonomy import read_runs
 
 PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
 STAGES = 4  # racing stages told apart
-COLUMNS = ("cell", "maze", "method", "seed", "phase", "evaluations", "sim_steps", "share_of_steps")
+COLUMNS = ("cell", "maze", "method", "seed", "finished", "phase", "evaluations", "sim_steps", "share_of_steps")
 
 
 def phase_offsets(passes: int = PASSES, stages: int = STAGES) -> dict[int, str]:
@@ -66,25 +67,39 @@ def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) 
     return spend
 
 
-def run_rows(run: Run, folder: Path) -> list[dict]:
-    """One row per phase of a finished run, most steps first."""
-    seed = int(run.result["seed"])
+def run_rows(record: dict, folder: Path, finished: bool = True) -> list[dict]:
+    """One row per phase of the run in ``folder`` (``record``: its result.json, or its run.json while it is not
+    finished), most steps first."""
+    seed = int(record["seed"])
     spend = cache_spend(folder / "cache", seed)
     total = sum(c["sim_steps"] for c in spend.values())
-    return [{"cell": run.cell, "maze": run.result.get("maze", ""), "method": run.result.get("method", ""),
-             "seed": seed, "phase": phase, "evaluations": c["evaluations"], "sim_steps": c["sim_steps"],
+    return [{"cell": folder.name, "maze": record.get("maze", ""), "method": record.get("method", ""), "seed": seed,
+             "finished": finished, "phase": phase, "evaluations": c["evaluations"], "sim_steps": c["sim_steps"],
              "share_of_steps": round(c["sim_steps"] / total, 4) if total else 0.0}
             for phase, c in sorted(spend.items(), key=lambda item: -item[1]["sim_steps"])]
+
+
+def cell_rows(cell: Path) -> list[dict]:
+    """A run folder's rows: finished (result.json), or still going or interrupted (its run.json names the seed)."""
+    from ..core.records import read_json
+
+    for run in read_runs([cell]):
+        return run_rows(run.result, cell)
+    if not (cell / "run.json").is_file():
+        return []
+    record = read_json(cell / "run.json", "run.json")
+    if not isinstance(record, dict) or not isinstance(record.get("seed"), int):
+        raise SpecrefineError(f"{cell / 'run.json'}: not a run's record (no integer seed)")
+    return run_rows(record, cell, finished=False)
 
 
 def spend_rows(folders: list[Path]) -> list[dict]:
     rows = []
     for folder in folders:
         cells = sorted((folder / "cells").iterdir()) if (folder / "cells").is_dir() else [folder]
-        for cell in cells:
-            rows += [row for run in read_runs([cell]) for row in run_rows(run, cell)]
+        rows += [row for cell in cells if cell.is_dir() for row in cell_rows(cell)]
     if not rows:
-        raise SpecrefineError("no finished run with an evaluation cache in the folders given")
+        raise SpecrefineError("no run with an evaluation cache in the folders given")
     return rows
 
 
@@ -96,7 +111,8 @@ def summary(rows: list[dict]) -> str:
     for cell, phases in by_cell.items():
         total = sum(r["sim_steps"] for r in phases)
         parts = ", ".join(f"{r['phase']} {r['share_of_steps']:.0%} ({r['evaluations']} entries)" for r in phases)
-        lines.append(f"{cell}: {total / 1e6:.1f}M simulator steps: {parts}")
+        so_far = "" if phases[0]["finished"] else " so far (not finished)"
+        lines.append(f"{cell}: {total / 1e6:.1f}M simulator steps{so_far}: {parts}")
     return "\n".join(lines) + "\n"
 
 
