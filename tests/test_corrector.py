@@ -40,6 +40,12 @@ class LegTable:
         self.table, self.fresh, self.calls = table, fresh or {}, []
         self.by_seed = by_seed or {}  # seed -> a fresh table of its own (a later pass's draw)
 
+    sim_steps = 0
+
+    @property
+    def evaluations(self) -> int:  # the evaluator's counter, as the search's steps log it so far
+        return len(self.calls)
+
     def evaluate(self, start, goal, avoid, goal_point=None, seed=None, n=None):
         x0 = 0.0 if isinstance(start, Box) else start[1][0]
         x1 = float(goal.centre()[0])
@@ -621,6 +627,7 @@ def test_a_dead_leg_is_finished_over_the_waypoints_of_replies_that_were_each_wro
     assert accepted[-1] == "roadmap"
     found = [s for s in result.steps if s["event"] == "roadmap" and s["reaches_end"]]
     assert found and found[-1]["edge"][1] == "G" and found[-1]["waypoints"] == 1
+    assert 0 < found[-1]["evaluations"] < found[-1]["evaluations_so_far"]  # its own search's, and the run's so far
     assert "a chain of 1, to the leg's end" in describe(found[-1])
 
 

@@ -31,7 +31,7 @@ CHAIN = ["refine", "u_chain_3", "--agent", "point", "--method", "ours", "--propo
 def test_sim_steps_are_the_same_after_a_rerun_and_after_a_resume_from_part_of_the_cache(tmp_path):
     out = tmp_path / "run"
     record = lambda: json.loads((out / "result.json").read_text())  # noqa: E731
-    counts = lambda: [(step["event"], step["evaluations"], step["sim_steps"])  # noqa: E731 (each step's so far)
+    counts = lambda: [(step["event"], step["evaluations_so_far"], step["sim_steps_so_far"])  # noqa: E731
                       for step in map(json.loads, (out / "steps.jsonl").read_text().splitlines())]
     assert cli_main([*CHAIN, "--out", str(out)]) == 0
     first, first_counts = record(), counts()

@@ -101,9 +101,9 @@ def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, t
     assert steps[begin + 1]["event"] == "correct-check"
     spent = re.search(r"spent: search ([\d,]+) evaluations \(.*\), correction ([\d,]+) evaluations", out)
     searched, corrected = (int(n.replace(",", "")) for n in spent.groups())
-    assert searched == steps[begin]["evaluations"] > 0
+    assert searched == steps[begin]["evaluations_so_far"] > 0
     assert corrected >= len(steps[begin + 1]["path"]) - 1  # its first check estimates every leg on fresh rollouts
-    assert searched + corrected == data["evaluations"] == steps[-1]["evaluations"]
+    assert searched + corrected == data["evaluations"] == steps[-1]["evaluations_so_far"]
 
 
 def unfinished(runs, tmp_path, pid: int, half_line: bool = True):

@@ -37,11 +37,12 @@ def test_the_phases_add_up_to_what_the_step_log_counted(run, tmp_path, capsys):
     assert "other" not in rows and {"search", "polish", "pass 1", "pass 2"} <= set(rows)
     count = lambda key, phases: sum(int(rows[p][key]) for p in phases if p in rows)  # noqa: E731
     passes = [p for p in rows if p.startswith("pass")]
-    assert count("evaluations", rows) == done["evaluations"]  # each cache entry simulated once, counted as it went
-    assert count("evaluations", passes) == done["evaluations"] - begin["evaluations"]  # drawn after it began
+    evaluations, steps = done["evaluations_so_far"], done["sim_steps_so_far"]
+    assert count("evaluations", rows) == evaluations  # each cache entry simulated once, counted as it went
+    assert count("evaluations", passes) == evaluations - begin["evaluations_so_far"]  # drawn after it began
     # an entry holds its episodes' rows; the counters also count the padding rows of batches shared by several tasks
-    assert 0.9 * done["sim_steps"] <= count("sim_steps", rows) <= done["sim_steps"]
-    assert 0.9 * (done["sim_steps"] - begin["sim_steps"]) <= count("sim_steps", passes)
+    assert 0.9 * steps <= count("sim_steps", rows) <= steps
+    assert 0.9 * (steps - begin["sim_steps_so_far"]) <= count("sim_steps", passes)
     assert sum(float(row["share_of_steps"]) for row in rows.values()) == pytest.approx(1.0, abs=1e-3)
 
 

@@ -684,7 +684,8 @@ class RefinementSearch:
         calls = getattr(self.proposer, "proposer_calls", None)
         if calls is not None:  # the proposer's calls so far: what each phase of the search cost can be read off
             step["proposer_calls"] = calls
-        step.update(evaluator_counts(self.evaluator))
+        # and the evaluations and simulator steps so far (named apart from a step's own, e.g. a roadmap search's)
+        step.update({f"{key}_so_far": count for key, count in evaluator_counts(self.evaluator).items()})
         self.steps.append(step)
         if self.on_step:
             self.on_step(step)

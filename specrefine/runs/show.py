@@ -20,6 +20,7 @@ from pathlib import Path
 from ..core.errors import SpecrefineError
 from .pipeline import RunResult
 
+SO_FAR = ("evaluations_so_far", "sim_steps_so_far")  # what each step of steps.jsonl counts so far (with proposer_calls)
 PHASES = (("search_seconds", "search"), ("measure_seconds", "measurement"), ("calibrate_seconds", "calibration"),
           ("input_seconds", "input task (after the run's counters)"))
 FILES = (("refined.png", "the refined task and the measured episodes"), ("graph.png", "the refined task graph"),
@@ -131,18 +132,18 @@ def spend_text(marks: dict[str, dict], data: dict) -> str:
     correction, then the measurement and calibration (simulator steps only); "" where the log predates the counts."""
     end, check = marks.get("end", {}), marks.get("correction")
     ends = [step for step in (check, end) if step is not None]
-    if not all(isinstance(step.get(key), int) for step in ends for key in ("evaluations", "sim_steps")) or not ends:
+    if not ends or not all(isinstance(step.get(key), int) for step in ends for key in SO_FAR):
         return ""
     labels = ["search", "correction"][:len(ends)]
-    before = {"evaluations": 0, "sim_steps": 0}
+    before = dict.fromkeys(SO_FAR, 0)
     parts = []
     for label, step in zip(labels, ends):
-        parts.append(f"{label} {step['evaluations'] - before['evaluations']:,} evaluations "
-                     f"({_steps_count(step['sim_steps'] - before['sim_steps'])} simulator steps)")
+        evaluations, steps = (step[key] - before[key] for key in SO_FAR)
+        parts.append(f"{label} {evaluations:,} evaluations ({_steps_count(steps)} simulator steps)")
         before = step
-    total = data.get("sim_steps")
-    if isinstance(total, int) and total >= end["sim_steps"]:
-        parts.append(f"measurement and calibration {_steps_count(total - end['sim_steps'])} simulator steps")
+    total, searched = data.get("sim_steps"), end["sim_steps_so_far"]
+    if isinstance(total, int) and total >= searched:
+        parts.append(f"measurement and calibration {_steps_count(total - searched)} simulator steps")
     return "spent: " + ", ".join(parts)
 
 
@@ -185,7 +186,8 @@ def _progress(log: Path | None, counts: bool = True) -> list[str]:
 def _counts(steps: list[dict]) -> str:
     """The steps logged by kind, with the proposer calls and evaluations so far."""
     counts = Counter(str(step.get("event", "?")) for step in steps)
-    so_far = [f"{last} {noun}" for key, noun in (("proposer_calls", "proposer calls"), ("evaluations", "evaluations"))
+    so_far = [f"{last} {noun}" for key, noun in (("proposer_calls", "proposer calls"),
+                                                 ("evaluations_so_far", "evaluations"))
               if (last := next((s[key] for s in reversed(steps) if isinstance(s.get(key), int)), None)) is not None]
     return (f"so far: {len(steps)} search steps (" + ", ".join(f"{event} {n}" for event, n in counts.items()) + ")"
             + "".join(f", {part}" for part in so_far))
