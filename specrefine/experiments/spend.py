@@ -26,7 +26,6 @@ from ..core.errors import SpecrefineError
 from ..refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET, PASS_SEED_STEP
 from ..refine.racing import STAGE_SEED_OFFSET
 from ..refine.search import CONFIRM_SEED_OFFSET, POLISH_SEED_OFFSET, TUNE_CHECK_SEED_OFFSET
-from .taxonomy import read_runs
 
 PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
 STAGES = 4  # racing stages told apart
@@ -81,10 +80,10 @@ def run_rows(record: dict, folder: Path, finished: bool = True) -> list[dict]:
 
 def cell_rows(cell: Path) -> list[dict]:
     """A run folder's rows: finished (result.json), or still going or interrupted (its run.json names the seed)."""
-    from ..core.records import read_json
+    from ..core.records import read_json, read_result
 
-    for run in read_runs([cell]):
-        return run_rows(run.result, cell)
+    if (cell / "result.json").is_file():
+        return run_rows(read_result(cell / "result.json"), cell)
     if not (cell / "run.json").is_file():
         return []
     record = read_json(cell / "run.json", "run.json")
