@@ -8,7 +8,7 @@ import json
 import pytest
 
 from specrefine.cli import main
-from specrefine.experiments.spend import phase_offsets
+from specrefine.experiments.spend import by_time, phase_offsets
 
 
 @pytest.fixture(scope="module")
@@ -23,6 +23,14 @@ def test_every_phase_draws_at_its_own_offset():
     offsets = phase_offsets()
     assert offsets[0] == "search" and len(set(offsets.values())) == len(offsets) // 5  # five draws each: racing
     assert {"polish", "confirm", "tune-check", "pass 1", "pass 2", "pass 1 second draw"} <= set(offsets.values())
+
+
+def test_draws_at_the_runs_own_seed_count_in_the_pass_running_when_they_were_written():
+    entries = [("search", 1, 10), ("polish", 2, 10), ("pass 1", 5, 10), ("search", 6, 1), ("pass 1 second draw", 7, 1),
+               ("pass 2", 9, 10), ("search", 9, 2), ("search", 12, 3), ("confirm", 13, 1), ("search", 4, 4)]
+    moved = ["search", "polish", "pass 1", "pass 1", "pass 1 second draw", "pass 2", "pass 2", "pass 2", "confirm",
+             "search"]
+    assert [phase for phase, _, _ in by_time(entries)] == moved
 
 
 def test_the_phases_add_up_to_what_the_step_log_counted(run, tmp_path, capsys):

@@ -3,15 +3,17 @@
     specrefine spend runs/ant_corrector_span --out data/results/corrector/diagnosis/spend.csv
 
 Descriptive, no rule. Each phase of a search draws its rollouts at a fixed offset from the run's seed: the search's
-own estimates (and each racing stage of adaptive evaluation, ``refine/racing.py``), polish's, the split confirmation's,
-the tuning check's, each correction pass's (its fresh check, its alternatives and its roadmap searches share the
-pass's draw) and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset names its
-phase; an offset none of them makes is counted as ``other``. Runs logged since every step carried the counts so far
-(``specrefine show`` reads those) need none of this; it serves the run folders written before (the Ant's corrector
-grids), and reads a run still going (or interrupted) as far as its cache goes. Evaluations here are cache entries:
-each racing stage is one, as the evaluator counts it. Simulator steps are each entry's own (the batch rows its
-episodes held); the run's counters also count the padding rows of batches that several subtasks shared, so they sum
-to a few per cent less than ``result.json``'s search steps.
+own estimates (and each racing stage of adaptive evaluation, ``refine/racing.py``), polish's, the split
+confirmation's, the tuning check's, each correction pass's (its fresh check and its alternatives judged on that draw)
+and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset
+names its phase; an offset none of them makes is counted as ``other``. The correction's own Algorithm 1 calls and
+roadmap searches estimate at the run's own seed, as the search does: such an entry is counted in the pass that was
+running when it was written (the last whose first entry, its fresh check, was written before it; file times). Runs
+logged since every step carried the counts so far (``specrefine show`` reads those) need none of this; it serves the
+run folders written before (the Ant's corrector grids), and reads a run still going (or interrupted) as far as its
+cache goes. Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator steps
+are each entry's own (the batch rows its episodes held); the run's counters also count the padding rows of batches
+that several subtasks shared, so they sum to a few per cent less than ``result.json``'s search steps.
 """
 
 from __future__ import annotations
@@ -51,19 +53,37 @@ def phase_offsets(passes: int = PASSES, stages: int = STAGES) -> dict[int, str]:
 
 def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) -> dict[str, Counter]:
     """{phase: Counter(evaluations=..., sim_steps=...)} over the cache entries under ``folder``; an unreadable entry
-    is skipped (the run recomputes those too)."""
+    is skipped (the run recomputes those too). An entry drawn at the run's own seed belongs to the search, or to the
+    correction pass that was running when it was written (:func:`by_time`)."""
     offsets = phase_offsets() if offsets is None else offsets
-    spend: dict[str, Counter] = {}
+    entries = []  # (phase by seed, file time, steps)
     for entry in sorted(folder.rglob("*.npz")):
         try:
             with np.load(entry, allow_pickle=False) as z:
                 key, steps = json.loads(str(z["key"])), int(z["steps"])
+            written = entry.stat().st_mtime_ns
         except (OSError, ValueError, KeyError, TypeError):
             continue
         drawn = key.get("seed") if isinstance(key, dict) else None
-        phase = offsets.get(drawn - seed, "other") if isinstance(drawn, int) else "other"
+        entries.append((offsets.get(drawn - seed, "other") if isinstance(drawn, int) else "other", written, steps))
+    spend: dict[str, Counter] = {}
+    for phase, _, steps in by_time(entries):
         spend.setdefault(phase, Counter()).update(evaluations=1, sim_steps=steps)
     return spend
+
+
+def by_time(entries: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
+    """The entries with those drawn at the run's own seed ("search") moved to the correction pass that was running
+    when they were written: the correction's Algorithm 1 calls and roadmap searches estimate as the search does, and a
+    pass begins with its fresh check, the first entry written at its own draw."""
+    starts = sorted((min(w for p, w, _ in entries if p == phase), phase)
+                    for phase in {p for p, _, _ in entries if p.startswith("pass ") and "second" not in p})
+    moved = []
+    for phase, written, steps in entries:
+        if phase == "search":
+            phase = next((name for start, name in reversed(starts) if start <= written), "search")
+        moved.append((phase, written, steps))
+    return moved
 
 
 def run_rows(record: dict, folder: Path, finished: bool = True) -> list[dict]:
