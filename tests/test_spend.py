@@ -83,3 +83,17 @@ def test_a_folder_with_no_finished_run_is_one_line(tmp_path, capsys, make):
     assert main(["spend", str(folder)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and (str(folder) in err or "no run with an evaluation cache" in err)
+
+
+@pytest.mark.parametrize("out", ["device", "link", "folder"])
+def test_out_that_is_no_regular_file_is_refused_before_any_work(run, tmp_path, capsys, out):
+    target = tmp_path / "target.csv"
+    target.write_text("kept\n")
+    path = {"device": "/dev/null", "link": tmp_path / "link.csv", "folder": tmp_path}[out]
+    if out == "link":
+        path.symlink_to(target)
+    capsys.readouterr()
+    assert main(["spend", str(run), "--out", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1 and "--out" in captured.err
+    assert target.read_text() == "kept\n"

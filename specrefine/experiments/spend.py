@@ -144,16 +144,19 @@ def add_arguments(p) -> None:
 
 
 def run(args, p) -> int:
-    from ..core.runfolder import write_atomic
+    from contextlib import nullcontext
+
+    from ..core.runfolder import write_atomic, writing_into
     from ..core.tables import csv_text
 
     for folder in args.runs:
         if not folder.is_dir():
             raise SpecrefineError(f"{folder}: not a folder")
-    rows = spend_rows(args.runs)
-    print(summary(rows), end="")
-    if args.out is not None:
-        write_atomic(args.out, csv_text(rows, COLUMNS))
+    with nullcontext() if args.out is None else writing_into(args.out) as out:  # checked before any work
+        rows = spend_rows(args.runs)
+        print(summary(rows), end="")
+        if out is not None:
+            write_atomic(out, csv_text(rows, COLUMNS))
     return 0
 
 
