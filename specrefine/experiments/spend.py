@@ -58,6 +58,8 @@ def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) 
     offsets = phase_offsets() if offsets is None else offsets
     entries = []  # (phase by seed, file time, steps)
     for entry in sorted(folder.rglob("*.npz")):
+        if entry.is_symlink() or not entry.is_file():  # a FIFO would block the read; a link is not the run's own
+            continue
         try:
             with np.load(entry, allow_pickle=False) as z:
                 key, steps = json.loads(str(z["key"])), int(z["steps"])
