@@ -150,6 +150,33 @@ def test_corrupt_cache_entry_is_ignored(maze, tmp_path, caplog):
     assert make(maze, cache_dir=tmp_path).evaluate(maze.start, maze.cell_box(3, 3), maze.walls).cached  # rewritten
 
 
+def test_a_fifo_in_a_cache_entrys_place_is_never_opened(maze, tmp_path):
+    import os
+    import signal
+
+    ev = make(maze, cache_dir=tmp_path)
+    a = ev.evaluate(maze.start, maze.cell_box(3, 3), maze.walls)
+    entry = next(tmp_path.rglob("*.npz"))
+    entry.unlink()
+    os.mkfifo(entry)  # opening it to read would wait for a writer forever
+
+    fired = []
+
+    def hung(signum, frame):
+        fired.append(signum)
+        raise TimeoutError("the cache opened a FIFO")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(10)
+    try:
+        b = make(maze, cache_dir=tmp_path).evaluate(maze.start, maze.cell_box(3, 3), maze.walls)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert not fired  # not even a wait that a caught error ended
+    assert not b.cached and b.p == a.p and entry.is_file()  # recomputed, and the entry written whole in its place
+
+
 def test_maze_scale_must_match_agent(maze):
     with pytest.raises(SpecrefineError, match="for_agent"):
         Evaluator(maze, "ant", PointController())

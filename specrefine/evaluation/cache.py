@@ -73,7 +73,7 @@ class ResultCache:
 
     def _load(self, key: str, text: str) -> EdgeResult | None:
         path = self.path(key)
-        if path is None or not path.exists():
+        if path is None or not path.is_file():  # a FIFO in its place is never opened: the read would wait forever
             return None
         try:
             with np.load(path, allow_pickle=False) as z:
