@@ -8,7 +8,8 @@ confirmation's, the tuning check's, each correction pass's (its fresh check and 
 and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset
 names its phase; an offset none of them makes is counted as ``other``. The correction's own Algorithm 1 calls and
 roadmap searches estimate at the run's own seed, as the search does: such an entry is counted in the pass that was
-running when it was written (the last whose first entry, its fresh check, was written before it; file times). Runs
+running when it was written (the last whose first entry, its fresh check, was written before it; file times), as
+"pass N at the run's seed". Runs
 logged since every step carried the counts so far (``specrefine show`` reads those) need none of this; it serves the
 run folders written before (the Ant's corrector grids), and reads a run still going (or interrupted) as far as its
 cache goes. Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator steps
@@ -29,6 +30,7 @@ from ..refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET, PASS_SEED_STE
 from ..refine.racing import STAGE_SEED_OFFSET
 from ..refine.search import CONFIRM_SEED_OFFSET, POLISH_SEED_OFFSET, TUNE_CHECK_SEED_OFFSET
 
+OWN_SEED = "at the run's seed"  # a pass's draws made as the search's: its Algorithm 1 calls and roadmap searches
 PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
 STAGES = 4  # racing stages told apart
 COLUMNS = ("cell", "maze", "method", "seed", "finished", "phase", "evaluations", "sim_steps", "share_of_steps")
@@ -76,15 +78,14 @@ def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) 
 
 def by_time(entries: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
     """The entries with those drawn at the run's own seed ("search") moved to the correction pass that was running
-    when they were written: the correction's Algorithm 1 calls and roadmap searches estimate as the search does, and a
-    pass begins with its fresh check, the first entry written at its own draw."""
+    when they were written ("pass 1 at the run's seed"): the correction's Algorithm 1 calls and roadmap searches
+    estimate as the search does, and a pass begins with its fresh check, the first entry written at its own draw."""
     starts = sorted((min(w for p, w, _ in entries if p == phase), phase)
                     for phase in {p for p, _, _ in entries if p.startswith("pass ") and "second" not in p})
     moved = []
     for phase, written, steps in entries:
-        if phase == "search":
-            phase = next((name for start, name in reversed(starts) if start <= written), "search")
-        moved.append((phase, written, steps))
+        running = next((name for start, name in reversed(starts) if start <= written), None)
+        moved.append((f"{running} {OWN_SEED}" if phase == "search" and running else phase, written, steps))
     return moved
 
 
