@@ -79,12 +79,14 @@ def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) 
 def by_time(entries: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
     """The entries with those drawn at the run's own seed ("search") moved to the correction pass that was running
     when they were written ("pass 1 at the run's seed"): the correction's Algorithm 1 calls and roadmap searches
-    estimate as the search does, and a pass begins with its fresh check, the first entry written at its own draw."""
+    estimate as the search does, and a pass begins with its fresh check, the first entry written at its own draw. File
+    times advance by the kernel's clock tick (a few ms), so an entry written in the tick a pass began counts in the
+    phase before it: the check simulates its first leg before it writes, so what shares that tick came before."""
     starts = sorted((min(w for p, w, _ in entries if p == phase), phase)
                     for phase in {p for p, _, _ in entries if p.startswith("pass ") and "second" not in p})
     moved = []
     for phase, written, steps in entries:
-        running = next((name for start, name in reversed(starts) if start <= written), None)
+        running = next((name for start, name in reversed(starts) if start < written), None)
         moved.append((f"{running} {OWN_SEED}" if phase == "search" and running else phase, written, steps))
     return moved
 
