@@ -5,16 +5,15 @@
 Descriptive, no rule. Each phase of a search draws its rollouts at a fixed offset from the run's seed: the search's
 own estimates (and each racing stage of adaptive evaluation, ``refine/racing.py``), polish's, the split
 confirmation's, the tuning check's, each correction pass's (its fresh check and its alternatives judged on that draw)
-and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset
-names its phase; an offset none of them makes is counted as ``other``. The correction's own Algorithm 1 calls and
-roadmap searches estimate at the run's own seed, as the search does: such an entry is counted in the pass that was
-running when it was written (the last whose first entry, its fresh check, was written before it; file times), as
-"pass N at the run's seed". Runs
-logged since every step carried the counts so far (``specrefine show`` reads those) need none of this; it serves the
-run folders written before (the Ant's corrector grids), and reads a run still going (or interrupted) as far as its
-cache goes. Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator steps
-are each entry's own (the batch rows its episodes held); the run's counters also count the padding rows of batches
-that several subtasks shared, so they sum to a few per cent less than ``result.json``'s search steps.
+and crosscheck's second draw. An evaluation cache entry names its draw's seed, so its offset names its phase; an
+offset none of them makes is counted as ``other``. The correction's own Algorithm 1 calls and roadmap searches
+estimate at the run's own seed, as the search does: such an entry is counted in the pass that was running when it was
+written (the last whose first entry, its fresh check, was written before it; file times), as "pass N at the run's
+seed". Runs logged since every step carried the counts so far (``specrefine show`` reads those) need none of this; it
+serves the run folders written before (the Ant's corrector grids), and reads a run still going (or interrupted) as far
+as its cache goes. Evaluations here are cache entries: each racing stage is one, as the evaluator counts it. Simulator
+steps are each entry's own (the batch rows its episodes held); the run's counters also count the padding rows of
+batches that several subtasks shared, so they sum to a few per cent less than ``result.json``'s search steps.
 """
 
 from __future__ import annotations
@@ -29,6 +28,7 @@ from ..core.errors import SpecrefineError
 from ..refine.correct import CHECK_SEED_OFFSET, CROSS_SEED_OFFSET, PASS_SEED_STEP
 from ..refine.racing import STAGE_SEED_OFFSET
 from ..refine.search import CONFIRM_SEED_OFFSET, POLISH_SEED_OFFSET, TUNE_CHECK_SEED_OFFSET
+from .taxonomy import run_folders
 
 OWN_SEED = "at the run's seed"  # a pass's draws made as the search's: its Algorithm 1 calls and roadmap searches
 PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
@@ -53,11 +53,11 @@ def phase_offsets(passes: int = PASSES, stages: int = STAGES) -> dict[int, str]:
     return offsets
 
 
-def cache_spend(folder: Path, seed: int, offsets: dict[int, str] | None = None) -> dict[str, Counter]:
+def cache_spend(folder: Path, seed: int) -> dict[str, Counter]:
     """{phase: Counter(evaluations=..., sim_steps=...)} over the cache entries under ``folder``; an unreadable entry
     is skipped (the run recomputes those too). An entry drawn at the run's own seed belongs to the search, or to the
     correction pass that was running when it was written (:func:`by_time`)."""
-    offsets = phase_offsets() if offsets is None else offsets
+    offsets = phase_offsets()
     entries = []  # (phase by seed, file time, steps)
     for entry in sorted(folder.rglob("*.npz")):
         if entry.is_symlink() or not entry.is_file():  # a FIFO would block the read; a link is not the run's own
@@ -120,8 +120,7 @@ def cell_rows(cell: Path) -> list[dict]:
 def spend_rows(folders: list[Path]) -> list[dict]:
     rows = []
     for folder in folders:
-        cells = sorted((folder / "cells").iterdir()) if (folder / "cells").is_dir() else [folder]
-        rows += [row for cell in cells if cell.is_dir() for row in cell_rows(cell)]
+        rows += [row for cell in run_folders(folder) if cell.is_dir() for row in cell_rows(cell)]
     if not rows:
         raise SpecrefineError("no run with an evaluation cache in the folders given")
     return rows

@@ -167,14 +167,18 @@ def summary_md(rows: list[dict], runs: list[Run], margin: float = MARGIN) -> str
     return "\n".join(lines) + "\n"
 
 
+def run_folders(folder: Path) -> list[Path]:
+    """A sweep folder's cells (``cells/*``), or the run folder itself."""
+    return sorted((folder / "cells").iterdir()) if (folder / "cells").is_dir() else [folder]
+
+
 def read_runs(folders: list[Path]) -> list[Run]:
     """Every finished run under the sweep folders (their ``cells/*``) or run folders given."""
     runs = []
     for folder in folders:
         if not folder.is_dir():
             raise SpecrefineError(f"{folder}: not a folder")
-        cells = sorted((folder / "cells").iterdir()) if (folder / "cells").is_dir() else [folder]
-        runs += [run for run in map(read_run, cells) if run is not None]
+        runs += [run for run in map(read_run, run_folders(folder)) if run is not None]
     return runs
 
 

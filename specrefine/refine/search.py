@@ -698,7 +698,7 @@ def evaluator_counts(evaluator) -> dict:
     if not hasattr(evaluator, "evaluations"):
         return {}
     return {"evaluations": int(evaluator.evaluations + getattr(evaluator, "disk_hits", 0)),
-            "sim_steps": int(evaluator.sim_steps + getattr(evaluator, "cached_steps", 0))}
+            "sim_steps": int(getattr(evaluator, "run_steps", evaluator.sim_steps))}
 
 
 def shortest_path(graph: TaskGraph, evaluator: SubtaskEvaluator, seed: int = 0) -> SearchResult:

@@ -123,8 +123,8 @@ def phase_marks(path: Path) -> dict[str, dict]:
         return {}
     steps = _steps(path)
     marks = {"end": steps[-1]} if steps else {}
-    begun = [s for s in steps if s.get("event") in ("correct-begin", "correct-check")]
-    return marks | ({"correction": begun[0]} if begun else {})
+    begun = next((s for s in steps if s.get("event") in ("correct-begin", "correct-check")), None)
+    return marks | ({"correction": begun} if begun is not None else {})
 
 
 def spend_text(marks: dict[str, dict], data: dict) -> str:
