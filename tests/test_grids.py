@@ -293,3 +293,22 @@ def test_the_paper_preset_grid_runs_what_preset_paper_resolves_to_for_the_ant(tm
         assert Path(c.config.policy).name == f"{paper.policy}.pt"
         # every setting equal; the preset itself is not recorded (run.json records what it decided)
         assert replace(c.config, policy=paper.policy, seed=paper.seed, preset="paper") == paper, c.id
+
+
+def test_status_reads_a_relative_out_from_the_working_directory(tmp_path, capsys, monkeypatch):
+    # a sweep folder named relative to where the user stands (not to the package's checkout) is the one read
+    g = grids.get("ant-corrector-span")
+    monkeypatch.setattr(grids, "ROOT", tmp_path / "checkout")  # a checkout with no table yet: every cell to run
+    missing = grids.status(g)[0].missing
+    cell = tmp_path / "mine" / "cells" / missing[0] / "cache" / "ab"
+    cell.mkdir(parents=True)
+    (cell / "ab0.npz").write_bytes(b"x")
+    monkeypatch.chdir(tmp_path)
+    grids.main(["status", "ant-corrector-span", "--out", "mine"])
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith("1 started (data/results/corrector/ant_span.csv)")
+    assert out[1] == f"  {missing[0]}  (started: 1 evaluations cached)"
+    assert grids.plan(g, out=grids._from_cwd("mine"))[1].split("\t")[3] == str(tmp_path / "mine")
+    assert grids._from_cwd(" ") == " "  # blank: left for plan to refuse in one line
+    with pytest.raises(grids.GridError, match="name a path"):
+        grids.plan(g, out=grids._from_cwd(" "))

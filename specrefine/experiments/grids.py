@@ -16,6 +16,7 @@ ids and parameters (``OUT/sweep.json`` refuses a cell run with another policy, r
 
 from __future__ import annotations
 
+import os
 import shlex
 from dataclasses import dataclass
 from pathlib import Path
@@ -1258,13 +1259,23 @@ def add_arguments(p) -> None:
                             help="only these of the grid's seeds (default: all)")
         if name == "status":
             sp.add_argument("--missing", action="store_true", help="list the cells still to run")
-            sp.add_argument("--out", default=None, help="the sweep folder to look for started cells in (parts: "
-                                                        "under it) (default: the grid's)")
+            sp.add_argument("--out", type=_from_cwd, default=None,
+                            help="the sweep folder to look for started cells in (parts: under it; a relative path is "
+                                 "taken from the working directory) (default: the grid's)")
         if name == "plan":
-            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it) "
-                                                        "(default: the grid's)")
-            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids) "
-                                                            "(default: the grid's)")
+            sp.add_argument("--out", type=_from_cwd, default=None,
+                            help="the sweep folder instead of the grid's (parts: under it; a relative path is taken "
+                                 "from the working directory) (default: the grid's)")
+            sp.add_argument("--shipped", type=_from_cwd, default=None,
+                            help="the table instead of the grid's (one-table grids; a relative path is taken from the "
+                                 "working directory) (default: the grid's)")
+
+
+def _from_cwd(path: str) -> str:
+    """A path typed on the command line, made absolute from the working directory: the grid's own folders are the
+    checkout's, but a folder a user names is where they stand (run_grid.sh runs from the checkout's root). A blank one
+    is left for ``plan`` to refuse."""
+    return os.path.abspath(path) if path.strip() else path
 
 
 def _subset(args) -> Subset:
