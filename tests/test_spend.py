@@ -6,10 +6,11 @@ import csv
 import json
 import os
 
+import numpy as np
 import pytest
 
 from specrefine.cli import main
-from specrefine.experiments.spend import by_time, phase_offsets
+from specrefine.experiments.spend import PACE_WINDOW_S, by_time, phase_offsets, recent_pace
 
 
 @pytest.fixture(scope="module")
@@ -80,6 +81,30 @@ def test_a_run_not_finished_is_read_as_far_as_its_cache_goes(run, tmp_path, caps
     (going / "run.json").write_text('{"seed": "two"}')
     assert main(["spend", str(going)]) == 2
     assert "not a run's record" in capsys.readouterr().err
+
+
+def test_a_run_still_going_is_paced_by_the_steps_its_cache_gained_lately(run, tmp_path, capsys):
+    import shutil
+    import time
+
+    going = tmp_path / "paced"
+    shutil.copytree(run, going)
+    (going / "result.json").unlink()
+    entries = sorted((going / "cache").rglob("*.npz"))
+    hour_ago = time.time() - 3600
+    for entry in entries:  # all written an hour ago but the last two, written now
+        os.utime(entry, (hour_ago, hour_ago))
+    recent = sum(int(np.load(e)["steps"]) for e in entries[-2:])
+    for entry in entries[-2:]:
+        entry.touch()
+    assert recent_pace(going / "cache", time.time_ns()) == pytest.approx(recent / PACE_WINDOW_S)
+    assert recent_pace(going / "cache", time.time_ns(), window_s=7200) == pytest.approx(
+        sum(int(np.load(e)["steps"]) for e in entries) / 7200)
+    capsys.readouterr()
+    assert main(["spend", str(going), str(run)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    pace = f"  {recent / PACE_WINDOW_S / 1e3:.1f}k simulator steps/s over the last 30 min"
+    assert [line.startswith(pace) for line in lines] == [False, True, False]  # the finished run has no pace
 
 
 @pytest.mark.parametrize("make", ["missing", "empty"])

@@ -33,6 +33,7 @@ from .taxonomy import run_folders
 OWN_SEED = "at the run's seed"  # a pass's draws made as the search's: its Algorithm 1 calls and roadmap searches
 PASSES = 4  # correction passes told apart (a pass beyond them counts as other)
 STAGES = 4  # racing stages told apart
+PACE_WINDOW_S = 1800.0  # the window a run still going is paced over
 COLUMNS = ("cell", "maze", "method", "seed", "finished", "phase", "evaluations", "sim_steps", "share_of_steps")
 
 
@@ -57,6 +58,14 @@ def cache_spend(folder: Path, seed: int) -> dict[str, Counter]:
     """{phase: Counter(evaluations=..., sim_steps=...)} over the cache entries under ``folder``; an unreadable entry
     is skipped (the run recomputes those too). An entry drawn at the run's own seed belongs to the search, or to the
     correction pass that was running when it was written (:func:`by_time`)."""
+    spend: dict[str, Counter] = {}
+    for phase, _, steps in by_time(cache_entries(folder, seed)):
+        spend.setdefault(phase, Counter()).update(evaluations=1, sim_steps=steps)
+    return spend
+
+
+def cache_entries(folder: Path, seed: int) -> list[tuple[str, int, int]]:
+    """(phase by its draw's seed, file time in ns, simulator steps) per readable cache entry under ``folder``."""
     offsets = phase_offsets()
     entries = []  # (phase by seed, file time, steps)
     for entry in sorted(folder.rglob("*.npz")):
@@ -70,10 +79,15 @@ def cache_spend(folder: Path, seed: int) -> dict[str, Counter]:
             continue
         drawn = key.get("seed") if isinstance(key, dict) else None
         entries.append((offsets.get(drawn - seed, "other") if isinstance(drawn, int) else "other", written, steps))
-    spend: dict[str, Counter] = {}
-    for phase, _, steps in by_time(entries):
-        spend.setdefault(phase, Counter()).update(evaluations=1, sim_steps=steps)
-    return spend
+    return entries
+
+
+def recent_pace(folder: Path, now_ns: int, window_s: float = PACE_WINDOW_S) -> float:
+    """Simulator steps a second over the last ``window_s`` seconds before ``now_ns``, from the cache entries written
+    in it: how fast a run still going advances (an entry counts when its evaluation ends, so a window much shorter
+    than the longest evaluation reads unevenly; time the run was not running counts too)."""
+    since = now_ns - int(window_s * 1e9)
+    return sum(steps for _, written, steps in cache_entries(folder, 0) if written > since) / window_s
 
 
 def by_time(entries: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
@@ -126,8 +140,19 @@ def spend_rows(folders: list[Path]) -> list[dict]:
     return rows
 
 
-def summary(rows: list[dict]) -> str:
-    """Each run's phases as shares of its simulator steps, one line a run."""
+def unfinished_paces(folders: list[Path], rows: list[dict]) -> dict[str, float]:
+    """{cell: recent_pace} for the runs of ``rows`` not finished, found again under ``folders``."""
+    import time
+
+    going = {row["cell"] for row in rows if not row["finished"]}
+    cells = [cell for folder in folders for cell in run_folders(folder) if cell.name in going]
+    return {cell.name: recent_pace(cell / "cache", time.time_ns()) for cell in cells}
+
+
+def summary(rows: list[dict], paces: dict[str, float] | None = None) -> str:
+    """Each run's phases as shares of its simulator steps, one line a run; ``paces`` ({cell: steps/s}, runs still
+    going) a line under it."""
+    paces = paces or {}
     lines, by_cell = [], {}
     for row in rows:
         by_cell.setdefault(row["cell"], []).append(row)
@@ -136,6 +161,9 @@ def summary(rows: list[dict]) -> str:
         parts = ", ".join(f"{r['phase']} {r['share_of_steps']:.0%} ({r['evaluations']} entries)" for r in phases)
         so_far = "" if phases[0]["finished"] else " so far (not finished)"
         lines.append(f"{cell}: {total / 1e6:.1f}M simulator steps{so_far}: {parts}")
+        if cell in paces:
+            lines.append(f"  {paces[cell] / 1e3:.1f}k simulator steps/s over the last {PACE_WINDOW_S / 60:.0f} min "
+                         "(the steps its cache gained then)")
     return "\n".join(lines) + "\n"
 
 
@@ -158,7 +186,7 @@ def run(args, p) -> int:
             raise SpecrefineError(f"{folder}: not a folder")
     with nullcontext() if args.out is None else writing_into(args.out) as out:  # checked before any work
         rows = spend_rows(args.runs)
-        print(summary(rows), end="")
+        print(summary(rows, unfinished_paces(args.runs, rows)), end="")
         if out is not None:
             write_atomic(out, csv_text(rows, COLUMNS))
     return 0
