@@ -445,7 +445,14 @@ def test_a_running_successors_costs_are_forecast_for_its_grid_from_its_ratio_to_
     assert evaluations["ratio_to_followed"] == pytest.approx(1.0) and evaluations["forecast"] == pytest.approx(2.0)
     assert cc.forecast_text(ant) == (f"{cc.SPAN} 1.50x `ours`'s proposer calls (within the 3.0x cap) and 2.00x its "
                                      f"evaluations (within the 3.0x cap) over the 27 cells (its 9 cells run at 0.30x "
-                                     f"and 1.00x {cc.REDRAW}'s, those ratios carried to the other 18)")
+                                     f"and 1.00x {cc.REDRAW}'s, those ratios carried to the other 18); within the "
+                                     f"cap over the grid its other 18 cells could spend at most 7.5 proposer calls "
+                                     f"and 18 evaluations a cell on average, where {cc.REDRAW} spent 10.0 and 10 on "
+                                     "them")
+    # the cap's room left: 3 x 27 cells x 2 calls (ours's) less the 9 x 3 spent, over the 18 cells not run
+    assert by[cc.SPAN]["left_per_cell"] == pytest.approx((3 * 27 * 2 - 9 * 3) / 18)
+    assert evaluations["left_per_cell"] == pytest.approx((3 * 27 * 5 - 9 * 10) / 18)
+    assert by[cc.SPAN]["followed_left_per_cell"] == pytest.approx(10)
 
 
 def test_a_successor_that_need_only_not_lie_below_is_read_and_of_two_that_hold_the_higher_one(tmp_path):

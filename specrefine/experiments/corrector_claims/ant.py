@@ -11,7 +11,19 @@ from ...core.results import wilson_ci
 from .. import ant_fresh
 from .. import comparison as cmp
 from ..grids import GRIDS, ROOT, SCALING_MAZES
-from .common import METHOD, NON_INFERIORITY, SPAN, as_ours, costs, done_cells, episodes_of, load, paired_rows, zero_runs
+from .common import (
+    COST_CAP,
+    METHOD,
+    NON_INFERIORITY,
+    SPAN,
+    as_ours,
+    costs,
+    done_cells,
+    episodes_of,
+    load,
+    paired_rows,
+    zero_runs,
+)
 
 ANT_FLOOR = 0.85
 #: the Ant's rules read this grid and its method (docs/corrector.md, "The Ant with a confirmed pick")
@@ -142,8 +154,13 @@ def cost_forecast(rows: list[dict], method: str, followed: str, key: str = "prop
     rest = sum(by[(m, followed, s)] for m, s in cells if (m, s) not in run)
     ours = sum(by[(m, "ours", s)] for m, s in cells)
     ratio = spent / theirs if theirs else math.nan
+    left = len(cells) - len(run)
     return {"cells": len(cells), "run": len(run), "ratio_to_followed": ratio,
-            "forecast": (spent + ratio * rest) / ours if run and ours else math.nan}
+            "forecast": (spent + ratio * rest) / ours if run and ours else math.nan,
+            # what each cell not run may spend on average for the whole grid to stay within the cap, beside what
+            # ``followed`` spent on those cells
+            "left_per_cell": (COST_CAP * ours - spent) / left if left else math.nan,
+            "followed_left_per_cell": rest / left if left else math.nan}
 
 
 def _pooled_success(per_maze: list[dict]) -> float:

@@ -257,7 +257,12 @@ def forecast_text(ant: dict) -> str:
             parts.append(f"{c['method']} {calls['forecast']:.2f}x `ours`'s proposer calls ({_cap(calls)}) and "
                          f"{evals['forecast']:.2f}x its evaluations ({_cap(evals)}) over the {cells} cells (its {run} "
                          f"cells run at {calls['ratio_to_followed']:.2f}x and {evals['ratio_to_followed']:.2f}x "
-                         f"{c['followed_method']}'s, those ratios carried to the other {cells - run})")
+                         f"{c['followed_method']}'s, those ratios carried to the other {cells - run}); within the "
+                         f"cap over the grid its other {cells - run} cells could spend at most "
+                         f"{max(calls['left_per_cell'], 0):.1f} proposer calls and "
+                         f"{max(evals['left_per_cell'], 0):.0f} evaluations a cell on average, where "
+                         f"{c['followed_method']} spent {calls['followed_left_per_cell']:.1f} and "
+                         f"{evals['followed_left_per_cell']:.0f} on them")
     return "; ".join(parts) or "no successor running"
 
 
