@@ -308,7 +308,5 @@ def test_status_reads_a_relative_out_from_the_working_directory(tmp_path, capsys
     out = capsys.readouterr().out.splitlines()
     assert out[0].endswith("1 started (data/results/corrector/ant_span.csv)")
     assert out[1] == f"  {missing[0]}  (started: 1 evaluations cached)"
-    assert grids.plan(g, out=grids._from_cwd("mine"))[1].split("\t")[3] == str(tmp_path / "mine")
-    assert grids._from_cwd(" ") == " "  # blank: left for plan to refuse in one line
-    with pytest.raises(grids.GridError, match="name a path"):
-        grids.plan(g, out=grids._from_cwd(" "))
+    assert grids.main(["status", "ant-corrector-span", "--out", str(tmp_path / "mine")]) == 0  # the same folder
+    assert capsys.readouterr().out.splitlines() == out

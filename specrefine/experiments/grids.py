@@ -1263,19 +1263,18 @@ def add_arguments(p) -> None:
                             help="the sweep folder to look for started cells in (parts: under it; a relative path is "
                                  "taken from the working directory) (default: the grid's)")
         if name == "plan":
-            sp.add_argument("--out", type=_from_cwd, default=None,
-                            help="the sweep folder instead of the grid's (parts: under it; a relative path is taken "
-                                 "from the working directory) (default: the grid's)")
-            sp.add_argument("--shipped", type=_from_cwd, default=None,
-                            help="the table instead of the grid's (one-table grids; a relative path is taken from the "
-                                 "working directory) (default: the grid's)")
+            sp.add_argument("--out", default=None, help="the sweep folder instead of the grid's (parts: under it; "
+                                                        "relative to the checkout's root, where run_grid.sh runs) "
+                                                        "(default: the grid's)")
+            sp.add_argument("--shipped", default=None, help="the table instead of the grid's (one-table grids; "
+                                                            "relative to the checkout's root) (default: the grid's)")
 
 
 def _from_cwd(path: str) -> str:
-    """A path typed on the command line, made absolute from the working directory: the grid's own folders are the
-    checkout's, but a folder a user names is where they stand (run_grid.sh runs from the checkout's root). A blank one
-    is left for ``plan`` to refuse."""
-    return os.path.abspath(path) if path.strip() else path
+    """A folder typed on ``status``'s command line, made absolute from the working directory: the grid's own folders
+    are the checkout's, but a folder a user names is where they stand. (``plan``'s are the checkout's: run_grid.sh
+    runs from its root and passes them on as given.)"""
+    return os.path.abspath(path)
 
 
 def _subset(args) -> Subset:
