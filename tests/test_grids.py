@@ -255,7 +255,9 @@ def test_status_counts_done_rows_names_the_rest_and_the_started_ones(tmp_path, c
     assert grids.status(g, root=tmp_path, out=str(sweep))[0].finished == frozenset()
     table.write_text(kept)
     out = capsys.readouterr().out.splitlines()
-    assert out[1:4] == [f"  {first[3]}  (started: 2 evaluations cached; running now)",
+    # its pace: the steps its cache gained in the last 30 min, none here (the entries are not readable ones)
+    assert out[1:4] == [f"  {first[3]}  (started: 2 evaluations cached; running now, 0.0k simulator steps/s over "
+                        "the last 30 min)",
                         f"  {first[4]}  (done in the sweep folder's table, not yet in the shipped one)",
                         f"  {first[5]}  (started: 0 evaluations cached)"]
 

@@ -1195,14 +1195,18 @@ class PartStatus(NamedTuple):
     running: frozenset = frozenset()  #: of those started, the ones a live run holds now (their folder's lock)
     finished: frozenset = frozenset()  #: of those started, the ones done in the sweep folder's own table, not yet
     #: copied into the shipped one
+    paces: dict = {}  #: of those running, simulator steps a second over the last 30 min (``spend.recent_pace``)
 
 
 def status(g: ExperimentGrid, root: Path | None = None, out: str | None = None) -> list[PartStatus]:
     """Per part: the cells done in its shipped table, the rest, and which of the rest have started in the sweep
     folder (the grid's, or ``out``; relative paths from ``root``, by default the checkout): a cut cell resumes from
     its evaluation cache; of those, which a live run holds now and which the sweep has finished (its own table)."""
+    import time
+
     from ..core.runfolder import live_holder
     from ..runs.sweep import done_ids, is_done, read_checked_table
+    from .spend import recent_pace
 
     root = ROOT if root is None else root
     report = []
@@ -1215,7 +1219,8 @@ def status(g: ExperimentGrid, root: Path | None = None, out: str | None = None) 
         started = {c: _cached(sweep / "cells" / c) for c in missing if (sweep / "cells" / c).is_dir()}
         running = frozenset(c for c in started if live_holder(sweep / "cells" / c))
         finished = frozenset(started) & done_ids(sweep / "results.csv")  # as the sweep reads its own table
-        report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started, running, finished))
+        paces = {c: recent_pace(sweep / "cells" / c / "cache", time.time_ns()) for c in running}
+        report.append(PartStatus(i, len(ids) - len(missing), len(ids), missing, started, running, finished, paces))
     return report
 
 
@@ -1225,7 +1230,11 @@ def _started_note(st: PartStatus, cell: str) -> str:
         return ""
     if cell in st.finished:
         return "  (done in the sweep folder's table, not yet in the shipped one)"
-    return f"  (started: {st.started[cell]} evaluations cached{'; running now' if cell in st.running else ''})"
+    from .spend import PACE_WINDOW_S
+
+    running = (f"; running now, {st.paces[cell] / 1e3:.1f}k simulator steps/s over the last "
+               f"{PACE_WINDOW_S / 60:.0f} min" if cell in st.running else "")
+    return f"  (started: {st.started[cell]} evaluations cached{running})"
 
 
 def _cached(cell: Path) -> int:
