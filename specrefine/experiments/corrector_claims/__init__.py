@@ -9,7 +9,8 @@ alone), the corrector variants' grids and ``ant-corrector-confirm`` (``ant-corre
 with the
 Ant scaling grid's one-shot;
 writes claims.md and claims.json (every rule with its estimate, interval and verdict, every cell counted) and
-rooms.png (success over rooms per method and preset, point mass). A rule with a cell missing is
+rooms.png (success over rooms per method and preset, point mass) and glance.png (the reported correctors per
+U-chain beside the oracle, ours and the one-shot, both agents). A rule with a cell missing is
 marked partial. ``--fill FILE ...`` also rewrites the ``<!-- front corrector NAME -->`` passages of those files
 (README.md, docs/corrector.md) from the same studies::
 
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 # what the command and the tests read here (as from the single module this package was); the rest from its module:
 # common (names, constants, shared helpers), point, ant, layouts, variants (the studies), formats, rules (verdicts),
-# report (claims.md), frontpage (README's passages, fill), figure (rooms.png), cli (the command)
+# report (claims.md), frontpage (README's passages, fill), figure (rooms.png), glance (glance.png), cli (the command)
 from ...core.errors import SpecrefineError
 from ..grids import (
     ADVANCE_CHECK_MIXES,

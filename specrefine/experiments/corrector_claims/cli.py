@@ -1,5 +1,5 @@
-"""``specrefine corrector-claims``: its options, and the run that writes claims.md, claims.json and rooms.png and
-fills the markers of ``--fill``'s files."""
+"""``specrefine corrector-claims``: its options, and the run that writes claims.md, claims.json, rooms.png and
+glance.png and fills the markers of ``--fill``'s files."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from .anyproposer import any_markdown, any_study
 from .default import default_markdown, default_studies, default_verdict, gr_markdown, gr_study
 from .figure import rooms_figure
 from .frontpage import fill, front
+from .glance import glance_figure, glance_panels
 from .point import held_out_study, levers_study, point_study
 from .report import markdown
 from .rules import variant_verdicts, verdicts
@@ -54,6 +55,7 @@ def run(args, p) -> int:
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants) + tail)
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)
+        save_figure(glance_figure(glance_panels()), args.out / "glance.png", dpi=110)
     for path in args.fill:
         fill(path, record["front"])
     print(f"-> {args.out}/claims.md")
