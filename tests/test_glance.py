@@ -32,5 +32,9 @@ def test_each_curve_counts_the_episodes_of_its_tables_runs(tmp_path):
     assert labels["corrector"] == ("point mass: ours-corrector-span (default); "
                                    "Ant: ours-corrector-redraw (default)")
     assert labels["span"].startswith("Ant: ours-corrector-span") and labels["ours"] == "ours (the paper's search)"
+    # the Ant's oracle at its correctors' settings (a confirmed pick), every cell run
+    assert labels["oracle"] == ("point mass: oracle (ours, geometric planner); "
+                                "Ant: oracle (ours-confirm, geometric planner)")
+    assert sum(runs for _, _, runs in ant["oracle"]["counts"]) == 27
     save_figure(glance_figure(panels), tmp_path / "glance.png", dpi=40)
     assert (tmp_path / "glance.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
