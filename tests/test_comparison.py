@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 
 import numpy as np
 import pytest
@@ -68,6 +69,20 @@ def test_ratio_interval_straddling_two_is_undecided():
     e = entry(cmp.claims(rows), "ratio")
     assert e["ci_low"] < 2 < e["ci_high"]
     assert e["verdict"] == "undecided"
+
+
+def test_a_one_shot_above_half_leaves_no_room_for_2x_and_the_rule_text_says_so():
+    # the one-shot at 0.75 on every cell: even ours at 1.000 everywhere gives 1/0.75 = 1.333, below 2
+    e = entry(cmp.claims(ratio_rows(lambda i, seed: 0.75, 1 / 0.75)), "ratio")
+    assert e["estimate"] == pytest.approx(4 / 3) and e["ceiling"] == pytest.approx(4 / 3)
+    assert cmp.ratio_rule_text(e).endswith("; at most 1.333 is possible here (the one-shot's mean 0.750, every cell "
+                                           "at 1.000 would give that)")
+    low = entry(cmp.claims(ratio_rows(lambda i, seed: 0.25, 3.0)), "ratio")  # room for 2x: the interval alone
+    assert low["ceiling"] == pytest.approx(4.0) and cmp.ratio_rule_text(low) == cmp._interval_text(low)
+    rows = [row(maze, m, 0.5 if m == "ours" else 0.0, seed, MODERATE)
+            for maze in cmp.MULTI_ROOM_MAZES for seed in cmp.SEEDS for m in ("ours", "vlm-oneshot")]
+    zero = entry(cmp.claims(rows), "ratio")  # a one-shot at 0: no ceiling
+    assert zero["ceiling"] == math.inf and cmp.ratio_rule_text(zero) == cmp._interval_text(zero)
 
 
 def test_bootstrap_is_reproducible():

@@ -139,11 +139,24 @@ def ratio_claim(cells, failed, proposer, seeds=SEEDS, mazes=MULTI_ROOM_MAZES) ->
     if not pairs:
         return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", math.nan, (math.nan, math.nan),
                       "undecided", n_expected, used_seeds, missing, "no cell with both methods")
-    ratio, ci, undefined = bootstrap_ratio(*np.array(pairs, dtype=float).T)
+    num, den = np.array(pairs, dtype=float).T
+    ratio, ci, undefined = bootstrap_ratio(num, den)
     note = f"ratio undefined (0/0: both methods at 0) in {undefined} of {BOOTSTRAP_RESAMPLES} resamples" \
         if undefined else ""
     return _entry(RATIO_CLAIM_TEXT, proposer, "ours / vlm-oneshot", ratio, ci,
-                  threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note)
+                  threshold_verdict(ci, RATIO_CLAIM), n_expected, used_seeds, missing, note) | {
+        "ceiling": float(_ratio(1.0, den.mean())), "oneshot_mean": float(den.mean())}
+
+
+def ratio_rule_text(entry) -> str:
+    """The ratio with its interval and, where the one-shot's mean on these cells leaves no method room to reach
+    RATIO_CLAIM (every cell at 1 gives 1 / its mean), that ceiling: the claim cannot be shown there."""
+    text = _interval_text(entry)
+    ceiling = entry.get("ceiling", math.inf)
+    if ceiling < RATIO_CLAIM:
+        text += (f"; at most {ceiling:.3f} is possible here (the one-shot's mean {entry['oneshot_mean']:.3f}, "
+                 "every cell at 1.000 would give that)")
+    return text
 
 
 def bootstrap_ratio(num: np.ndarray, den: np.ndarray) -> tuple[float, tuple[float, float], int]:

@@ -30,7 +30,7 @@ def verdicts(point: dict, ant: dict | None) -> list[dict]:
         out.append(_suite_rule(point["versus_ours"], proposer, f"{proposer}"))
         ratio = next(e for e in point["ratio"] if e["proposer"] == proposer and e["method"].startswith(METHOD))
         out.append({"rule": f"{proposer}: {METHOD} >= 2x the one-shot on multi-room (point)",
-                    "value": cmp._interval_text(ratio), "verdict": ratio["verdict"]
+                    "value": cmp.ratio_rule_text(ratio), "verdict": ratio["verdict"]
                     + ("" if ratio["complete"] else " (partial)")})
     severe = point["severe_vs_repair"]
     out.append({"rule": "imperfect:severe: no worse than ours-repair (paired, U-chains)",
@@ -61,7 +61,7 @@ def _ant_verdicts(ant: dict) -> list[dict]:
         out = [{"rule": floor, "value": f"below on {len(low)} of the {len(ran)} mazes{scope}"
                 + (f": {', '.join(low)}" if low else ""),
                 "verdict": _verdict(not low, complete)},
-               {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp._interval_text(ratio),
+               {"rule": f"Ant: {ant['method']} >= 2x the one-shot on multi-room", "value": cmp.ratio_rule_text(ratio),
                 "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")},
                _ant_cost_verdict(ant)]
     return out + [_candidate_verdict(c, ant["method"]) for c in ant["candidates"]] + \
@@ -186,7 +186,7 @@ def variant_verdicts(vs: dict) -> list[dict]:
         ratio = next((e for e in vs.get("ratio", []) if e["proposer"] == proposer), None)
         if ratio is not None:
             out.append({"rule": f"{method}, {proposer}: >= 2x the one-shot on multi-room (point)",
-                        "value": cmp._interval_text(ratio),
+                        "value": cmp.ratio_rule_text(ratio),
                         "verdict": ratio["verdict"] + ("" if ratio["complete"] else " (partial)")})
     if "severe_vs_repair" in vs:
         severe = vs["severe_vs_repair"]
