@@ -48,8 +48,8 @@ def glance_panels(root: Path = ROOT) -> list[dict]:
 def _panel(agent: str, proposer: str, rows: list[dict], curves: list, seeds, corrector: str,
            floor: float | None = None) -> dict:
     out = []
-    for role, (method, proposer) in curves:
-        counts = [episodes_of(rows, maze, method, proposer, seeds) for maze in SCALING_MAZES]
+    for role, (method, drawn_by) in curves:
+        counts = [episodes_of(rows, maze, method, drawn_by, seeds) for maze in SCALING_MAZES]
         runs, cells = sum(c[2] for c in counts), len(SCALING_MAZES) * len(seeds)
         label = {"corrector": corrector, "span": SPAN, "oracle": f"oracle ({method}, geometric planner)"
                  }.get(role, STYLE[role][0])
