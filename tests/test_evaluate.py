@@ -116,6 +116,24 @@ def test_start_state_propagation(maze):
     assert res.p == 0.0 and res.n == 0 and ev.sim_steps == steps
 
 
+def test_evaluations_are_counted_once_however_often_the_disk_is_read(maze, tmp_path):
+    # a memory cache of one: each result is read back from disk when asked again, which is no new evaluation
+    from specrefine.refine.search import evaluator_counts
+
+    cells = ((3, 3), (1, 3), (3, 3), (1, 3))
+    ev = make(maze, cache_dir=tmp_path)
+    ev.cache.memo_size = 1
+    for cell in cells:
+        ev.evaluate(maze.start, maze.cell_box(*cell), maze.walls)
+    assert ev.evaluations == 2 and ev.disk_hits == 2 and ev.run_evaluations == 2
+    assert evaluator_counts(ev) == {"evaluations": 2, "sim_steps": ev.sim_steps}
+    again = make(maze, cache_dir=tmp_path)  # a resumed run: both read back, each counted once
+    again.cache.memo_size = 1
+    for cell in cells:
+        again.evaluate(maze.start, maze.cell_box(*cell), maze.walls)
+    assert again.evaluations == 0 and again.disk_hits == 4 and evaluator_counts(again) == evaluator_counts(ev)
+
+
 def test_cache_hits_identical_and_free(maze, tmp_path):
     ev = make(maze, cache_dir=tmp_path)
     a = ev.evaluate(maze.start, maze.cell_box(3, 3), maze.walls)

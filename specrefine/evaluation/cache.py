@@ -46,6 +46,12 @@ class ResultCache:
         self.hits += 1
         return replace(hit, cached=True)
 
+    @property
+    def read_back(self) -> int:
+        """Results found on disk that this process never simulated (an earlier run of the folder did), each counted
+        once however often it is read again after the memory's ``memo_size`` are full."""
+        return len(self._read_back)
+
     def first_read(self, key: str) -> bool:
         """True the first time ``key``, found by :meth:`lookup`, is work this process never simulated (an earlier run
         of the same folder did), else False: each such result is counted once, where a run in one go simulated it."""

@@ -193,8 +193,15 @@ class Evaluator:
 
     @property
     def disk_hits(self) -> int:
-        """Evaluations found in cache_dir, written by an earlier (interrupted) run."""
+        """Reads of cache_dir: results an earlier (interrupted) run wrote, and any result read again once the memory
+        cache is full (so not a count of evaluations: :attr:`run_evaluations` is)."""
         return self.cache.disk_hits
+
+    @property
+    def run_evaluations(self) -> int:
+        """Subtask evaluations as a run in one go would have made them: those simulated here and those an earlier run
+        of cache_dir simulated, each once (as ``run_steps`` counts their steps)."""
+        return self.evaluations + self.cache.read_back
 
     @property
     def cached_steps(self) -> int:

@@ -697,7 +697,7 @@ def evaluator_counts(evaluator) -> dict:
     counters."""
     if not hasattr(evaluator, "evaluations"):
         return {}
-    return {"evaluations": int(evaluator.evaluations + getattr(evaluator, "disk_hits", 0)),
+    return {"evaluations": int(getattr(evaluator, "run_evaluations", evaluator.evaluations)),
             "sim_steps": int(getattr(evaluator, "run_steps", evaluator.sim_steps))}
 
 

@@ -162,7 +162,7 @@ def budget_of_ours(job: SearchJob) -> tuple[int, int]:
     twin = evaluator.fresh_copy(cache_dir=cache)
     proposer = make_proposer(job.proposer.spec, seed=job.config.seed)
     METHODS["ours"].search(replace(job, evaluator=twin, proposer=proposer, on_step=None))
-    return proposer.proposer_calls, twin.evaluations + twin.disk_hits
+    return proposer.proposer_calls, twin.run_evaluations
 
 
 # the paper's Sec. 5.1, plus controls (every control removes one thing from ours) and what goes beyond the paper

@@ -114,7 +114,7 @@ class RunProgress:
             parts.append(ev.simulating)
         if self.estimate is not None:
             parts.append(f"best path {self.estimate:.2f}" + (f" (to {self.towards})" if self.towards else ""))
-        parts += [f"{ev.evaluations + getattr(ev, 'disk_hits', 0)} evaluations", f"{int(ev.sim_steps):,} sim steps",
+        parts += [f"{getattr(ev, 'run_evaluations', ev.evaluations)} evaluations", f"{int(ev.sim_steps):,} sim steps",
                   f"{int(getattr(proposer, 'proposer_calls', 0) or 0)} proposer calls"]
         return " | ".join(parts)
 
