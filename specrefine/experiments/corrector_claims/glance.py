@@ -10,7 +10,7 @@ import numpy as np
 from ...core.results import wilson_ci
 from ..grids import GRIDS, ROOT, SCALING_MAZES
 from .ant import ANT_ERRING, ANT_ONESHOT, ANT_REDRAW, ANT_SEEDS, ANT_SPAN, REDRAW
-from .common import ORACLE, POINT_SEEDS, SPAN, VARIANT_GRIDS, episodes_of, load, named
+from .common import ORACLE, POINT_SEEDS, SPAN, episodes_of, load
 from .frontpage import _maze_label
 
 ANT_FLOOR_LINE = 0.85  # issue 39's floor for the Ant, drawn on its panel
@@ -25,10 +25,9 @@ STYLE = {"oracle": (None, "black", "--", "o"),
 
 def glance_panels(root: Path = ROOT) -> list[dict]:
     """Per panel: its title and, per curve, its role, label and (successes, episodes, runs) per U-chain maze."""
-    from .variants import _base_rows, _reference_rows
+    from .variants import variant_rows
 
-    point = (_base_rows(SPAN, root) + _reference_rows(SPAN, root)
-             + named(load(GRIDS[VARIANT_GRIDS[SPAN]].tables, root), SPAN))
+    point = variant_rows(SPAN, root)
     panels = []
     for proposer in ("imperfect:mild", "imperfect:moderate"):
         curves = [("oracle", ORACLE), ("corrector", (SPAN, proposer)), ("ours", ("ours", proposer)),

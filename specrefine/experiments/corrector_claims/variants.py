@@ -46,7 +46,7 @@ def variant_study(method: str, root: Path = ROOT) -> dict | None:
     rules, its cost beside the reference's, the held-out cells and, where its grid ran severe, severe against
     ours-repair."""
     grid, ref = GRIDS[VARIANT_GRIDS[method]], reference_of(method)
-    rows = _base_rows(method, root) + _reference_rows(method, root) + named(load(grid.tables, root), method)
+    rows = variant_rows(method, root)
     if not any(r["method"] == method for r in rows):
         return None
     cells, failed = cmp.table_cells(rows, "point")
@@ -141,6 +141,13 @@ def _oracle_versus_paper(rows: list[dict], root: Path) -> dict:
     cells, failed = cmp.table_cells(mine + paper, "point")
     return cmp.paired_difference(cells, failed, ORACLE[1], "oracle (its settings)", "oracle (paper)", POINT_SEEDS,
                                  SCALING_MAZES)
+
+
+def variant_rows(method: str, root: Path = ROOT) -> list[dict]:
+    """The rows a variant is judged on: its grid's (under its name), its reference's and the oracle's, ours's,
+    ours-repair's and the one-shot's."""
+    return _base_rows(method, root) + _reference_rows(method, root) + named(
+        load(GRIDS[VARIANT_GRIDS[method]].tables, root), method)
 
 
 def _base_rows(method: str, root: Path) -> list[dict]:
