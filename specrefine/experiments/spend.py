@@ -64,17 +64,19 @@ def cache_spend(folder: Path, seed: int) -> dict[str, Counter]:
     return spend
 
 
-def cache_entries(folder: Path, seed: int) -> list[tuple[str, int, int]]:
-    """(phase by its draw's seed, file time in ns, simulator steps) per readable cache entry under ``folder``."""
+def cache_entries(folder: Path, seed: int, written_after: int = -1) -> list[tuple[str, int, int]]:
+    """(phase by its draw's seed, file time in ns, simulator steps) per readable cache entry under ``folder``, of those
+    written after ``written_after`` (ns; by default all: an older one is not opened)."""
     offsets = phase_offsets()
     entries = []  # (phase by seed, file time, steps)
     for entry in sorted(folder.rglob("*.npz")):
         if entry.is_symlink() or not entry.is_file():  # a FIFO would block the read; a link is not the run's own
             continue
         try:
+            if (written := entry.stat().st_mtime_ns) <= written_after:
+                continue
             with np.load(entry, allow_pickle=False) as z:
                 key, steps = json.loads(str(z["key"])), int(z["steps"])
-            written = entry.stat().st_mtime_ns
         except (OSError, ValueError, KeyError, TypeError):
             continue
         drawn = key.get("seed") if isinstance(key, dict) else None
@@ -86,8 +88,7 @@ def recent_pace(folder: Path, now_ns: int, window_s: float = PACE_WINDOW_S) -> f
     """Simulator steps a second over the last ``window_s`` seconds before ``now_ns``, from the cache entries written
     in it: how fast a run still going advances (an entry counts when its evaluation ends, so a window much shorter
     than the longest evaluation reads unevenly; time the run was not running counts too)."""
-    since = now_ns - int(window_s * 1e9)
-    return sum(steps for _, written, steps in cache_entries(folder, 0) if written > since) / window_s
+    return sum(steps for _, _, steps in cache_entries(folder, 0, now_ns - int(window_s * 1e9))) / window_s
 
 
 def by_time(entries: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
