@@ -279,3 +279,64 @@ def test_same_seed_same_replies_and_its_own_random_stream():
     b, _ = replies(PRESETS["moderate"], n=10, seed=5)
     c, _ = replies(PRESETS["moderate"], n=10, seed=6)
     assert a == b and a != c
+
+
+MISREAD = dict(position_sigma=0.2)  # a base whose replies differ from one another
+
+
+def test_misreadings_leave_every_other_draw_as_it_was():
+    base, _ = replies(ImperfectConfig(**MISREAD), seed=7)
+    texts, client = replies(ImperfectConfig(**MISREAD, p_swap_xy=0.2, p_shuffle=0.2, p_truncate=0.2, p_stale=0.2),
+                            seed=7)
+    untouched = [not any(k in r for k in ("swapped_xy", "shuffled", "truncated", "stale")) for r in client.injected]
+    assert 0 < sum(untouched) < N
+    assert all(a == b for a, b, u in zip(base, texts, untouched) if u)
+    assert all(a != b for a, b, u in zip(base, texts, untouched) if not u)
+
+
+def test_swapped_replies_exchange_x_and_y_at_the_stated_rate():
+    base, _ = replies(ImperfectConfig(**MISREAD), seed=8)
+    texts, client = replies(ImperfectConfig(**MISREAD, p_swap_xy=0.3), seed=8)
+    swapped = [bool(r.get("swapped_xy")) for r in client.injected]
+    assert binomial_ok(sum(swapped), N, 0.3)
+    for a, b, s in zip(base, texts, swapped):
+        assert np.allclose(centres(b), centres(a)[:, ::-1] if s else centres(a))
+
+
+def test_bias_moves_every_waypoint_by_one_vector_per_run():
+    m = maze()
+    moves = {}
+    for seed in (1, 2):
+        base, _ = replies(ImperfectConfig(**MISREAD), m, n=20, seed=seed)
+        texts, _ = replies(ImperfectConfig(**MISREAD, bias=0.5), m, n=20, seed=seed)
+        shift = np.concatenate([centres(b) - centres(a) for a, b in zip(base, texts)])
+        assert np.allclose(shift, shift[0], atol=0.02)  # coordinates are written to two decimals before the shift
+        assert np.linalg.norm(shift[0]) == pytest.approx(0.5 * m.cell_size, abs=0.02)
+        moves[seed] = shift[0]
+    assert not np.allclose(moves[1], moves[2])  # the direction is drawn per run
+
+
+def test_shuffled_and_truncated_replies_keep_their_waypoints_or_their_first_half():
+    base, _ = replies(ImperfectConfig(**MISREAD), seed=9)
+    texts, client = replies(ImperfectConfig(**MISREAD, p_shuffle=0.3, p_truncate=0.3), seed=9)
+    log = client.injected
+    assert binomial_ok(sum("shuffled" in r for r in log), N, 0.3)
+    assert binomial_ok(sum("truncated" in r for r in log), N, 0.3)
+    for a, b, r in zip(base, texts, log):
+        before, after = centres(a), centres(b)
+        if "truncated" in r:
+            assert len(after) == len(before) // 2 and r["truncated"] == len(before) - len(after)
+        else:
+            assert len(after) == len(before)
+        if "shuffled" not in r:
+            assert np.allclose(after, before[: len(after)])
+        elif "truncated" not in r:
+            assert sorted(map(tuple, after)) == sorted(map(tuple, before))
+
+
+def test_stale_replies_repeat_the_previous_edge_answer():
+    texts, client = replies(ImperfectConfig(**MISREAD, p_stale=0.3), seed=10)
+    stale = [bool(r.get("stale")) for r in client.injected]
+    assert not stale[0] and binomial_ok(sum(stale), N - 1, 0.3)
+    for i in range(1, N):
+        assert np.array_equal(centres(texts[i]), centres(texts[i - 1])) == stale[i]

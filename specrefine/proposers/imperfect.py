@@ -25,6 +25,16 @@ Error modes (``ImperfectConfig``; lengths in maze cells, probabilities per reply
   half) it repairs another leg, or repeats an earlier answer with jitter;
 * whole-graph queries only: the input graph's subgoals ignored (``p_ignore_subgoals``).
 
+Misreadings, added after every corrector lever had been designed (2026-12-07), as error kinds none of them had met
+(every preset leaves them at 0; they draw from a random stream of their own, so a configuration without them replies
+exactly as before they existed):
+
+* a whole reply with x and y swapped (``p_swap_xy``: a picture's rows and columns confused);
+* every waypoint of every reply moved ``bias`` cells in one direction, drawn once per run (a misregistered origin:
+  asking again does not average it away);
+* edge queries only: the waypoints listed out of order (``p_shuffle``), the list cut to its first half while the
+  JSON stays valid (``p_truncate``), or the previous edge's answer given again (``p_stale``: the context confused).
+
 The same model answers edge queries and whole-graph queries (a whole-graph reply is the corrupted
 route of every edge of the input graph). ``alpha`` grows the position error, the turn-drop and the
 false-opening probabilities with the number of turns T the query spans: x (1 + alpha (T - 1)).
@@ -64,6 +74,11 @@ class ImperfectConfig:
     rho: float = 1.0  # a follow-up repairs the weakest leg
     p_ignore_subgoals: float = 0.0  # a whole-graph reply that plans start -> goal, ignoring subgoals
     alpha: float = 0.0  # error growth per extra turn the query spans
+    p_swap_xy: float = 0.0  # a reply with x and y swapped
+    bias: float = 0.0  # cells: every waypoint moved this far, in one direction drawn once per run
+    p_shuffle: float = 0.0  # an edge reply with its waypoints out of order
+    p_truncate: float = 0.0  # an edge reply cut to the first half of its waypoints
+    p_stale: float = 0.0  # an edge reply that repeats the previous edge reply's waypoints
 
     def __post_init__(self):
         for f in fields(self):
@@ -130,6 +145,9 @@ class ErrorModelClient(VLMClient):
         self.injected: list[dict] = []  # per reply: which errors were injected (for tests and analysis)
         self._planner = GeometricProposer(seed=seed)
         self._corners: dict = {}
+        self._misread_rng = np.random.default_rng([int(seed), 0x5EAD])  # the misreadings' own stream
+        self._bias_angle = float(self._misread_rng.uniform(0.0, 2 * math.pi))
+        self._last_waypoints: list | None = None  # the previous edge reply's, for p_stale
 
     def complete(self, messages, n: int = 1) -> list[str]:
         kind, q, feedback = self.context
@@ -171,6 +189,7 @@ class ErrorModelClient(VLMClient):
         return self._finish(answer, maze, log)
 
     def _finish(self, answer: dict, maze, log: dict) -> str:
+        answer = self._misread(answer, maze, log)
         if self.rng.random() < self.cfg.p_mirror_y:
             log["mirrored_y"] = True
             answer = _mirror_y(answer)
@@ -180,6 +199,33 @@ class ErrorModelClient(VLMClient):
             text = _garble(text, self.rng)
         self.injected.append(log)
         return text
+
+    def _misread(self, answer: dict, maze, log: dict) -> dict:
+        """The misreadings (module docstring), each drawn only where its probability is set."""
+        cfg, rng = self.cfg, self._misread_rng
+        if "waypoints" in answer:
+            answer = {**answer, "waypoints": self._misordered(list(answer["waypoints"]), log)}
+        if cfg.p_swap_xy and rng.random() < cfg.p_swap_xy:
+            log["swapped_xy"] = True
+            answer = _moved(answer, lambda x, y: (y, x))
+        if cfg.bias:
+            dx, dy = cfg.bias * maze.cell_size * np.array([math.cos(self._bias_angle), math.sin(self._bias_angle)])
+            answer = _moved(answer, lambda x, y: (round(x + dx, 3), round(y + dy, 3)))
+        return answer
+
+    def _misordered(self, waypoints: list, log: dict) -> list:
+        cfg, rng = self.cfg, self._misread_rng
+        if cfg.p_stale and rng.random() < cfg.p_stale and self._last_waypoints:
+            log["stale"] = True
+            waypoints = list(self._last_waypoints)
+        if cfg.p_shuffle and rng.random() < cfg.p_shuffle and len(waypoints) > 1:
+            log["shuffled"] = True
+            waypoints = [waypoints[i] for i in rng.permutation(len(waypoints))]
+        if cfg.p_truncate and rng.random() < cfg.p_truncate and len(waypoints) > 1:
+            log["truncated"] = len(waypoints) - len(waypoints) // 2
+            waypoints = waypoints[: len(waypoints) // 2]
+        self._last_waypoints = waypoints
+        return waypoints
 
     # --- follow-ups ------------------------------------------------------------------------------
     def _follow_up(self, answers, successes, ends, q, mult, log) -> list:
@@ -412,21 +458,27 @@ def _shifted(region, offset):
 
 
 def _mirror_y(answer: dict) -> dict:
-    def flip(region):
+    return _moved(answer, lambda x, y: (x, -y))
+
+
+def _moved(answer: dict, f) -> dict:
+    """``answer`` with every region's coordinates mapped by ``f`` ((x, y) -> (x, y)); a box stays axis-aligned."""
+    def move(region):
         if not isinstance(region, dict):
             return region
         out = dict(region)
         if "center" in out:
-            out["center"] = [out["center"][0], -out["center"][1]]
+            out["center"] = list(f(*out["center"]))
         if "min" in out and "max" in out:
-            out["min"], out["max"] = [out["min"][0], -out["max"][1]], [out["max"][0], -out["min"][1]]
+            a, b = f(*out["min"]), f(*out["max"])
+            out["min"], out["max"] = [min(a[0], b[0]), min(a[1], b[1])], [max(a[0], b[0]), max(a[1], b[1])]
         return out
 
     answer = dict(answer)
     if "waypoints" in answer:
-        answer["waypoints"] = [flip(w) for w in answer["waypoints"]]
+        answer["waypoints"] = [move(w) for w in answer["waypoints"]]
     if "vertices" in answer:
-        answer["vertices"] = [{**v, "region": flip(v["region"])} for v in answer["vertices"]]
+        answer["vertices"] = [{**v, "region": move(v["region"])} for v in answer["vertices"]]
     return answer
 
 
