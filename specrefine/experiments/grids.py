@@ -531,6 +531,18 @@ SPAN_MIXES = ("random",
               "imperfect:position_sigma=0.4,radius=0.25,radius_log_sigma=0.4,corner_pull=0.5,p_drop_turn=0.4,"
               "p_wrong_branch=0.4,p_false_opening=0.3,p_uncapped=0.5,alpha=0.3,rho=0.5")
 
+#: layouts and error mixes no run had used before grid corrector-span-misread (docs/corrector.md, "Misreadings no lever
+#: had met"), made after every grid above had been looked at: four generated mazes (sizes chosen, seeds drawn by
+#: random.Random(202612071)) and the two longest U-chains, and two mixes of the error model's misreadings, added on
+#: 2026-12-07 after every lever had been designed: AY (the misreadings alone: swapped axes, a bias of a third of a cell
+#: for the whole run, waypoints out of order, cut short, or the previous edge's answer again) and AZ (the same, milder,
+#: on top of the moderate preset)
+MISREAD_MAZES = ("random:12x12:78", "random:17x9:34", "random:9x17:21", "random:15x13:92", "u_chain_5",
+                 "u_chain_5_subgoals")
+MISREAD_MIXES = ("imperfect:p_swap_xy=0.15,bias=0.3,p_shuffle=0.3,p_truncate=0.3,p_stale=0.2",
+                 "imperfect:moderate,p_swap_xy=0.1,bias=0.2,p_shuffle=0.2,p_truncate=0.2,p_stale=0.15")
+MISREAD_CODE = "3989efc"  # the commit that added the misreadings (ImperfectConfig.p_swap_xy, ...)
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -1072,6 +1084,10 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-span-new", "docs/corrector.md, 'Weak legs mended past their end' (issue 39; fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-span", "ours-corrector-fine", "ours"),
                      SPAN_MAZES, SPAN_MIXES, "span_new", code=SPAN_CODE),
+    # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:55 UTC, before it ran)
+    new_layouts_grid("corrector-span-misread", "docs/corrector.md, 'Misreadings no lever had met' (issue 39; fixed "
+                     "2026-12-07 before it ran)", ("ours-corrector-span", "ours"), MISREAD_MAZES, MISREAD_MIXES,
+                     "span_misread", code=MISREAD_CODE),
     *centre_variant_grids("corrector-span", "Weak legs mended past their end", "ours-corrector-span", "span",
                           code=SPAN_CODE,
                           informed=Part(("ours-corrector-span",), ("random",), mazes=SCALING_MAZES + OTHER_POINT_MAZES,
