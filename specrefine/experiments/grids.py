@@ -1084,7 +1084,7 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-span-new", "docs/corrector.md, 'Weak legs mended past their end' (issue 39; fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-span", "ours-corrector-fine", "ours"),
                      SPAN_MAZES, SPAN_MIXES, "span_new", code=SPAN_CODE),
-    # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:55 UTC, before it ran)
+    # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:08 UTC in 74d153d, before it ran)
     new_layouts_grid("corrector-span-misread", "docs/corrector.md, 'Misreadings no lever had met' (issue 39; fixed "
                      "2026-12-07 before it ran)", ("ours-corrector-span", "ours"), MISREAD_MAZES, MISREAD_MIXES,
                      "span_misread", code=MISREAD_CODE),
