@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..grids import GR_MIXES, GRIDS, ROOT
 from .common import BACKTRACK, DEEP, FINE, MEND, SPAN, costs, episodes_of, load, paired_rows, per_maze, zero_runs
-from .formats import _ant_paired_text, _diff, _num
+from .formats import _ant_paired_text, _cost_table, _diff, _num
 
 GRID = "corrector-deep-oracle"
 MEND_ORACLE_GRID = "corrector-mend-oracle"
@@ -139,8 +139,4 @@ def gr_markdown(d: dict) -> list[str]:
              "|---|---|---|---|---|---|---|---|"]
     lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
               f"{_diff(e)} | {_num(e['oracle'])} | {_num(e['mend'])} ({e['mend_runs']}) |" for e in d["per_maze"]]
-    lines += ["", "| proposer | pairs | proposer calls | evaluations | simulator steps |", "|---|---|---|---|---|"]
-    lines += [f"| {c['proposer']} | {c['pairs']} | {_num(c['proposer_calls_ratio'], '{:.2f}x')} | "
-              f"{_num(c['evaluations_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"
-              for c in d["costs"]]
-    return lines
+    return lines + _cost_table("proposer", [(c["proposer"], c) for c in d["costs"]])

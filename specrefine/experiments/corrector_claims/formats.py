@@ -55,6 +55,14 @@ def _cost_pair(c: dict) -> str:
             f"({c['pairs']} pairs)")
 
 
+def _cost_table(label: str, named: list[tuple[str, dict]]) -> list[str]:
+    """A markdown table of cost ratios over another method's, a row per (name, cost) of ``named``."""
+    keys = ("proposer_calls_ratio", "evaluations_ratio", "sim_steps_ratio")
+    return (["", f"| {label} | pairs | proposer calls | evaluations | simulator steps |", "|---|---|---|---|---|"]
+            + [f"| {name} | {c['pairs']} | " + " | ".join(_num(c[k], "{:.2f}x") for k in keys) + " |"
+               for name, c in named])
+
+
 def _cost_text(c: dict) -> str:
     return (f"{c['proposer'].split(':')[1]} ({c['pairs']} pairs) {_num(c['evaluations_ratio'], '{:.1f}x')} the "
             f"evaluations, {_num(c['proposer_calls_ratio'], '{:.1f}x')} the proposer calls, "

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..grids import GRIDS, MISREAD_MAZES, MISREAD_MIXES, ROOT
 from .common import ORACLE, SPAN, TOLERANCE, costs, episodes_of, load, per_maze, table_name, zero_runs
-from .formats import _diff, _num
+from .formats import _cost_table, _diff, _num
 
 GRID = "corrector-span-misread"
 MIX_NAMES = dict(zip(MISREAD_MIXES, ("AY", "AZ")))
@@ -74,8 +74,4 @@ def misread_markdown(d: dict) -> list[str]:
              "|---|---|---|---|---|---|---|---|"]
     lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
               f"{_diff(e)} | {_num(e['oracle'])} | {e['zero']} / {e['ours_zero']} |" for e in d["per_maze"]]
-    lines += ["", "| mix | pairs | evaluations | proposer calls | simulator steps |", "|---|---|---|---|---|"]
-    lines += [f"| {name} | {c['pairs']} | {_num(c['evaluations_ratio'], '{:.2f}x')} | "
-              f"{_num(c['proposer_calls_ratio'], '{:.2f}x')} | {_num(c['sim_steps_ratio'], '{:.2f}x')} |"
-              for name, c in d["cost"].items()]
-    return lines
+    return lines + _cost_table("mix", list(d["cost"].items()))
