@@ -1084,6 +1084,16 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-span-new", "docs/corrector.md, 'Weak legs mended past their end' (issue 39; fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-span", "ours-corrector-fine", "ours"),
                      SPAN_MAZES, SPAN_MIXES, "span_new", code=SPAN_CODE),
+    # docs/corrector.md, "The point mass's default on D4RL's maps, misreadings included" (fixed 2026-12-07, before it
+    # ran)
+    ExperimentGrid("corrector-span-gr", "docs/corrector.md, 'The point mass's default on D4RL's maps, misreadings "
+                   "included' (issue 39; fixed 2026-12-07 before it ran): ours-corrector-span beside ours and the "
+                   "oracle on D4RL's three maps, corrector-deep-gr's proposers and the misreadings", "point",
+                   parts=(Part(("ours-corrector-span", "ours"), GR_MIXES + MISREAD_MIXES, split="proposers"),
+                          Part(("ours",), ("geometric",), table="data/results/corrector/span_gr_oracle.csv",
+                               out="oracle")),
+                   seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1, code=MISREAD_CODE,
+                   table="data/results/corrector/span_gr.csv", out="runs/corrector_span_gr"),
     # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:08 UTC in 74d153d, before it ran)
     new_layouts_grid("corrector-span-misread", "docs/corrector.md, 'Misreadings no lever had met' (issue 39; fixed "
                      "2026-12-07 before it ran)", ("ours-corrector-span", "ours"), MISREAD_MAZES, MISREAD_MIXES,
