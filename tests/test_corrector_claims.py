@@ -1259,26 +1259,39 @@ def test_the_random_proposers_statement_needs_every_maze_near_the_oracle_and_no_
     assert "not on u_chain_5 0.000 against 1.000" in any_text(d) and any_text(d).endswith("does not hold")
 
 
-def test_the_misreadings_statement_needs_every_maze_and_mix_near_the_oracle_none_at_0_and_none_below_ours(tmp_path):
-    """corrector-span-misread: span against the oracle and ours per maze and mix; the statement holds only when all
-    12 are within 0.05 of the oracle, no span run is at 0 and no difference from ours is wholly below 0."""
-    from specrefine.experiments.corrector_claims.misread import misread_markdown, misread_study, misread_text
+def test_a_statement_needs_every_maze_and_proposer_near_the_oracle_none_at_0_and_none_below_ours(tmp_path):
+    """corrector-span-misread and corrector-span-gr: span against the oracle and ours per maze and proposer; a
+    statement holds only when all are within 0.05 of the oracle, no span run is at 0 and no difference from ours is
+    wholly below 0."""
+    from specrefine.experiments.corrector_claims.statements import (
+        STATEMENTS,
+        statement_markdown,
+        statement_studies,
+        statement_study,
+        statement_text,
+    )
 
-    assert misread_study(tmp_path) is None and misread_text(None) == "not run yet"
-    lay_all_parts(tmp_path, "corrector-span-misread",
+    misread, gr = STATEMENTS
+    assert statement_studies(tmp_path) == {"misread": None, "span-gr": None} and statement_text(None) == "not run yet"
+    lay_all_parts(tmp_path, misread.grid,
                   lambda maze, m, p: 1.0 if p == "geometric" else {"ours": 0.5, cc.SPAN: 0.98}[m])
-    d = misread_study(tmp_path)
+    d = statement_study(misread, tmp_path)
     assert d["verdict"] == "holds" and d["runs"] == 24 and d["zero"] == d["ours_zero"] == 0
     assert len(d["per_maze"]) == 12 and not d["misses"] and not d["below"]
     assert {c["pairs"] for c in d["cost"].values()} == {12}
-    assert misread_text(d).startswith("span within 0.05 of the oracle on 12 of 12 mazes and mixes run")
-    assert len(misread_markdown(d)) == 5 + 12 + 3 + 2  # heading, 12 rows, cost heading, 2 mixes
-    lay_all_parts(tmp_path, "corrector-span-misread",
+    assert statement_text(d).startswith("span within 0.05 of the oracle on 12 of 12 mazes and proposers run")
+    assert len(statement_markdown(d)) == 5 + 12 + 3 + 2  # heading, 12 rows, cost heading, 2 mixes
+    lay_all_parts(tmp_path, misread.grid,
                   lambda maze, m, p: {"ours": 1.0, cc.SPAN: 0.9 if maze == "u_chain_5" and "moderate" in p else 1.0
                                       }.get(m, 1.0))
-    d = misread_study(tmp_path)
+    d = statement_study(misread, tmp_path)
     assert d["verdict"] == "does not hold" and d["misses"] == d["below"] == [("AZ", "u_chain_5")]
-    assert "not on AZ u_chain_5 0.900 against 1.000; below ours on 1 (AZ u_chain_5)" in misread_text(d)
+    assert "not on AZ u_chain_5 0.900 against 1.000; below ours on 1 (AZ u_chain_5)" in statement_text(d)
+    lay_all_parts(tmp_path, gr.grid, lambda maze, m, p: 0.0 if m == cc.SPAN and p == "imperfect:severe" and
+                  maze == "gr:LARGE_MAZE" else 1.0)
+    d = statement_studies(tmp_path)["span-gr"]
+    assert len(d["per_maze"]) == 18 and d["runs"] == 72 and d["zero"] == 4 and d["verdict"] == "does not hold"
+    assert d["misses"] == d["below"] == [("severe", "gr:LARGE_MAZE")]
 
 
 def test_the_reported_methods_severe_line_reads_its_cells_runs_at_0_and_cost():

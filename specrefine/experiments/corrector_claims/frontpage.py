@@ -34,8 +34,6 @@ from .common import (
 from .default import DEFAULTS, default_marker, default_studies, default_text, default_verdict, gr_study, gr_text
 from .formats import _ant_against, _cost_pair, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
-from .misread import GRID as MISREAD_GRID
-from .misread import misread_study, misread_text
 from .rules import (
     _adoption_rows,
     _cost_verdict,
@@ -46,6 +44,7 @@ from .rules import (
     verdicts,
     versus_corrector,
 )
+from .statements import STATEMENTS, statement_studies, statement_text
 
 MARKER = re.compile(r"(<!-- front corrector ([\w-]+) -->)(.*?)(<!-- /front corrector \2 -->)", re.S)
 
@@ -112,15 +111,16 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
           ant: dict | None = None, fresh: dict | None = None, defaults: list[dict] | None = None,
-          gr: dict | None = None, anyone: dict | None = None, misread: dict | None = None,
+          gr: dict | None = None, anyone: dict | None = None, statements: dict | None = None,
           **variants: dict | None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
     their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s; ``defaults`` and ``gr``: ``default_studies``'s and
-    ``gr_study``'s, ``anyone`` ``any_study``'s, ``misread`` ``misread_study``'s, computed here when not given)."""
+    ``gr_study``'s, ``anyone`` ``any_study``'s, ``statements`` ``statement_studies``'s, computed here when not
+    given)."""
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
-             MISREAD_GRID, ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES, *ANT_SUCCESSORS)
+             *(st.grid for st in STATEMENTS), ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES, *ANT_SUCCESSORS)
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -175,7 +175,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
         out[default_marker(method)] = default_text(next((d for d in defaults if d["method"] == method), None))
     out["point-default-gr"] = gr_text(gr_study(root) if gr is None else gr)
     out["any-proposer"] = any_text(any_study(root) if anyone is None else anyone)
-    out["misread"] = misread_text(misread_study(root) if misread is None else misread)
+    for marker, d in (statement_studies(root) if statements is None else statements).items():
+        out[marker] = statement_text(d)
     out["reported"] = f"`{VARIANTS[reported(variants)]}`"
     out["reported-severe"] = severe_text(variants.get(reported(variants)))
     if held_out:
