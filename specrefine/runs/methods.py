@@ -387,6 +387,14 @@ register_method("ours-corrector-span",
                 "its start to each of the next two vertices of its split past its end, on legs as sound: a mend that "
                 "enters the leg's end from another side can kill the next leg, which a chain past it judges together",
                 colour="#283593")
+#: ours-corrector-span-bridge: span, whose weak leg is also offered the roadmap's chain from the leg before it, as
+#: bridge's is (docs/corrector.md, "Entered another way: span with the bridge")
+register_method("ours-corrector-span-bridge",
+                ours_variant(**MENDED | BACKTRACK | FINE | SPAN | BRIDGE),
+                "beyond the paper: ours-corrector-span whose weak leg is also offered, after its own chain, the "
+                "roadmap's chain from the start of the leg before it to its end, on legs as sound, replacing the "
+                "waypoint between them: a waypoint whose arrivals every next leg loses (one a deaf proposer put "
+                "against a wall) is stepped round, not searched from", colour="#1a237e")
 #: ours-corrector-guard: deep, a correction's win on its window kept only if the whole path checked again scores no
 #: lower (docs/corrector.md, "A window's win checked on the whole path")
 GUARD = dict(correct_guard=True)
