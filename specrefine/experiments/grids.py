@@ -543,6 +543,19 @@ MISREAD_MIXES = ("imperfect:p_swap_xy=0.15,bias=0.3,p_shuffle=0.3,p_truncate=0.3
                  "imperfect:moderate,p_swap_xy=0.1,bias=0.2,p_shuffle=0.2,p_truncate=0.2,p_stale=0.15")
 MISREAD_CODE = "3989efc"  # the commit that added the misreadings (ImperfectConfig.p_swap_xy, ...)
 
+#: the deaf proposer whose pilot cells informed ours-corrector-span-bridge (docs/corrector.md, "Entered another way:
+#: span with the bridge"): every turn dropped, feedback never used, so each reply is the straight line capped at the
+#: policy's reach
+DEAF = "imperfect:p_drop_turn=1,rho=0"
+#: layouts and error mixes no run had used before grid corrector-span-bridge-new, made after span-bridge's pilot: four
+#: generated mazes (sizes chosen, seeds drawn by random.Random(202612072)) and two deaf mixes: BA (nearly every turn
+#: dropped, feedback never used, offsets and regions pulled toward corners) and BB (half the turns dropped, feedback
+#: never used, small regions, a bias for the whole run and stale replies)
+SPAN_BRIDGE_MAZES = ("random:13x10:24", "random:10x13:99", "random:14x14:2", "random:16x11:5")
+SPAN_BRIDGE_MIXES = ("imperfect:position_sigma=0.2,corner_pull=0.3,p_drop_turn=0.9,rho=0",
+                     "imperfect:position_sigma=0.15,radius=0.25,p_drop_turn=0.6,bias=0.25,p_stale=0.3,rho=0")
+SPAN_BRIDGE_CODE = "77dafe1"  # the commit of ours-corrector-span-bridge (span's settings with roadmap_bridge)
+
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
 MEMORY_CODE = "b8d7f64"  # the commit of ours-corrector-memory's code (Roadmap.remember)
@@ -640,10 +653,11 @@ def new_layouts_grid(name: str, source: str, methods: tuple, mazes: tuple, mixes
                           out=f"runs/{name.replace('-', '_')}")
 
 
-def default_oracle_grid(name: str, section: str, method: str, stem: str, code: str) -> ExperimentGrid:
+def default_oracle_grid(name: str, section: str, method: str, stem: str, code: str, fixed: str = "2026-12-05"
+                        ) -> ExperimentGrid:
     """``method`` and ours with the oracle on the 17 suite mazes, seeds 0-3, centre goal points (issue 39: the point
     mass's default rule, docs/corrector.md SECTION), into data/results/corrector/STEM_oracle.csv."""
-    return ExperimentGrid(name, f"docs/corrector.md, '{section}' (issue 39; fixed 2026-12-05 before it ran): {method} "
+    return ExperimentGrid(name, f"docs/corrector.md, '{section}' (issue 39; fixed {fixed} before it ran): {method} "
                           "and ours with the oracle on the 17 suite mazes", "point",
                           parts=(Part((method, "ours"), ("geometric",), split="seeds"),),
                           seeds=(0, 1, 2, 3), mazes=SCALING_MAZES + OTHER_POINT_MAZES, goal_points="centre", workers=1,
@@ -1084,6 +1098,19 @@ GRIDS = {g.name: g for g in (
     new_layouts_grid("corrector-span-new", "docs/corrector.md, 'Weak legs mended past their end' (issue 39; fixed "
                      "2026-12-05 before it ran)", ("ours-corrector-span", "ours-corrector-fine", "ours"),
                      SPAN_MAZES, SPAN_MIXES, "span_new", code=SPAN_CODE),
+    # docs/corrector.md, "Entered another way: span with the bridge" (fixed 2026-12-07, before they ran)
+    *centre_variant_grids("corrector-span-bridge", "Entered another way: span with the bridge",
+                          "ours-corrector-span-bridge", "span_bridge", code=SPAN_BRIDGE_CODE,
+                          informed=Part(("ours-corrector-span-bridge", "ours-corrector-span", "ours"), (DEAF,),
+                                        mazes=SCALING_MAZES, seeds=(0, 1), table="data/results/corrector/"
+                                        "span_bridge_deaf.csv", out="informed"),
+                          fixed="2026-12-07"),
+    new_layouts_grid("corrector-span-bridge-new", "docs/corrector.md, 'Entered another way: span with the bridge' "
+                     "(issue 39; fixed 2026-12-07 before it ran)",
+                     ("ours-corrector-span-bridge", "ours-corrector-span", "ours"), SPAN_BRIDGE_MAZES,
+                     SPAN_BRIDGE_MIXES, "span_bridge_new", code=SPAN_BRIDGE_CODE),
+    default_oracle_grid("corrector-span-bridge-oracle", "Entered another way: span with the bridge",
+                        "ours-corrector-span-bridge", "span_bridge", SPAN_BRIDGE_CODE, fixed="2026-12-07"),
     # docs/corrector.md, "The point mass's default on D4RL's maps, misreadings included" (fixed 2026-12-07, before it
     # ran)
     ExperimentGrid("corrector-span-gr", "docs/corrector.md, 'The point mass's default on D4RL's maps, misreadings "
