@@ -1240,6 +1240,32 @@ def test_span_is_judged_against_fine_on_its_new_layouts_and_the_random_proposers
     assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.SPAN] == ("informed",)
 
 
+def test_span_bridge_is_judged_against_span_on_its_new_layouts_and_the_deaf_proposers_cells_that_informed_it(
+        tmp_path):
+    """corrector-span-bridge: span its reference and control; the deaf proposer's U-chain cells (its own grid's
+    informed part, span and ours beside) informed it; its new layouts (BA, BB) put it, span and ours side by side; its
+    adoption counts runs below 0.9 and asks for no more than span's."""
+    from specrefine.experiments.grids import DEAF, SPAN_BRIDGE_MIXES
+
+    base, dead = fine_rate(), {"u_chain_1", "random:13x10:24"}
+
+    def rate(maze, method, proposer):
+        if method in (cc.SPAN_BRIDGE, cc.SPAN):
+            deaf = proposer in (DEAF, *SPAN_BRIDGE_MIXES)
+            return 0.0 if method == cc.SPAN and deaf and cc.table_name(maze) in dead else 0.99
+        return base(maze, method, proposer)
+
+    laid = (*THROUGH_FINE, "corrector-fine-new", "corrector-fine-random", "corrector-span", "corrector-span-suite",
+            "corrector-span-new", "corrector-span-bridge", "corrector-span-bridge-suite")
+    _, vs = judged_after_its_reference(
+        tmp_path, "span-bridge", rate, laid,
+        (["deaf"], "corrector-span-bridge", {cc.SPAN_BRIDGE: 0, cc.SPAN: 2, "ours": 0}),
+        "corrector-span-bridge-new", (["BA", "BB"], {cc.SPAN_BRIDGE: 0, cc.SPAN: 4, "ours": 0}),
+        {cc.SPAN_BRIDGE: 0, cc.SPAN: 4})
+    assert vs["adoption"]["floor"] == 0.9 and cc.INFORMED_PARTS[cc.SPAN_BRIDGE] == ("informed",)
+    assert vs["informed"]["runs"] == 18  # the nine U-chains, seeds 0-1, each run once (not again from the grid's part)
+
+
 def test_the_random_proposers_statement_needs_every_maze_near_the_oracle_and_no_run_at_0(tmp_path):
     """corrector-fine-random (described): fine against the oracle per maze (fine's oracle grid on the suite, the
     grid's own on its new layouts); the statement holds only when every maze is within 0.05 and no run is at 0."""

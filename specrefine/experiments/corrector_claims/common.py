@@ -39,11 +39,12 @@ MEND = "ours-corrector-mend"  # deep, a live leg below 0.9 also offered the road
 BACKTRACK = "ours-corrector-backtrack"  # mend, a dead leg of a dead path also offered the chain from the path's start
 FINE = "ours-corrector-fine"  # backtrack, probes at half the radius once every first ring of a search is spent
 SPAN = "ours-corrector-span"  # fine, a weak leg also offered the chains from its start past its end (two vertices)
+SPAN_BRIDGE = "ours-corrector-span-bridge"  # span, a weak leg also offered the chain from the leg before it
 SHOWN_BESIDE = ("ours-corrector-advance",)  # run beside a variant on its new layouts (advance without the budget)
 #: a variant whose adoption counts runs below this success instead of runs at 0 (its docs/corrector.md section)
-ADOPTION_FLOOR = {SOUND: 0.5, MEND: 0.9, BACKTRACK: 0.9, FINE: 0.9, SPAN: 0.9}
+ADOPTION_FLOOR = {SOUND: 0.5, MEND: 0.9, BACKTRACK: 0.9, FINE: 0.9, SPAN: 0.9, SPAN_BRIDGE: 0.9}
 #: a variant whose adoption asks for no more such runs than its reference, not fewer (its docs/corrector.md section)
-NO_MORE = {MEND, BACKTRACK, FINE, SPAN}
+NO_MORE = {MEND, BACKTRACK, FINE, SPAN, SPAN_BRIDGE}
 NON_INFERIORITY = 0.02  # a variant - ours-corrector: the interval's lower end at or above -this (no worse)
 #: each variant of the corrector and its grid
 VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "corrector-precise",
@@ -54,13 +55,14 @@ VARIANT_GRIDS = {GATED: "corrector-gated", LEAN: "corrector-lean", PRECISE: "cor
                  KEEP: "corrector-keep", FALLBACK: "corrector-fallback", ADVANCE: "corrector-advance",
                  ROADMAP: "corrector-roadmap", SOUND: "corrector-sound", MEMORY: "corrector-memory",
                  PROBE: "corrector-probe", DEEP: "corrector-deep", MEND: "corrector-mend",
-                 BACKTRACK: "corrector-backtrack", FINE: "corrector-fine", SPAN: "corrector-span"}
+                 BACKTRACK: "corrector-backtrack", FINE: "corrector-fine", SPAN: "corrector-span",
+                 SPAN_BRIDGE: "corrector-span-bridge"}
 #: the method a variant is judged against where it is not ours-corrector (its docs/corrector.md section)
 VARIANT_REFERENCE = {TRIM: PRECISE, SPREAD: PRECISE, RECHECK: SPREAD, FRUGAL: SPREAD, RETRY: SPREAD,
                      THRIFT: RECHECK, POLISH: THRIFT, CENTRE: POLISH, PERSIST: CENTRE,
                      SNAP: PERSIST, EXTEND: SNAP, KEEP: SNAP, FALLBACK: SNAP, ADVANCE: SNAP,
                      ROADMAP: ADVANCE, SOUND: ROADMAP, MEMORY: ROADMAP, PROBE: ROADMAP,
-                     DEEP: PROBE, MEND: DEEP, BACKTRACK: MEND, FINE: BACKTRACK, SPAN: FINE}
+                     DEEP: PROBE, MEND: DEEP, BACKTRACK: MEND, FINE: BACKTRACK, SPAN: FINE, SPAN_BRIDGE: SPAN}
 #: the grid that runs a variant on the rest of the point suite (docs/corrector.md, "The whole suite")
 VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-suite",
                  THRIFT: "corrector-thrift-suite", POLISH: "corrector-polish-suite",
@@ -70,24 +72,25 @@ VARIANT_SUITE = {SPREAD: "corrector-precise-suite", RECHECK: "corrector-recheck-
                  ADVANCE: "corrector-advance-suite", ROADMAP: "corrector-roadmap-suite",
                  SOUND: "corrector-sound-suite", MEMORY: "corrector-memory-suite",
                  PROBE: "corrector-probe-suite", DEEP: "corrector-deep-suite", MEND: "corrector-mend-suite",
-                 BACKTRACK: "corrector-backtrack-suite", FINE: "corrector-fine-suite", SPAN: "corrector-span-suite"}
+                 BACKTRACK: "corrector-backtrack-suite", FINE: "corrector-fine-suite", SPAN: "corrector-span-suite",
+                 SPAN_BRIDGE: "corrector-span-bridge-suite"}
 #: the method a variant's grid runs where the claims name it otherwise
 VARIANT_RUNS = {SPREAD: PRECISE, CENTRE: POLISH}
 #: variants run at other settings, whose grids run their own oracle, ours, ours-repair and one-shot beside them
 #: (their rules read those, never the taxonomy and corrector grids' rows); their held-out part is in their suite grid
 SELF_CONTAINED = {CENTRE, PERSIST, SNAP, EXTEND, KEEP, FALLBACK, ADVANCE, ROADMAP, SOUND, MEMORY, PROBE, DEEP, MEND,
-                  BACKTRACK, FINE, SPAN}
+                  BACKTRACK, FINE, SPAN, SPAN_BRIDGE}
 #: each variant by its short name (README's marker, claims.json's key), in the order claims.md shows them
 VARIANTS = {"gated": GATED, "lean": LEAN, "precise": PRECISE, "trim": TRIM, "spread": SPREAD, "recheck": RECHECK,
             "frugal": FRUGAL, "retry": RETRY, "thrift": THRIFT, "polish": POLISH, "centre": CENTRE, "persist": PERSIST,
             "snap": SNAP, "extend": EXTEND, "keep": KEEP, "fallback": FALLBACK, "advance": ADVANCE,
             "roadmap": ROADMAP, "sound": SOUND, "memory": MEMORY,
             "probe": PROBE, "deep": DEEP, "mend": MEND, "backtrack": BACKTRACK,
-            "fine": FINE, "span": SPAN}
+            "fine": FINE, "span": SPAN, "span-bridge": SPAN_BRIDGE}
 REPORTED = "centre"  # the variant README reports first (docs/corrector.md, "Aimed at the centre") unless ...
 #: ... or the latest of these adopted (reported())
-ADOPTABLE = ("span", "fine", "backtrack", "mend", "deep", "probe", "memory", "sound", "roadmap", "advance", "fallback",
-             "keep", "extend", "snap", "persist")
+ADOPTABLE = ("span-bridge", "span", "fine", "backtrack", "mend", "deep", "probe", "memory", "sound", "roadmap",
+             "advance", "fallback", "keep", "extend", "snap", "persist")
 ORACLE = ("ours", "geometric")
 TOLERANCE = 0.05  # within this of the oracle, and flat within this
 COST_CAP = 3.0

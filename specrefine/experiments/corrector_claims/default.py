@@ -8,14 +8,28 @@ import math
 from pathlib import Path
 
 from ..grids import GR_MIXES, GRIDS, ROOT
-from .common import BACKTRACK, DEEP, FINE, MEND, SPAN, costs, episodes_of, load, paired_rows, per_maze, zero_runs
+from .common import (
+    BACKTRACK,
+    DEEP,
+    FINE,
+    MEND,
+    SPAN,
+    SPAN_BRIDGE,
+    costs,
+    episodes_of,
+    load,
+    paired_rows,
+    per_maze,
+    zero_runs,
+)
 from .formats import _ant_paired_text, _cost_table, _diff, _num
 
 GRID = "corrector-deep-oracle"
 MEND_ORACLE_GRID = "corrector-mend-oracle"
 #: each candidate's oracle grid, in the order they were adopted or fixed
 DEFAULTS = ((GRID, DEEP), (MEND_ORACLE_GRID, MEND), ("corrector-backtrack-oracle", BACKTRACK),
-            ("corrector-fine-oracle", FINE), ("corrector-span-oracle", SPAN))
+            ("corrector-fine-oracle", FINE), ("corrector-span-oracle", SPAN),
+            ("corrector-span-bridge-oracle", SPAN_BRIDGE))
 PROPOSER = "geometric"
 MARGIN = 0.01  # the pooled difference's lower end at or above -MARGIN
 

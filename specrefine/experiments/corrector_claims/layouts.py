@@ -16,6 +16,7 @@ from ..grids import (
     BACKTRACK_MIXES,
     CHECK_MAZES,
     CHECK_MIXES,
+    DEAF,
     DEEP_CHECK_MAZES,
     DEEP_CHECK_MIXES,
     DEEP_MAZES,
@@ -54,6 +55,8 @@ from ..grids import (
     SNAP_MIXES,
     SOUND_MAZES,
     SOUND_MIXES,
+    SPAN_BRIDGE_MAZES,
+    SPAN_BRIDGE_MIXES,
     SPAN_MAZES,
     SPAN_MIXES,
 )
@@ -77,6 +80,7 @@ from .common import (
     SNAP,
     SOUND,
     SPAN,
+    SPAN_BRIDGE,
     VARIANT_GRIDS,
     VARIANTS,
     episodes_of,
@@ -111,7 +115,9 @@ NEW_STUDIES = {PERSIST: ("corrector-persist-new", NEW_MAZES, NEW_MIXES, ("E", "F
                FINE: ("corrector-fine-new", FINE_MAZES, FINE_MIXES, ("AT", "AU")),
                "fine-random": ("corrector-fine-random", SCALING_MAZES + OTHER_POINT_MAZES, ("random",), ("random",)),
                SPAN: ("corrector-span-new", SPAN_MAZES, SPAN_MIXES, ("random", "AX")),
-               "fine-check": ("corrector-fine-check", FINE_CHECK_MAZES, FINE_CHECK_MIXES, ("AV", "AW"))}
+               "fine-check": ("corrector-fine-check", FINE_CHECK_MAZES, FINE_CHECK_MIXES, ("AV", "AW")),
+               "deaf": ("corrector-span-bridge", SCALING_MAZES, (DEAF,), ("deaf",)),
+               SPAN_BRIDGE: ("corrector-span-bridge-new", SPAN_BRIDGE_MAZES, SPAN_BRIDGE_MIXES, ("BA", "BB"))}
 NEW_GRIDS = tuple(grid for grid, *_ in NEW_STUDIES.values())
 #: the new-layout study of a last check after a variant's adoption
 LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-check", MEND: "mend-check",
@@ -119,7 +125,7 @@ LAST_CHECK = {ADVANCE: "advance-check", ROADMAP: "roadmap-check", DEEP: "deep-ch
 #: the new-layout study whose cells informed a variant (beside snap's, which names its own)
 INFORMED_ON = {EXTEND: "check", KEEP: EXTEND, FALLBACK: KEEP, ADVANCE: FALLBACK, ROADMAP: "advance-check",
                SOUND: "roadmap-check", MEMORY: SOUND, PROBE: MEMORY,
-               DEEP: PROBE, BACKTRACK: "mend-check", FINE: BACKTRACK, SPAN: "fine-random"}
+               DEEP: PROBE, BACKTRACK: "mend-check", FINE: BACKTRACK, SPAN: "fine-random", SPAN_BRIDGE: "deaf"}
 #: a variant's studies on cells beside its new ones (README's markers NAME-PART): those that informed it, a last check
 INFORMED_PARTS = {m: ("informed",) * (m in INFORMED_ON or m == SNAP) + ("check",) * (m in LAST_CHECK or m == SNAP)
                   for m in (SNAP, *INFORMED_ON, *LAST_CHECK)}
@@ -131,7 +137,7 @@ def new_study(method: str, root: Path = ROOT, on: str | None = None, reference: 
     variant - its reference paired over the cells (and the reference - polish where polish is not it)."""
     grid, mazes, mixes, names = NEW_STUDIES[on or method]
     rows, ref = _new_rows(grid, root), reference or reference_of(method)
-    if on:  # the variant's own cells there come from its grid's part on them
+    if on and grid != VARIANT_GRIDS[method]:  # the variant's own cells there come from its grid's part on them
         rows += [r for r in load(GRIDS[VARIANT_GRIDS[method]].tables, root) if r["proposer"] in mixes]
     if not any(r["method"] == method for r in rows):
         return None
