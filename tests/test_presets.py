@@ -34,10 +34,11 @@ def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules(
     assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
     point, point_paper = resolved(), resolved("--preset", "paper")
     # the point mass: the same settings but the goal points (centre since grid corrector-centre) and the method (the
-    # corrector since grid corrector-deep-oracle, mend since corrector-mend-oracle, span since corrector-span-oracle)
-    assert replace(point_paper, preset="best", goal_points="centre", method="ours-corrector-span") == point
+    # corrector since grid corrector-deep-oracle, mend since corrector-mend-oracle, span since corrector-span-oracle,
+    # span-bridge since corrector-span-bridge-oracle)
+    assert replace(point_paper, preset="best", goal_points="centre", method="ours-corrector-span-bridge") == point
     assert (point.evaluation, point.goal_points, point.policy) == ("fixed", "centre", "shipped")
-    assert (point.method, point_paper.method) == ("ours-corrector-span", "ours")
+    assert (point.method, point_paper.method) == ("ours-corrector-span-bridge", "ours")
     assert resolved("--agent", "ant", "--method", "ours").method == "ours"  # an explicit method wins
     assert (point_paper.evaluation, point_paper.goal_points, point_paper.policy) == ("fixed", "sampled", "shipped")
     explicit = resolved("--agent", "ant", "--preset", "paper", "--goal-points", "centre", "--policy", "shipped")
@@ -53,17 +54,17 @@ def test_a_run_records_its_preset_and_official_prints_it(tmp_path, capsys):
     data = json.loads((out / "result.json").read_text())
     assert data["preset"] == "best" and data["config"]["goal_points"] == "centre"
     assert data["config"]["evaluation"] == "fixed" and data["config"]["policy"] == "shipped"
-    assert data["config"]["method"] == "ours-corrector-span"
+    assert data["config"]["method"] == "ours-corrector-span-bridge"
     # the point mass's presets differ in the goal points and the method: run.json records what runs, so the paper's
     # preset is another run (refused), and with centre points and the corrector the same one (the folder takes it)
     assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--out", str(out)]) == 2
     assert "holds another run" in capsys.readouterr().err
     assert main(["refine", "split_doorway", *TINY, "--preset", "paper", "--goal-points", "centre", "--method",
-                 "ours-corrector-span", "--out", str(out)]) == 0
+                 "ours-corrector-span-bridge", "--out", str(out)]) == 0
     assert json.loads((out / "result.json").read_text())["preset"] == "paper"
     capsys.readouterr()
     assert main(["official", str(out), "--episodes", "2"]) == 0
-    assert ("the run's preset: paper with method=ours-corrector-span, goal_points=centre (the best preset's "
+    assert ("the run's preset: paper with method=ours-corrector-span-bridge, goal_points=centre (the best preset's "
             "settings)") in capsys.readouterr().out
     assert json.loads((out / "official.json").read_text())["preset"] == "paper"
 

@@ -81,8 +81,8 @@ AGENTS: dict[str, Agent] = {
         planar=True, action_in_disc=True, max_speed=5.0, bench_room_cells=61,
         # centre goal points passed their rule on the corrector's grids (docs/corrector.md, "Aimed at the centre");
         # the corrector, adopted with erring proposers, passed its rule with the oracle (docs/corrector.md, "The point
-        # mass's default method")
-        default_goal_points="centre", default_method="ours-corrector-span"),
+        # mass's default method"; span-bridge since "Entered another way: span with the bridge")
+        default_goal_points="centre", default_method="ours-corrector-span-bridge"),
     "ant": Agent(
         name="ant",
         description="the MuJoCo Ant, a four-legged walking robot (as in Gymnasium-Robotics AntMaze); it is slow to "

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...core.agents import get_agent
 from ...core.results import wilson_ci
 from ..grids import GRIDS, ROOT, SCALING_MAZES
 from .ant import ANT_ERRING, ANT_ONESHOT, ANT_REDRAW, ANT_SEEDS, ANT_SPAN, REDRAW
@@ -27,12 +28,13 @@ def glance_panels(root: Path = ROOT) -> list[dict]:
     """Per panel: its title and, per curve, its role, label and (successes, episodes, runs) per U-chain maze."""
     from .variants import variant_rows
 
-    point = variant_rows(SPAN, root)
+    default = get_agent("point").default_method  # the point mass's --preset best method
+    point = variant_rows(default, root)
     panels = []
     for proposer in ("imperfect:mild", "imperfect:moderate"):
-        curves = [("oracle", ORACLE), ("corrector", (SPAN, proposer)), ("ours", ("ours", proposer)),
+        curves = [("oracle", ORACLE), ("corrector", (default, proposer)), ("ours", ("ours", proposer)),
                   ("vlm-oneshot", ("vlm-oneshot", proposer))]
-        panels.append(_panel("point mass", proposer, point, curves, POINT_SEEDS, f"{SPAN} (default)"))
+        panels.append(_panel("point mass", proposer, point, curves, POINT_SEEDS, f"{default} (default)"))
     # the Ant's oracle at its correctors' settings (the split's later-round pick confirmed): README's reference there
     ant = load(GRIDS[ANT_REDRAW].tables + GRIDS[ANT_SPAN].tables + GRIDS[ANT_ORACLE_GRID].tables
                + (ANT_ONESHOT, ANT_ERRING), root)
