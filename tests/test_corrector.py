@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from test_refine_search import WALLS, _Arrive, _chain_graph, _Query, box_at
 
+from specrefine.core.errors import SpecrefineError
 from specrefine.core.graph import TaskGraph, check_refines
 from specrefine.core.regions import Box, Disc
 from specrefine.refine import RefinementSearch, SearchConfig
@@ -644,6 +645,77 @@ def test_a_live_path_never_consults_the_roadmap():
                         correct_advance=True, correct_reach=3.5, correct_roadmap=setting)
         runs.append((book.queries, xs(result), [s["event"] for s in result.steps]))
     assert runs[0] == runs[1] and "roadmap" not in runs[1][2]
+
+
+# --- a rescue (SearchConfig.rescue): method ours-corrector-redraw-rescue ---------------------------------------------
+#: the base correction: two passes, no roadmap (redraw's shape); the rescue: the pooled replies' roadmap
+BASE = dict(correct_rollouts=4, correct_passes=2, max_edge_splits=8)
+RESCUE = dict(correct_while_dead=True, correct_advance=True, correct_reach=3.5, correct_roadmap=True)
+
+
+def test_a_path_the_correction_leaves_dead_is_rescued_over_the_replies_pooled_before_the_rescue():
+    g, result = run(LegTable(NO_REPLY_RIGHT), EdgeQueue(WRONG_REPLIES), **BASE, rescue=RESCUE)
+    assert xs(result) == [0.0, 3.0, 6.0, 9.0, 10.0] and check_refines(result.graph, g) == []
+    events = [s["event"] for s in result.steps]
+    assert events.count("rescue") == 1 and events.index("rescue") < events.index("roadmap")
+    rescue = result.steps[events.index("rescue")]
+    assert rescue["path"] == ["S", "G"] and rescue["changes"] == sorted(RESCUE)
+    assert "the path corrected once more, 4 settings changed" in describe(rescue)
+    assert result.roadmap is not None and len(result.roadmap.points) >= 2  # the search's reply (3, 9) pooled too
+
+
+def test_without_a_rescue_the_same_replies_leave_the_base_correction_dead():
+    _, result = run(LegTable(NO_REPLY_RIGHT), EdgeQueue(WRONG_REPLIES), **BASE)
+    assert result.predicted_success == 0.0 and result.roadmap is None
+    assert not any(s["event"] in ("rescue", "roadmap") for s in result.steps)
+
+
+def test_a_rescue_draws_apart_from_the_passes_before_it():
+    table = LegTable(NO_REPLY_RIGHT)
+    _, result = run(table, EdgeQueue(WRONG_REPLIES), **BASE, rescue=RESCUE)
+    at = next(s["evaluations_so_far"] for s in result.steps if s["event"] == "rescue")
+    before = {seed for *_, seed in table.calls[:at] if seed is not None}
+    after = {seed for *_, seed in table.calls[at:] if seed is not None}
+    assert len(before) == 2 and after and not before & after  # two passes' draws, then the rescue's own
+
+
+def test_a_rescue_never_touches_a_path_the_correction_leaves_alive():
+    runs = []
+    for rescue in (None, RESCUE):
+        book, table = AnswerBook({(0.0, 10.0): [3, 6]}), LegTable(LUCKY, {(3.0, 6.0): 0.75})
+        _, result = run(table, book, **BASE, rescue=rescue)
+        runs.append((book.queries, table.calls, xs(result), result.steps, result.roadmap))
+    assert runs[0] == runs[1] and runs[1][-1] is None
+
+
+def test_a_rescue_needs_the_correction_and_known_fields():
+    with pytest.raises(ValueError, match="rescue needs correct_rollouts"):
+        SearchConfig(rescue=RESCUE)
+    with pytest.raises(SpecrefineError, match="no field 'roadmap_wide'"):
+        SearchConfig(correct_rollouts=4, rescue=dict(roadmap_wide=True))
+    with pytest.raises(ValueError, match="correct_roadmap needs correct_reach"):
+        SearchConfig(correct_rollouts=4, rescue=dict(correct_roadmap=True))
+
+
+def test_a_deaf_proposer_leaves_redraw_at_0_and_its_rescue_finds_the_way(tmp_path):
+    """Every turn dropped, feedback never used: redraw (the Ant's default before its rescue) ends at 0; its rescue
+    builds the way from the replies and its own probes (docs/corrector.md, "A rescue for the Ant's default")."""
+    from specrefine.runs.pipeline import refine_maze
+
+    deaf = dict(proposer="imperfect:p_drop_turn=1,rho=0", agent="point", rollouts=8, episodes=20, seed=0,
+                goal_points="centre")
+    redraw = refine_maze("u_chain_1", method="ours-corrector-redraw", out=tmp_path / "redraw", **deaf).data
+    rescue = refine_maze("u_chain_1", method="ours-corrector-redraw-rescue", out=tmp_path / "rescue", **deaf).data
+    assert redraw["success_rate"] == 0.0 and rescue["success_rate"] >= 0.9
+    steps = [json.loads(line) for line in (tmp_path / "rescue" / "steps.jsonl").read_text().splitlines()]
+    assert [s["event"] for s in steps].count("rescue") == 1 and (tmp_path / "rescue" / "roadmap.png").is_file()
+
+
+def test_redraw_rescue_is_redraw_with_span_bridges_correction_as_its_rescue():
+    from specrefine.runs.methods import REDRAW, SPAN_BRIDGE
+
+    assert "rescue" not in REDRAW and SPAN_BRIDGE["roadmap_bridge"] and SPAN_BRIDGE["roadmap_span"] == 2
+    assert get_method("ours-corrector-redraw-rescue").description.startswith("beyond the paper: ours-corrector-redraw")
 
 
 def test_the_roadmap_needs_a_reach():

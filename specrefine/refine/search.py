@@ -129,6 +129,10 @@ class SearchConfig:
     #                        this many vertices of its split past its end (correct.py; 2: method ours-corrector-span)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
+    rescue: dict | None = None  # beyond the paper: where the correction leaves a leg that never succeeded on its
+    #                             last fresh check, the path is corrected once more with these changes to this
+    #                             config (method ours-corrector-redraw-rescue: span-bridge's correction); a path it
+    #                             leaves alive is never touched, so on every such run the method is its base
 
     def __post_init__(self):
         if self.evaluation not in EVALUATIONS:
@@ -170,6 +174,15 @@ class SearchConfig:
                 raise ValueError(f"{name} must lie in [0, 1], got {getattr(self, name)!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
             raise ValueError(f"correct_rounds must be at least 1 (or None: d), got {self.correct_rounds!r}")
+        if self.rescue is not None:
+            if not self.correct_rollouts:
+                raise ValueError("rescue needs correct_rollouts (it follows the correction)")
+            check_changes(self.rescue)
+            self.rescued()  # its own checks
+
+    def rescued(self) -> SearchConfig:
+        """The configuration a rescue corrects with: this one with ``rescue``'s changes (and no further rescue)."""
+        return replace(self, **(self.rescue or {}), rescue=None)
 
     @classmethod
     def from_run(cls, run, **changes) -> SearchConfig:
@@ -261,11 +274,14 @@ class RefinementSearch:
         self.splits_generated = 0
         self.vertex_generated = 0
         self._extended = False  # the correction has gone past max_edge_splits (dead_budget), logged once
-        self.roadmap = (Roadmap(reach=self.cfg.correct_reach, sound=self.cfg.roadmap_sound,
-                                remember=self.cfg.roadmap_remember, explore=self.cfg.roadmap_explore,
-                                probe=self.cfg.roadmap_probe, rings=self.cfg.roadmap_rings,
-                                evaluations=self.cfg.roadmap_evaluations)
-                        if self.cfg.correct_roadmap else None)
+        self._draws = 0  # the correction's fresh draws so far (a rescue's passes draw apart from them)
+        # the pooled replies: kept from the first split where the correction or its rescue may search them
+        pooled = self.cfg.rescued() if self.cfg.rescue else self.cfg
+        self.roadmap = (Roadmap(reach=pooled.correct_reach, sound=pooled.roadmap_sound,
+                                remember=pooled.roadmap_remember, explore=pooled.roadmap_explore,
+                                probe=pooled.roadmap_probe, rings=pooled.roadmap_rings,
+                                evaluations=pooled.roadmap_evaluations)
+                        if self.cfg.correct_roadmap or pooled.correct_roadmap else None)
         if self.cfg.edge_refinement and (proposer is None or query_for is None):
             raise ValueError("edge refinement needs a proposer and a query builder")
 
@@ -299,16 +315,18 @@ class RefinementSearch:
         if path and self.cfg.correct_rollouts:
             self._log("correct-begin", path=path)  # its counts: what the search (and polish) spent
             if before is not None and path != before[1]:
-                path = self._correct_kept(path, before)
+                path, alive = self._correct_kept(path, before)
             else:
-                path, _ = self._correct(path)
+                path, alive = self._correct(path)
+            if not alive and self.cfg.rescue:
+                path = self._rescue(path)
         probs = [self.results[(a, b)].p for a, b in zip(path, path[1:])] if path else []
         self._log("done", path=path, predicted_success=float(math.prod(probs)) if path else 0.0,
                   probabilities=probs, splits_generated=self.splits_generated,
                   max_edge_splits=self.cfg.max_edge_splits,
                   **({"dead_budget": self.cfg.dead_budget} if self.cfg.dead_budget is not None else {}))
         return SearchResult(self.graph, path, probs, self.steps, self.accepted, self.splits_generated,
-                            self.vertex_generated, self.roadmap)
+                            self.vertex_generated, self.roadmap if self.cfg.correct_roadmap else None)
 
     def _relax(self, u: str, v: str) -> None:
         f = self.f
@@ -541,26 +559,36 @@ class RefinementSearch:
             self.results[edge] = result
 
     # --- beyond the paper: correcting the found path on fresh rollouts (correct.py) ------
-    def _correct_kept(self, path: list[str], before: tuple) -> list[str]:
+    def _correct_kept(self, path: list[str], before: tuple) -> tuple[list[str], bool]:
         """The correction of a path that took a declined split (keep_fallback): up to half the budget left, and where
         the path is still dead then, back to the graph, path and estimates before the split was taken, corrected
-        within the rest as a path without it would have been."""
+        within the rest as a path without it would have been -> (the path, whether it was left alive)."""
         limit = self._dead_limit()
         path, alive = self._correct(path, limit=self.splits_generated + (limit - self.splits_generated) // 2)
         if alive or self.splits_generated >= limit:
-            return path
+            return path, alive
         self.graph, path, self.results = before[0], list(before[1]), dict(before[2])
         self._log("declined-dropped", path=path, splits=[self.splits_generated, limit],
                   reason="the kept split's path is still dead")
-        return self._correct(path)[0]
+        return self._correct(path)
 
-    def _correct(self, path: list[str], limit: int | None = None) -> tuple[list[str], bool]:
+    def _rescue(self, path: list[str]) -> list[str]:
+        """The correction once more, with ``rescue``'s changes, on draws of its own: the path its correction left has
+        a leg that never succeeded, and a proposer that gives nothing valid (or never uses its feedback) leaves the
+        base method's correction nothing else to try there (docs/corrector.md, "A rescue for the Ant's default")."""
+        self._log("rescue", path=path, reason="the correction left a leg that never succeeded",
+                  changes=sorted(self.cfg.rescue))
+        self.cfg = self.cfg.rescued()
+        return self._correct(path, first_pass=self._draws)[0]
+
+    def _correct(self, path: list[str], limit: int | None = None, first_pass: int = 0) -> tuple[list[str], bool]:
         """The correction (correct.py), ``correct_passes`` times: each pass on its own fresh draw (new first
         states, so a leg chosen on one pass's rollouts is judged again on rollouts that did not choose it), with a
-        budget of its own -> (the path, whether its last fresh check found no dead leg)."""
-        for pass_ in range(self.cfg.correct_passes):
+        budget of its own -> (the path, whether its last fresh check found no dead leg). ``first_pass``: the draws
+        used before (a rescue's passes draw apart from the correction's)."""
+        for pass_ in range(first_pass, first_pass + self.cfg.correct_passes):
             path, check = self._correct_pass(path, pass_)
-        pass_, limit = self.cfg.correct_passes, limit or self._dead_limit()
+        pass_, limit = first_pass + self.cfg.correct_passes, limit or self._dead_limit()
         if self.cfg.correct_wide:
             path, check = self._correct_pass(path, pass_, wide=True)
             pass_ += 1
@@ -575,6 +603,7 @@ class RefinementSearch:
                 break
         assert_refines(self.graph, self.original)
         self._estimate_again(path)
+        self._draws = pass_  # the next pass draws apart from every one so far
         return path, check.p > 0.0
 
     def _dead_limit(self) -> int:
@@ -617,7 +646,7 @@ class RefinementSearch:
                                       reach=reach, clearance=getattr(self.evaluator, "clearance", 0.0), log=log,
                                       min_failures=min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
-                                      roadmap=self._roadmap_chain if self.roadmap is not None else None,
+                                      roadmap=self._roadmap_chain if self.cfg.correct_roadmap else None,
                                       roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
                                       bridge=self.cfg.roadmap_bridge, backtrack=self.cfg.roadmap_backtrack,
                                       span=self.cfg.roadmap_span,

@@ -25,6 +25,7 @@ EVENT_TEXT = {
     "correct-leg": "correct leg {leg} ({edge[0]} -> {edge[1]}, fresh p {p_leg:.3f}, window {p_window:.3f}): "
                    "tried {tried_text}; accepted {accepted_text}",
     "correct-done": "correction done{pass_text}: p = {p:.3f} over {n_legs} legs (on the rollouts that chose them)",
+    "rescue": "rescue: {reason}; the path corrected once more, {n_changes} settings changed",
     "roadmap": "roadmap for {edge[0]} -> {edge[1]} over {pooled} pooled waypoints: a chain of {waypoints}, "
                "{reach_text} ({evaluations} evaluations)",
 }
@@ -50,6 +51,8 @@ def describe(step: dict) -> str:
         detail["n_legs"] = len(detail["probabilities"])
     if "reaches_end" in detail:
         detail["reach_text"] = "to the leg's end" if detail["reaches_end"] else "short of the leg's end"
+    if "changes" in detail:
+        detail["n_changes"] = len(detail["changes"])
     detail["pass_text"] = f" (pass {detail['correct_pass']})" if "correct_pass" in detail else ""
     if "tried" in detail:
         detail["tried_text"] = ", ".join(f"{t['kind']} {t['p_window']:.3f}" + _nearer(t) for t in detail["tried"]) \

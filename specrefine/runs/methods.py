@@ -124,14 +124,12 @@ def ours_variant(**changes) -> Callable[[SearchJob], object]:
     from ..refine.search import check_changes
 
     check_changes(changes)
+    check_changes(changes.get("rescue") or {})
 
     def search(job: SearchJob):
         from ..refine import RefinementSearch, SearchConfig
 
-        c, variant = job.config, dict(changes)
-        for reach in ("shortcut_reach", "correct_reach"):
-            if variant.get(reach) == "policy":  # as far as the policy was trained to reach a goal
-                variant[reach] = get_agent(c.agent).reach_task.goal_max
+        c, variant = job.config, _policy_reach(changes, get_agent(job.config.agent).reach_task.goal_max)
         cfg = SearchConfig.from_run(c, **variant)
         images = getattr(job.proposer, "sees_images", True)  # offline proposers: no picture is drawn (seconds per run)
         query_for = edge_query_builder(job.maze, c.agent, job.evaluator.facts(), images=images)
@@ -139,6 +137,15 @@ def ours_variant(**changes) -> Callable[[SearchJob], object]:
                                 query_for=query_for, picture=candidate_picture(job.maze) if images else None).run()
 
     return search
+
+
+def _policy_reach(changes: dict, reach: float) -> dict:
+    """``changes`` with each reach given as "policy" (here and in a rescue's changes) set to ``reach``: as far as
+    the policy was trained to reach a goal."""
+    out = {k: reach if k in ("shortcut_reach", "correct_reach") and v == "policy" else v for k, v in changes.items()}
+    if out.get("rescue"):
+        out["rescue"] = _policy_reach(out["rescue"], reach)
+    return out
 
 
 def vlm_oneshot(job: SearchJob, budget: tuple[int, int] | None = None):
@@ -389,8 +396,9 @@ register_method("ours-corrector-span",
                 colour="#283593")
 #: ours-corrector-span-bridge: span, whose weak leg is also offered the roadmap's chain from the leg before it, as
 #: bridge's is (docs/corrector.md, "Entered another way: span with the bridge")
+SPAN_BRIDGE = MENDED | BACKTRACK | FINE | SPAN | BRIDGE  # the point mass's default (core/agents.py)
 register_method("ours-corrector-span-bridge",
-                ours_variant(**MENDED | BACKTRACK | FINE | SPAN | BRIDGE),
+                ours_variant(**SPAN_BRIDGE),
                 "beyond the paper: ours-corrector-span whose weak leg is also offered, after its own chain, the "
                 "roadmap's chain from the start of the leg before it to its end, on legs as sound, replacing the "
                 "waypoint between them: a waypoint whose arrivals every next leg loses (one a deaf proposer put "
@@ -423,6 +431,14 @@ register_method("ours-corrector-redraw", ours_variant(**REDRAW),
                 "it left on a fresh draw of its own (new first states, a budget of one proposer split per leg), so "
                 "that a leg chosen on one draw's rollouts is judged again on rollouts that did not choose it",
                 colour="#3e2723")
+#: ours-corrector-redraw-rescue: redraw, whose path, where its correction leaves a dead leg, is corrected once more as
+#: span-bridge corrects (docs/corrector.md, "A rescue for the Ant's default")
+register_method("ours-corrector-redraw-rescue", ours_variant(**REDRAW | dict(rescue=SPAN_BRIDGE)),
+                "beyond the paper: ours-corrector-redraw whose path, where its correction leaves a leg that never "
+                "succeeded on its last fresh check, is corrected once more as ours-corrector-span-bridge corrects "
+                "(the replies pooled with its own probes into a roadmap; up to 90 proposer splits in all): a proposer "
+                "that gives nothing valid, or never uses its feedback, leaves redraw at 0; a path redraw leaves "
+                "alive is never touched", colour="#d84315")
 #: ours-corrector-sparing: redraw, whose two passes ask the proposer only about a leg with at least 3 fresh failures
 #: (docs/corrector.md, "A gate for the Ant's corrector")
 SPARING = REDRAW | dict(correct_min_failures=3)
