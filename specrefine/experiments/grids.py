@@ -555,6 +555,12 @@ SPAN_BRIDGE_MAZES = ("random:13x10:24", "random:10x13:99", "random:14x14:2", "ra
 SPAN_BRIDGE_MIXES = ("imperfect:position_sigma=0.2,corner_pull=0.3,p_drop_turn=0.9,rho=0",
                      "imperfect:position_sigma=0.15,radius=0.25,p_drop_turn=0.6,bias=0.25,p_stale=0.3,rho=0")
 SPAN_BRIDGE_CODE = "77dafe1"  # the commit of ours-corrector-span-bridge (span's settings with roadmap_bridge)
+#: issue 39: the Ant's default with two deaf proposers no Ant run had used (docs/corrector.md, "A rescue for the Ant's
+#: default"): the error model's deaf extreme and the random proposer; U-chain 1-3 judged, the longer ones described
+RESCUE_CODE = "55dd142"  # the commit of ours-corrector-redraw-rescue (SearchConfig.rescue)
+RESCUE_MAZES = ("u_chain_1", "u_chain_2", "u_chain_3")
+RESCUE_LONG_MAZES = ("u_chain_2_subgoals", "u_chain_3_subgoals", "u_chain_4", "u_chain_4_subgoals", "u_chain_5",
+                     "u_chain_5_subgoals")
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
@@ -1049,6 +1055,15 @@ GRIDS = {g.name: g for g in (
                        "and 42; fixed 2026-12-05 06:48 UTC when ant-oracle-wide-scaling's rule 2 held, before its "
                        "first cell ran): ant-corrector-redraw's cells with lever 8's wide pass", "ant_wide",
                        code="adda718", method="ours-corrector-wide", split_pick="confirmed"),
+    ExperimentGrid(
+        "ant-corrector-rescue", "docs/corrector.md, 'A rescue for the Ant's default' (issue 39; fixed 2026-12-07 11:48 "
+        "UTC before its first cell ran; one pilot cell informed it): redraw and its rescue with two deaf proposers",
+        "ant", parts=(Part(("ours-corrector-redraw-rescue", "ours-corrector-redraw"), (DEAF, "random")),
+                      Part(("ours-corrector-redraw-rescue", "ours-corrector-redraw"), (DEAF, "random"),
+                           mazes=RESCUE_LONG_MAZES, table="data/results/corrector/ant_rescue_long.csv", out="long")),
+        seeds=(0,), mazes=RESCUE_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
+        goal_points="centre", split_pick="confirmed", workers=1, code=RESCUE_CODE,
+        table="data/results/corrector/ant_rescue.csv", out="runs/ant_corrector_rescue"),
     ant_corrector_grid("ant-corrector-span", "docs/corrector.md, 'The point mass's corrector on the Ant' (issue 39; "
                        "fixed 2026-12-06 01:53 UTC before its first cell ran; one pilot cell informed it): "
                        "ant-corrector-redraw's cells with the point mass's default corrector, ours-corrector-span",
