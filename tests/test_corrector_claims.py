@@ -8,6 +8,14 @@ from test_comparison import row, write_csv
 
 from specrefine.experiments import corrector_claims as cc
 from specrefine.experiments.corrector_claims.ant import ANT_ERRING
+from specrefine.experiments.corrector_claims.rescue import GRID as RESCUE_GRID
+from specrefine.experiments.corrector_claims.rescue import (
+    RESCUE,
+    rescue_markdown,
+    rescue_study,
+    rescue_text,
+    rescue_verdict,
+)
 from specrefine.experiments.grids import GRIDS, OTHER_POINT_MAZES, SCALING_MAZES
 
 LEVELS = ("imperfect:mild", "imperfect:moderate")
@@ -989,9 +997,11 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     lines = table.strip().splitlines()
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
-    # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its cost, its two candidates and each
-    # successor
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5 + len(cc.ANT_SUCCESSORS)
+    # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its cost, its two candidates, each
+    # successor and the rescue
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5 + len(cc.ANT_SUCCESSORS) + 1
+    assert rules[-1].startswith(f"Ant, deaf proposers: {RESCUE} in place of {cc.REDRAW}")
+    rules = rules[:-1]
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
     ant = rules[-5 - len(cc.ANT_SUCCESSORS):]
@@ -1003,6 +1013,26 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
                                                                                    cc.WIDE, cc.SPAN)]
     assert table.startswith("\n") and table.endswith("\n\n")  # the markers stay on lines of their own
     assert cc.rules_table(None, point, None) == "not run yet"
+
+
+def test_the_rescue_is_adopted_only_over_all_six_cells_above_redraw_and_none_below(tmp_path):
+    lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.95 if m == RESCUE else 0.0, drop=1)
+    partial = rescue_study(tmp_path)
+    assert partial["verdict"] == "undecided" and partial["pooled"]["cells"] == 5
+    assert rescue_verdict(partial)["verdict"] == "undecided (5 of 6 cells)"
+    lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.95 if m == RESCUE else 0.0)
+    lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.5, part=1)  # described: never read by the rule
+    d = rescue_study(tmp_path)
+    assert d["verdict"] == "adopted" and d["pooled"]["difference"] == pytest.approx(0.95)
+    assert [c["judged"] for c in d["cells"]] == [True] * 6 + [False] * 12
+    text = rescue_text(d)
+    assert text.startswith("6 of 6 cells of the rule: rescue 0.950-0.950 per cell, redraw 0.000-0.000")
+    assert "runs at 0: rescue 0, redraw 6" in text and "**adopted**" in text and "12 of 12 cells" in text
+    lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: (0.9 if maze == "u_chain_3" else 1.0) if m == RESCUE else
+             (1.0 if maze == "u_chain_3" else 0.0))
+    d = rescue_study(tmp_path)  # above redraw pooled, but below it on U-chain 3's two cells
+    assert d["pooled"]["ci"][0] > 0 and d["below"] == 2 and d["verdict"] == "not adopted"
+    assert "| u_chain_3 | deaf | 0 | yes | 0.900" in "\n".join(rescue_markdown(d))
 
 
 def test_corrector_claims_refuses_a_file_to_fill_that_is_missing_or_a_link_before_any_work(tmp_path, capsys):
