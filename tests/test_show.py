@@ -106,6 +106,25 @@ def test_show_gives_what_the_run_asked_and_where_the_correction_spent_it(runs, t
     assert searched + corrected == data["evaluations"] == steps[-1]["evaluations_so_far"]
 
 
+def test_show_splits_a_rescued_runs_correction_from_its_rescue(tmp_path, capsys):
+    run = tmp_path / "rescue"
+    assert main(["refine", "u_chain_1", "--method", "ours-corrector-redraw-rescue", "--proposer",
+                 "imperfect:p_drop_turn=1,rho=0", "--seed", "0", "--out", str(run), *TINY]) == 0
+    data = json.loads((run / "result.json").read_text())
+    steps = [json.loads(line) for line in (run / "steps.jsonl").read_text().splitlines()]
+    begun, rescue = (next(s for s in steps if s["event"] == event) for event in ("correct-begin", "rescue"))
+    capsys.readouterr()
+    assert main(["show", str(run)]) == 0
+    out = capsys.readouterr().out
+    calls = (begun["proposer_calls"], rescue["proposer_calls"] - begun["proposer_calls"],
+             data["proposer_calls"] - rescue["proposer_calls"])
+    assert "(proposer calls: {} in the search, {} in the correction, {} in its rescue)".format(*calls) in out
+    spent = re.search(r"spent: search ([\d,]+) evaluations \(.*\), correction ([\d,]+) evaluations \(.*\), "
+                      r"rescue ([\d,]+) evaluations", out)
+    assert sum(int(n.replace(",", "")) for n in spent.groups()) == data["evaluations"]
+    assert int(spent.group(3).replace(",", "")) > 0
+
+
 def unfinished(runs, tmp_path, pid: int, half_line: bool = True):
     """The 'ours' run as a killed or running one would leave it: no result.json, its step log under the temporary
     name the run writes it to (the last line half-written)."""

@@ -109,7 +109,11 @@ def cost_text(run_dir: Path, data: dict) -> str:
     text = f"cost: {calls} proposer calls, {data.get('evaluations', '?')} evaluations"
     marks = phase_marks(run_dir / "steps.jsonl")
     before = marks.get("correction", {}).get("proposer_calls")
-    if isinstance(before, int):
+    rescued = marks.get("rescue", {}).get("proposer_calls")
+    if isinstance(before, int) and isinstance(rescued, int):
+        text += (f" (proposer calls: {before} in the search, {rescued - before} in the correction, {calls - rescued} "
+                 "in its rescue)")
+    elif isinstance(before, int):
         text += f" (proposer calls: {before} in the search, {calls - before} in the correction)"
     spend = spend_text(marks, data)
     return text + (f"\n{spend}" if spend else "")
@@ -117,24 +121,27 @@ def cost_text(run_dir: Path, data: dict) -> str:
 
 def phase_marks(path: Path) -> dict[str, dict]:
     """The steps that end a run's phases, from its step log: ``correction`` the 'correct-begin' step (logged as the
-    correction begins; in a log from before it, the first 'correct-check'), ``end`` the last step (the search's end);
-    {} for a file that is not a readable regular one."""
+    correction begins; in a log from before it, the first 'correct-check'), ``rescue`` the 'rescue' step (where the
+    correction left a dead leg and the method rescues it), ``end`` the last step (the search's end); {} for a file
+    that is not a readable regular one."""
     if not path.is_file() or path.is_symlink():
         return {}
     steps = _steps(path)
     marks = {"end": steps[-1]} if steps else {}
     begun = next((s for s in steps if s.get("event") in ("correct-begin", "correct-check")), None)
-    return marks | ({"correction": begun} if begun is not None else {})
+    rescue = next((s for s in steps if s.get("event") == "rescue"), None)
+    return marks | ({"correction": begun} if begun is not None else {}) | ({"rescue": rescue} if rescue else {})
 
 
 def spend_text(marks: dict[str, dict], data: dict) -> str:
     """Where the evaluations and simulator steps went: the search (up to the correction, where there is one), the
     correction, then the measurement and calibration (simulator steps only); "" where the log predates the counts."""
-    end, check = marks.get("end", {}), marks.get("correction")
-    ends = [step for step in (check, end) if step is not None]
+    end, check, rescue = marks.get("end", {}), marks.get("correction"), marks.get("rescue")
+    ends = [step for step in (check, rescue, end) if step is not None]
     if not ends or not all(isinstance(step.get(key), int) for step in ends for key in SO_FAR):
         return ""
-    labels = ["search", "correction"][:len(ends)]
+    labels = ["search", "correction", "rescue"][:len(ends)] if rescue is not None else \
+        ["search", "correction"][:len(ends)]
     before = dict.fromkeys(SO_FAR, 0)
     parts = []
     for label, step in zip(labels, ends):
