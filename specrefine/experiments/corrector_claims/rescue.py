@@ -30,7 +30,7 @@ def rescue_study(root: Path = ROOT) -> dict | None:
     if not rows:
         return None
     by = {(r["maze"], r["method"], r["proposer"], int(r["seed"])): r for r in rows}
-    judged = [(m, p, s) for m in g.mazes for p in g.parts[0].proposers for s in g.seeds]
+    judged = _judged()
     described = [(m, p, s) for m in g.parts[1].mazes for p in g.parts[1].proposers for s in g.seeds]
     cells = [_cell(by, key, key in judged) for key in judged + described]
     pooled = paired_rows(rows, RESCUE, REDRAW, judged)
@@ -39,6 +39,12 @@ def rescue_study(root: Path = ROOT) -> dict | None:
                "adopted" if pooled["ci"][0] > 0 and not below else "not adopted")
     return {"grid": GRID, "cells": cells, "pooled": pooled, "below": len(below), "verdict": verdict,
             "judged": len(judged), "described": len(described)}
+
+
+def _judged() -> list[tuple]:
+    """The rule's cells (maze, proposer, seed): the grid's first part."""
+    g = GRIDS[GRID]
+    return [(m, p, s) for m in g.mazes for p in g.parts[0].proposers for s in g.seeds]
 
 
 def _cell(by: dict, key: tuple, judged: bool) -> dict:
@@ -92,7 +98,7 @@ def rescue_verdict(d: dict | None) -> dict:
     value = "no cell in both yet" if d is None else _ant_paired_text(d["pooled"]) + (
         f"; {d['below']} cell(s) wholly below 0" if d["below"] else "; no cell wholly below 0")
     done = 0 if d is None else d["pooled"]["cells"]
-    verdict = "undecided (0 of 6 cells)" if d is None else d["verdict"] + (
+    verdict = f"undecided (0 of {len(_judged())} cells)" if d is None else d["verdict"] + (
         f" ({done} of {d['judged']} cells)" if d["verdict"] == "undecided" else "")
     return {"rule": f"Ant, deaf proposers: {RESCUE} in place of {REDRAW}: rescue - redraw above 0 (pooled, Newcombe "
                     "95 %) and no cell below (U-chain 1-3, seed 0)", "value": value, "verdict": verdict}
@@ -122,4 +128,3 @@ def _rate(side: dict | None) -> str:
 
 def _spent(side: dict | None) -> str:
     return "—" if side is None else f"{side['proposer_calls']}, {side['evaluations']}"
-
