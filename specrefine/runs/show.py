@@ -140,8 +140,7 @@ def spend_text(marks: dict[str, dict], data: dict) -> str:
     ends = [step for step in (check, rescue, end) if step is not None]
     if not ends or not all(isinstance(step.get(key), int) for step in ends for key in SO_FAR):
         return ""
-    labels = ["search", "correction", "rescue"][:len(ends)] if rescue is not None else \
-        ["search", "correction"][:len(ends)]
+    labels = ["search", "correction", "rescue"][:len(ends)]  # a rescue follows a correction
     before = dict.fromkeys(SO_FAR, 0)
     parts = []
     for label, step in zip(labels, ends):

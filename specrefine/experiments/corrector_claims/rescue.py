@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...core.results import newcombe_ci, wilson_ci
+from ...core.results import newcombe_ci, rate_text
 from .. import comparison as cmp
 from ..grids import DEAF, GRIDS, ROOT
 from .ant import ANT_FLOOR, REDRAW
@@ -120,10 +120,7 @@ def rescue_markdown(d: dict) -> list[str]:
 
 
 def _rate(side: dict | None) -> str:
-    if side is None:
-        return "—"
-    lo, hi = wilson_ci(side["successes"], side["episodes"])
-    return f"{side['success']:.3f} [{lo:.3f}, {hi:.3f}]"
+    return "—" if side is None else rate_text(side["successes"], side["episodes"])
 
 
 def _spent(side: dict | None) -> str:
