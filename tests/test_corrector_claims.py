@@ -1327,8 +1327,9 @@ def test_a_statement_needs_every_maze_and_proposer_near_the_oracle_none_at_0_and
         statement_text,
     )
 
-    misread, gr = STATEMENTS
-    assert statement_studies(tmp_path) == {"misread": None, "span-gr": None} and statement_text(None) == "not run yet"
+    misread, gr, misread_bridge, _ = STATEMENTS
+    assert statement_studies(tmp_path) == dict.fromkeys(("misread", "span-gr", "misread-bridge", "span-gr-bridge"))
+    assert statement_text(None) == "not run yet"
     lay_all_parts(tmp_path, misread.grid,
                   lambda maze, m, p: 1.0 if p == "geometric" else {"ours": 0.5, cc.SPAN: 0.98}[m])
     d = statement_study(misread, tmp_path)
@@ -1348,6 +1349,16 @@ def test_a_statement_needs_every_maze_and_proposer_near_the_oracle_none_at_0_and
     d = statement_studies(tmp_path)["span-gr"]
     assert len(d["per_maze"]) == 18 and d["runs"] == 72 and d["zero"] == 4 and d["verdict"] == "does not hold"
     assert d["misses"] == d["below"] == [("severe", "gr:LARGE_MAZE")]
+    # span-bridge's statement: its own grid's rows, ours's and the oracle's from span's grid (never span's rows)
+    assert statement_study(misread_bridge, tmp_path) is None  # span's rows alone are not span-bridge's
+    lay_all_parts(tmp_path, misread_bridge.grid, lambda maze, m, p: 0.5 if maze == "u_chain_5" else 1.0)
+    d = statement_study(misread_bridge, tmp_path)
+    assert d["runs"] == 24 and d["verdict"] == "does not hold" and statement_text(d).startswith("span-bridge within")
+    assert d["misses"] == [("AY", "u_chain_5"), ("AZ", "u_chain_5")]  # against span's oracle rows (1.0)
+    assert {e["reference_success"] for e in d["per_maze"]} == {1.0}  # ours from span's table (set to 1.0 above)
+    md = statement_markdown(d)
+    assert md[1].startswith("The statements again, with the default: misreadings (grid corrector-span-bridge-misread")
+    assert cc.SPAN_BRIDGE in md[3]
 
 
 def test_the_reported_methods_severe_line_reads_its_cells_runs_at_0_and_cost():

@@ -558,6 +558,9 @@ SPAN_BRIDGE_CODE = "77dafe1"  # the commit of ours-corrector-span-bridge (span's
 #: issue 39: the Ant's default with two deaf proposers no Ant run had used (docs/corrector.md, "A rescue for the Ant's
 #: default"): the error model's deaf extreme and the random proposer; U-chain 1-3 judged, the longer ones described
 RESCUE_CODE = "55dd142"  # the commit of ours-corrector-redraw-rescue (SearchConfig.rescue)
+#: the code of the point mass's default run again on span's statement grids (docs/corrector.md, "The statements again,
+#: with the default"): main after the rescue (55dd142), which left span-bridge's runs as they were
+BRIDGE_AGAIN_CODE = "aa6b52b"
 RESCUE_MAZES = ("u_chain_1", "u_chain_2", "u_chain_3")
 RESCUE_LONG_MAZES = ("u_chain_2_subgoals", "u_chain_3_subgoals", "u_chain_4", "u_chain_4_subgoals", "u_chain_5",
                      "u_chain_5_subgoals")
@@ -1136,6 +1139,19 @@ GRIDS = {g.name: g for g in (
                                out="oracle")),
                    seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1, code=MISREAD_CODE,
                    table="data/results/corrector/span_gr.csv", out="runs/corrector_span_gr"),
+    # docs/corrector.md, "The statements again, with the default" (fixed 2026-12-07 14:50 UTC, before they ran): the
+    # point mass's default on the cells of span's two statements; ours and the oracle are read from span's tables
+    ExperimentGrid("corrector-span-bridge-misread", "docs/corrector.md, 'The statements again, with the default' "
+                   "(issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on corrector-span-misread's "
+                   "cells", "point", parts=(Part(("ours-corrector-span-bridge",), MISREAD_MIXES, split="proposers"),),
+                   seeds=(0, 1), mazes=MISREAD_MAZES, goal_points="centre", workers=1, code=BRIDGE_AGAIN_CODE,
+                   table="data/results/corrector/span_bridge_misread.csv", out="runs/corrector_span_bridge_misread"),
+    ExperimentGrid("corrector-span-bridge-gr", "docs/corrector.md, 'The statements again, with the default' "
+                   "(issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on corrector-span-gr's "
+                   "cells", "point",
+                   parts=(Part(("ours-corrector-span-bridge",), GR_MIXES + MISREAD_MIXES, split="proposers"),),
+                   seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1, code=BRIDGE_AGAIN_CODE,
+                   table="data/results/corrector/span_bridge_gr.csv", out="runs/corrector_span_bridge_gr"),
     # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:08 UTC in 74d153d, before it ran)
     new_layouts_grid("corrector-span-misread", "docs/corrector.md, 'Misreadings no lever had met' (issue 39; fixed "
                      "2026-12-07 before it ran)", ("ours-corrector-span", "ours"), MISREAD_MAZES, MISREAD_MIXES,

@@ -1,9 +1,11 @@
 """The point mass's default against the oracle and ``ours`` where a statement was fixed before its grid ran
 (docs/corrector.md): "Misreadings no lever had met" (grid corrector-span-misread: the error model's five misreadings,
 added after every lever had been designed, on four new layouts and U-chain 5 with and without subgoals) and "The
-point mass's default on D4RL's maps, misreadings included" (grid corrector-span-gr). Each statement holds only if,
-per maze and proposer pooled over the seeds, ``ours-corrector-span`` is within 0.05 of the oracle on every one, no
-run of it ends at 0, and it is below ``ours`` on none (the Newcombe 95 % interval of the difference wholly below 0)."""
+point mass's default on D4RL's maps, misreadings included" (grid corrector-span-gr); and both again with the default
+since, ``ours-corrector-span-bridge`` ("The statements again, with the default": grids corrector-span-bridge-misread
+and -gr, whose ``ours`` and oracle rows are span's grids'). Each statement holds only if, per maze and proposer pooled
+over the seeds, its method is within 0.05 of the oracle on every one, no run of it ends at 0, and it is below ``ours``
+on none (the Newcombe 95 % interval of the difference wholly below 0)."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..grids import GR_MAZES, GR_MIXES, GRIDS, MISREAD_MAZES, MISREAD_MIXES, ROOT
-from .common import ORACLE, SPAN, TOLERANCE, costs, episodes_of, load, per_maze, table_name, zero_runs
+from .common import ORACLE, SPAN, SPAN_BRIDGE, TOLERANCE, costs, episodes_of, load, per_maze, table_name, zero_runs
 from .formats import _cost_table, _diff, _num
 
 
@@ -23,29 +25,40 @@ class Statement:
     title: str  # its docs/corrector.md section
     mazes: tuple
     names: dict  # proposer -> its short name in the tables
+    method: str = SPAN
+    label: str = "span"  # the method's name in README's sentence
+    reference_grid: str | None = None  # the grid whose tables hold ours's and the oracle's rows (None: ``grid``)
 
 
 MISREAD_NAMES = dict(zip(MISREAD_MIXES, ("AY", "AZ")))
+GR_NAMES = dict(zip(GR_MIXES, ("moderate", "severe", "AJ", "AK"))) | MISREAD_NAMES
+AGAIN = "The statements again, with the default"
 STATEMENTS = (Statement("misread", "corrector-span-misread", "Misreadings no lever had met", MISREAD_MAZES,
                         MISREAD_NAMES),
               Statement("span-gr", "corrector-span-gr", "The point mass's default on D4RL's maps, misreadings "
-                        "included", GR_MAZES, dict(zip(GR_MIXES, ("moderate", "severe", "AJ", "AK"))) | MISREAD_NAMES))
+                        "included", GR_MAZES, GR_NAMES),
+              Statement("misread-bridge", "corrector-span-bridge-misread", f"{AGAIN}: misreadings", MISREAD_MAZES,
+                        MISREAD_NAMES, SPAN_BRIDGE, "span-bridge", "corrector-span-misread"),
+              Statement("span-gr-bridge", "corrector-span-bridge-gr", f"{AGAIN}: D4RL's maps", GR_MAZES, GR_NAMES,
+                        SPAN_BRIDGE, "span-bridge", "corrector-span-gr"))
 
 
 def statement_study(st: Statement, root: Path = ROOT) -> dict | None:
-    """Per maze and proposer: span's and ours's pooled success, their Newcombe difference, the oracle's, runs at 0;
-    span's cost over ours's per proposer; the statement's verdict. None before the grid's first row of span."""
-    g = GRIDS[st.grid]
+    """Per maze and proposer: the method's and ours's pooled success, their Newcombe difference, the oracle's, runs at
+    0; its cost over ours's per proposer; the statement's verdict. None before the grid's first row of the method."""
+    g, method = GRIDS[st.grid], st.method
     rows = load(g.tables, root)
-    if not any(r["method"] == SPAN for r in rows):
+    if not any(r["method"] == method for r in rows):
         return None
+    if st.reference_grid:
+        rows += [r for r in load(GRIDS[st.reference_grid].tables, root) if r["method"] != method]
     mazes, seeds = tuple(table_name(m) for m in st.mazes), g.seeds
     entries = []
     for proposer, name in st.names.items():
-        for e in per_maze(rows, proposer, mazes, seeds, reference=("ours", "*"), method=SPAN):
+        for e in per_maze(rows, proposer, mazes, seeds, reference=("ours", "*"), method=method):
             k, n, oracle_runs = episodes_of(rows, e["maze"], *ORACLE, seeds)
             entries.append(e | {"mix": name, "oracle": k / n if n else math.nan, "oracle_runs": oracle_runs,
-                                "zero": zero_runs(rows, SPAN, proposer, (e["maze"],))[0],
+                                "zero": zero_runs(rows, method, proposer, (e["maze"],))[0],
                                 "ours_zero": zero_runs(rows, "ours", proposer, (e["maze"],))[0]})
     done = [e for e in entries if e["runs"]]
     misses = [e for e in done if not e["success"] >= e["oracle"] - TOLERANCE]  # no oracle yet: a miss, not a pass
@@ -53,11 +66,12 @@ def statement_study(st: Statement, root: Path = ROOT) -> dict | None:
     complete = all(e["runs"] == e["reference_runs"] == e["oracle_runs"] == len(seeds) for e in entries)
     zero = sum(e["zero"] for e in done)
     verdict = "does not hold" if zero or complete and (misses or below) else "holds" if complete else "undecided"
-    return {"grid": st.grid, "title": st.title, "per_maze": entries, "runs": sum(e["runs"] for e in done),
+    return {"grid": st.grid, "title": st.title, "method": method, "label": st.label, "per_maze": entries,
+            "runs": sum(e["runs"] for e in done),
             "zero": zero, "ours_zero": sum(e["ours_zero"] for e in done),
             "misses": [(e["mix"], e["maze"]) for e in misses], "below": [(e["mix"], e["maze"]) for e in below],
             "verdict": verdict,
-            "cost": {name: costs(rows, proposer, mazes, seeds, first=SPAN) for proposer, name in st.names.items()}}
+            "cost": {name: costs(rows, proposer, mazes, seeds, first=method) for proposer, name in st.names.items()}}
 
 
 def statement_studies(root: Path = ROOT) -> dict[str, dict | None]:
@@ -77,19 +91,21 @@ def statement_text(d: dict | None) -> str:
                      f"{_num(c['evaluations_ratio'], '{:.2f}x')} the evaluations over {c['pairs']} pairs"
                      for name, c in d["cost"].items() if c["pairs"])
     ours = [e["reference_success"] for e in done if not math.isnan(e["reference_success"])]
-    return (f"span within {TOLERANCE} of the oracle on {len(done) - len(d['misses'])} of {len(done)} mazes and "
+    label = d["label"]
+    return (f"{label} within {TOLERANCE} of the oracle on {len(done) - len(d['misses'])} of {len(done)} mazes and "
             f"proposers run ({len(d['per_maze'])} in the grid)" + (f", not on {missed}" if missed else "")
             + f"; below ours on {len(d['below'])}" + (f" ({below})" if below else "")
-            + f"; runs at 0: span {d['zero']} of {d['runs']}, ours {d['ours_zero']}"
+            + f"; runs at 0: {label} {d['zero']} of {d['runs']}, ours {d['ours_zero']}"
             + (f"; ours {min(ours):.3f}-{max(ours):.3f} per maze and proposer" if ours else "")
-            + (f"; span's cost over ours's: {cost}" if cost else "") + f": the statement {d['verdict']}")
+            + (f"; {label}'s cost over ours's: {cost}" if cost else "") + f": the statement {d['verdict']}")
 
 
 def statement_markdown(d: dict) -> list[str]:
-    lines = ["", f"{d['title']} (grid {d['grid']}; docs/corrector.md): {SPAN} and ours, pooled over seeds, the oracle "
-             f"beside; {SPAN} - ours (Newcombe 95 %). Within {TOLERANCE} of the oracle everywhere, no run at 0 and "
-             f"below ours nowhere: {d['verdict']}.", "",
-             f"| proposer | maze | runs | {SPAN} | ours | difference | oracle | runs at 0 ({SPAN} / ours) |",
+    method = d["method"]
+    lines = ["", f"{d['title']} (grid {d['grid']}; docs/corrector.md): {method} and ours, pooled over seeds, the "
+             f"oracle beside; {method} - ours (Newcombe 95 %). Within {TOLERANCE} of the oracle everywhere, no run at "
+             f"0 and below ours nowhere: {d['verdict']}.", "",
+             f"| proposer | maze | runs | {method} | ours | difference | oracle | runs at 0 ({method} / ours) |",
              "|---|---|---|---|---|---|---|---|"]
     lines += [f"| {e['mix']} | {e['maze']} | {e['runs']} | {_num(e['success'])} | {_num(e['reference_success'])} | "
               f"{_diff(e)} | {_num(e['oracle'])} | {e['zero']} / {e['ours_zero']} |" for e in d["per_maze"]]
