@@ -1139,8 +1139,8 @@ GRIDS = {g.name: g for g in (
                                out="oracle")),
                    seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1, code=MISREAD_CODE,
                    table="data/results/corrector/span_gr.csv", out="runs/corrector_span_gr"),
-    # docs/corrector.md, "The statements again, with the default" (fixed 2026-12-07 14:46 UTC in 07c7b98, before they ran): the
-    # point mass's default on the cells of span's two statements; ours and the oracle are read from span's tables
+    # docs/corrector.md, "The statements again, with the default" (fixed 2026-12-07 14:46 UTC in 07c7b98, before they
+    # ran): the point mass's default on the cells of span's two statements; ours and the oracle read from span's tables
     ExperimentGrid("corrector-span-bridge-misread", "docs/corrector.md, 'The statements again, with the default' "
                    "(issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on corrector-span-misread's "
                    "cells", "point", parts=(Part(("ours-corrector-span-bridge",), MISREAD_MIXES, split="proposers"),),

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from .. import comparison as cmp
 from ..grids import GR_MAZES, GR_MIXES, GRIDS, MISREAD_MAZES, MISREAD_MIXES, ROOT
 from .common import ORACLE, SPAN, SPAN_BRIDGE, TOLERANCE, costs, episodes_of, load, per_maze, table_name, zero_runs
 from .formats import _cost_table, _diff, _num
@@ -50,8 +51,11 @@ def statement_study(st: Statement, root: Path = ROOT) -> dict | None:
     rows = load(g.tables, root)
     if not any(r["method"] == method for r in rows):
         return None
+    same = None
     if st.reference_grid:
-        rows += [r for r in load(GRIDS[st.reference_grid].tables, root) if r["method"] != method]
+        reference = [r for r in load(GRIDS[st.reference_grid].tables, root) if r["method"] != method]
+        same = same_runs(rows, reference)
+        rows += reference
     mazes, seeds = tuple(table_name(m) for m in st.mazes), g.seeds
     entries = []
     for proposer, name in st.names.items():
@@ -70,13 +74,24 @@ def statement_study(st: Statement, root: Path = ROOT) -> dict | None:
             "runs": sum(e["runs"] for e in done),
             "zero": zero, "ours_zero": sum(e["ours_zero"] for e in done),
             "misses": [(e["mix"], e["maze"]) for e in misses], "below": [(e["mix"], e["maze"]) for e in below],
-            "verdict": verdict,
+            "verdict": verdict, "same_as_span": same,
             "cost": {name: costs(rows, proposer, mazes, seeds, first=method) for proposer, name in st.names.items()}}
 
 
 def statement_studies(root: Path = ROOT) -> dict[str, dict | None]:
     """Every statement's study, by its marker."""
     return {st.marker: statement_study(st, root) for st in STATEMENTS}
+
+
+RUN_COLUMNS = ("success_rate", "evaluations", "proposer_calls", "sim_steps")
+
+
+def same_runs(rows, reference) -> tuple[int, int]:
+    """(cells whose run equals span's in the reference rows, column for column in RUN_COLUMNS; cells run)."""
+    span = {(r["maze"], r["proposer"], r["seed"]): r for r in reference if r["method"] == SPAN and cmp.is_done(r)}
+    done = [r for r in rows if cmp.is_done(r)]
+    return sum(all(r[c] == span[key][c] for c in RUN_COLUMNS) for r in done
+               if (key := (r["maze"], r["proposer"], r["seed"])) in span), len(done)
 
 
 def statement_text(d: dict | None) -> str:
@@ -97,7 +112,10 @@ def statement_text(d: dict | None) -> str:
             + f"; below ours on {len(d['below'])}" + (f" ({below})" if below else "")
             + f"; runs at 0: {label} {d['zero']} of {d['runs']}, ours {d['ours_zero']}"
             + (f"; ours {min(ours):.3f}-{max(ours):.3f} per maze and proposer" if ours else "")
-            + (f"; {label}'s cost over ours's: {cost}" if cost else "") + f": the statement {d['verdict']}")
+            + (f"; {label}'s cost over ours's: {cost}" if cost else "")
+            + (f"; the same runs as span's (success, evaluations, proposer calls, simulator steps) on "
+               f"{d['same_as_span'][0]} of {d['same_as_span'][1]} cells" if d.get("same_as_span") else "")
+            + f": the statement {d['verdict']}")
 
 
 def statement_markdown(d: dict) -> list[str]:
