@@ -674,6 +674,19 @@ def default_oracle_grid(name: str, section: str, method: str, stem: str, code: s
                           out=f"runs/{name.replace('-', '_')}")
 
 
+def bridge_again_grid(statement: str, mazes: tuple, mixes: tuple, seeds: tuple) -> ExperimentGrid:
+    """The point mass's default, span-bridge, alone on the cells of span's statement grid corrector-span-STATEMENT
+    (docs/corrector.md, "The statements again, with the default"), into data/results/corrector/
+    span_bridge_STATEMENT.csv; ``ours`` and the oracle stay span's grid's."""
+    return ExperimentGrid(f"corrector-span-bridge-{statement}", "docs/corrector.md, 'The statements again, with the "
+                          "default' (issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on "
+                          f"corrector-span-{statement}'s cells", "point",
+                          parts=(Part(("ours-corrector-span-bridge",), mixes, split="proposers"),), seeds=seeds,
+                          mazes=mazes, goal_points="centre", workers=1, code=BRIDGE_AGAIN_CODE,
+                          table=f"data/results/corrector/span_bridge_{statement}.csv",
+                          out=f"runs/corrector_span_bridge_{statement}")
+
+
 def ant_corrector_grid(name: str, source: str, stem: str, code: str, method: str = "ours-corrector",
                        split_pick: str | None = None) -> ExperimentGrid:
     """``method`` on the Ant (issue 39): the U-chains at imperfect:moderate, seeds 0-2 seed by seed, stage 5,
@@ -1141,17 +1154,8 @@ GRIDS = {g.name: g for g in (
                    table="data/results/corrector/span_gr.csv", out="runs/corrector_span_gr"),
     # docs/corrector.md, "The statements again, with the default" (fixed 2026-12-07 14:46 UTC in 07c7b98, before they
     # ran): the point mass's default on the cells of span's two statements; ours and the oracle read from span's tables
-    ExperimentGrid("corrector-span-bridge-misread", "docs/corrector.md, 'The statements again, with the default' "
-                   "(issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on corrector-span-misread's "
-                   "cells", "point", parts=(Part(("ours-corrector-span-bridge",), MISREAD_MIXES, split="proposers"),),
-                   seeds=(0, 1), mazes=MISREAD_MAZES, goal_points="centre", workers=1, code=BRIDGE_AGAIN_CODE,
-                   table="data/results/corrector/span_bridge_misread.csv", out="runs/corrector_span_bridge_misread"),
-    ExperimentGrid("corrector-span-bridge-gr", "docs/corrector.md, 'The statements again, with the default' "
-                   "(issue 39; fixed 2026-12-07 before it ran): ours-corrector-span-bridge on corrector-span-gr's "
-                   "cells", "point",
-                   parts=(Part(("ours-corrector-span-bridge",), GR_MIXES + MISREAD_MIXES, split="proposers"),),
-                   seeds=(0, 1, 2, 3), mazes=GR_MAZES, goal_points="centre", workers=1, code=BRIDGE_AGAIN_CODE,
-                   table="data/results/corrector/span_bridge_gr.csv", out="runs/corrector_span_bridge_gr"),
+    bridge_again_grid("misread", MISREAD_MAZES, MISREAD_MIXES, (0, 1)),
+    bridge_again_grid("gr", GR_MAZES, GR_MIXES + MISREAD_MIXES, (0, 1, 2, 3)),
     # docs/corrector.md, "Misreadings no lever had met" (fixed 2026-12-07 09:08 UTC in 74d153d, before it ran)
     new_layouts_grid("corrector-span-misread", "docs/corrector.md, 'Misreadings no lever had met' (issue 39; fixed "
                      "2026-12-07 before it ran)", ("ours-corrector-span", "ours"), MISREAD_MAZES, MISREAD_MIXES,
