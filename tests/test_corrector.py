@@ -23,12 +23,13 @@ from specrefine.refine.correct import (
     Check,
     _span_ahead,
     split_start,
+    weak_below,
     weakest_untried,
 )
 from specrefine.refine.roadmap import Roadmap
 from specrefine.refine.search import live_start
 from specrefine.runs.explore import describe
-from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, FINE, GUARD, MEND, SPAN, get_method
+from specrefine.runs.methods import BACKTRACK, BRIDGE, DEEP, FINE, FLOOR, GUARD, MEND, SPAN, get_method
 
 
 class LegTable:
@@ -924,6 +925,40 @@ def test_mending_needs_the_roadmap_and_a_level_in_0_1():
     with pytest.raises(ValueError, match="roadmap_weak must lie in"):
         SearchConfig(roadmap_weak=1.5, correct_roadmap=True, correct_reach=3.0)
     assert MEND == {"roadmap_weak": 0.9} and get_method("ours-corrector-mend").name == "ours-corrector-mend"
+
+
+# --- weak legs judged by the path (SearchConfig.roadmap_floor): the rescue of ours-corrector-redraw-rescue-floor -----
+#: WEAK_LEG with all three legs live above mend's 0.9: 0.95 x 0.92 x 0.95 = 0.83 on the path, below a floor of 0.85,
+#: whose share per leg is 0.85 ** (1 / 3) = 0.947: the leg at 0.92 is weak by the path's measure, not by mend's
+ABOVE_MEND = WEAK_LEG | {(0.0, 3.0): 0.95, (3.0, 6.0): 0.92, (6.0, 10.0): 0.95}
+
+
+@pytest.mark.parametrize("floor", [0.0, 0.85])
+def test_a_leg_above_mends_level_is_mended_where_the_path_is_below_the_floor(floor):
+    book, g, result, kinds, leg = weak_leg_run(ABOVE_MEND, WEAK_REPLIES, roadmap_weak=0.9, roadmap_floor=floor)
+    assert leg["p_leg"] == pytest.approx(0.92, abs=0.01)
+    if floor:  # the pooled 5 mends it, as mend would below 0.9; the legs at 0.95 lie above the share and are left
+        assert kinds[-1] == "roadmap" and leg["accepted"] == "roadmap"
+        assert xs(result) == [0.0, 3.0, 5.0, 6.0, 10.0] and check_refines(result.graph, g) == []
+        others = [s for s in result.steps if s["event"] == "roadmap" and s["edge"] != ["x0", "x1"]]
+        assert others == []
+    else:
+        assert "roadmap" not in kinds and leg["accepted"] is None and xs(result) == [0.0, 3.0, 6.0, 10.0]
+
+
+def test_the_floors_share_is_the_weak_level_only_while_the_path_is_below_it():
+    legs = lambda *ps: Check(results=[_Arrive(p, n=128) for p in ps], path=[f"x{i}" for i in range(len(ps) + 1)])
+    assert weak_below(legs(0.95, 0.92, 0.95), 0.9, 0.85) == pytest.approx(0.85 ** (1 / 3))
+    assert weak_below(legs(0.95, 0.92, 0.95), 0.9) == 0.9  # no floor: mend's level
+    assert weak_below(legs(0.99, 0.92, 0.99), 0.9, 0.85) == 0.9  # the path (0.90) is above the floor
+    assert weak_below(legs(0.95, 0.0, 0.95), 0.9, 0.85) == 0.9  # a dead path: the dead legs' own rules
+    assert weak_below(legs(0.8, 0.8, 0.8, 0.8), 0.9, 0.5) == 0.9  # the share (0.841) is below mend's level
+    with pytest.raises(ValueError, match="roadmap_floor needs roadmap_weak"):
+        SearchConfig(roadmap_floor=0.85, correct_roadmap=True, correct_reach=3.0)
+    with pytest.raises(ValueError, match="roadmap_floor must lie in"):
+        SearchConfig(roadmap_floor=1.5, roadmap_weak=0.9, correct_roadmap=True, correct_reach=3.0)
+    method = get_method("ours-corrector-redraw-rescue-floor")
+    assert FLOOR == {"roadmap_floor": 0.85} and method.name == "ours-corrector-redraw-rescue-floor"
 
 
 # --- a weak leg bridged from the leg before (SearchConfig.roadmap_bridge): method ours-corrector-bridge ------------

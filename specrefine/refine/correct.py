@@ -63,6 +63,12 @@ least that sound, so that the weak leg itself does not count as reaching its end
 a dead leg of a dead path, and a live leg the proposer cannot mend stays as it is (docs/corrector.md, "Weak legs
 mended on the roadmap").
 
+``floor`` (``SearchConfig.roadmap_floor``; the rescue's changes of method ``ours-corrector-redraw-rescue-floor``): while
+the path's fresh check is below ``floor``, a live leg is weak below ``floor ** (1 / legs)`` too, where that is above
+``roadmap_weak``: on the Ant, thirteen legs at 0.92-0.98, each above mend's level, took a path to 0.75, and a deaf
+proposer's splits could not mend them (docs/corrector.md, "Weak legs judged by the path"). The chain's own legs are
+held to the same level (else the weak leg itself would count as reaching its end); it is judged as any alternative.
+
 ``roadmap_span`` (method ``ours-corrector-span``): such a weak leg is also offered, last, the roadmap's chain from its
 start to each of the next ``span`` vertices past its end that lie on its split, skipping the waypoints between, on
 legs as sound. A mend that enters the leg's end from another side changes where the next legs start, and a next leg
@@ -148,6 +154,14 @@ def weakest_untried(check: Check, tried: set, dead_only: bool = False) -> int | 
     return min(legs, key=lambda i: (check.probabilities[i], i)) if legs else None
 
 
+def weak_below(check: Check, weak: float, floor: float = 0.0) -> float:
+    """The fresh success below which a live leg of ``check``'s path is weak: ``weak``, or, while the path's check is
+    below ``floor``, ``floor ** (1 / legs)`` where that is higher (each leg's share of the floor)."""
+    if floor and weak and 0.0 < check.p < floor and check.results:
+        return max(weak, floor ** (1.0 / len(check.results)))
+    return weak
+
+
 def failures(result) -> int:
     """How many of a leg's rollouts failed."""
     return result.n - result.successes
@@ -216,7 +230,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             log: Callable[..., None], min_failures: int = 1, lean: bool = False,
             first_win: bool = False, advance: bool = False,
             roadmap: Callable | None = None, reaim: Callable | None = None,
-            crosscheck: bool = False, roadmap_weak: float = 0.0,
+            crosscheck: bool = False, roadmap_weak: float = 0.0, floor: float = 0.0,
             guard: bool = False, bridge: bool = False, backtrack: bool = False, span: int = 0
             ) -> tuple[TaskGraph, list[str], Check]:
     """The corrected (graph, path) and its fresh check. ``split_leg(graph, a, b, result, start)`` -> the best
@@ -232,10 +246,11 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     offered first for a dead leg of a dead path (its live part as ``advance`` offers a reply's); ``reaim(region)`` ->
     the point a re-aimed waypoint of that region aims at; ``crosscheck``: a win is taken only if it also wins on a
     second draw (module doc); ``roadmap_weak``: a live leg whose fresh success is below it is offered the roadmap's
-    chain to its end last, after the proposer's splits and whatever their budget left; ``guard``: a window's win is
-    kept only if the path checked again from the window on scores no lower than before (module doc); ``bridge``: such a
-    leg is also offered the chain from the leg before it; ``backtrack``: a dead leg of a dead path, the chain from the
-    start of its split; ``span``: such a weak leg, the chains past its end (module doc). No chain skips a subgoal."""
+    chain to its end last, after the proposer's splits and whatever their budget left (``floor``: that level scaled
+    to the path while its check is below ``floor``, ``weak_below``); ``guard``: a window's win is kept only if the
+    path checked again from the window on scores no lower than before (module doc); ``bridge``: such a leg is also
+    offered the chain from the leg before it; ``backtrack``: a dead leg of a dead path, the chain from the start of
+    its split; ``span``: such a weak leg, the chains past its end (module doc). No chain skips a subgoal."""
     state = _State(graph, path, check_path(graph, path, evaluator, rollouts=rollouts, seed=seed,
                                            start=graph.region(path[0])), evaluator, rollouts, seed, lean, advance,
                    guard=guard)
@@ -248,7 +263,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim, roadmap_weak, bridge, backtrack, span)
+                               reaim, weak_below(state.check, roadmap_weak, floor), bridge, backtrack, span)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None

@@ -127,6 +127,10 @@ class SearchConfig:
     #                                  offered the chain from the path's start (correct.py; ours-corrector-backtrack)
     roadmap_span: int = 0  # beyond the paper: such a weak leg is also offered the chains from its start to each of
     #                        this many vertices of its split past its end (correct.py; 2: method ours-corrector-span)
+    roadmap_floor: float = 0.0  # beyond the paper: while the path's fresh check is below this, a live leg is also
+    #                             weak below floor ** (1 / legs), where that is above roadmap_weak: legs that each lose
+    #                             a few per cent and together take the path under it (correct.py; the rescue's changes
+    #                             of method ours-corrector-redraw-rescue-floor)
     empty_retries: int = 0  # beyond the paper: an edge split whose reply gave no valid candidate is asked again
     #                         this many times at most, within the budget (method ours-corrector-retry)
     rescue: dict | None = None  # beyond the paper: where the correction leaves a leg that never succeeded on its
@@ -169,7 +173,10 @@ class SearchConfig:
             raise ValueError(f"roadmap_rings must be at least 1, got {self.roadmap_rings!r}")
         if self.roadmap_rings > 1 and not self.roadmap_probe:
             raise ValueError("roadmap_rings > 1 needs roadmap_probe > 0 (they are the probes' finer rings)")
-        for name in ("roadmap_sound", "roadmap_weak"):
+        if self.roadmap_floor and not self.roadmap_weak:
+            raise ValueError("roadmap_floor needs roadmap_weak > 0 (it raises the level below which mend's chain is "
+                             "offered)")
+        for name in ("roadmap_sound", "roadmap_weak", "roadmap_floor"):
             if not 0.0 <= getattr(self, name) <= 1.0:
                 raise ValueError(f"{name} must lie in [0, 1], got {getattr(self, name)!r}")
         if self.correct_rounds is not None and self.correct_rounds < 1:
@@ -647,7 +654,8 @@ class RefinementSearch:
                                       min_failures=min_failures, lean=self.cfg.correct_lean,
                                       first_win=self.cfg.correct_first_win, advance=self.cfg.correct_advance,
                                       roadmap=self._roadmap_chain if self.cfg.correct_roadmap else None,
-                                      roadmap_weak=self.cfg.roadmap_weak, guard=self.cfg.correct_guard,
+                                      roadmap_weak=self.cfg.roadmap_weak, floor=self.cfg.roadmap_floor,
+                                      guard=self.cfg.correct_guard,
                                       bridge=self.cfg.roadmap_bridge, backtrack=self.cfg.roadmap_backtrack,
                                       span=self.cfg.roadmap_span,
                                       reaim=self.evaluator.clearest if self.cfg.correct_reaim else None,

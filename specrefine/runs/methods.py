@@ -439,6 +439,13 @@ register_method("ours-corrector-redraw-rescue", ours_variant(**REDRAW | dict(res
                 "(the replies pooled with its own probes into a roadmap; up to 90 proposer splits in all): a proposer "
                 "that gives nothing valid, or never uses its feedback, leaves redraw at 0; a path redraw leaves "
                 "alive is never touched", colour="#d84315")
+#: ours-corrector-redraw-rescue-floor: the rescue, whose correction also mends live legs above mend's level while the
+#: path is below FLOOR (docs/corrector.md, "Weak legs judged by the path")
+FLOOR = dict(roadmap_floor=0.85)
+register_method("ours-corrector-redraw-rescue-floor", ours_variant(**REDRAW | dict(rescue=SPAN_BRIDGE | FLOOR)),
+                "beyond the paper: ours-corrector-redraw-rescue whose rescue, while the path's fresh check is below "
+                "0.85, also offers the roadmap's chain to a live leg below 0.85 ** (1 / legs), not only below 0.9: "
+                "thirteen legs at 0.92-0.98, each above mend's level, took an Ant path to 0.75", colour="#ffab40")
 #: ours-corrector-sparing: redraw, whose two passes ask the proposer only about a leg with at least 3 fresh failures
 #: (docs/corrector.md, "A gate for the Ant's corrector")
 SPARING = REDRAW | dict(correct_min_failures=3)
