@@ -564,6 +564,9 @@ BRIDGE_AGAIN_CODE = "aa6b52b"
 RESCUE_MAZES = ("u_chain_1", "u_chain_2", "u_chain_3")
 RESCUE_LONG_MAZES = ("u_chain_2_subgoals", "u_chain_3_subgoals", "u_chain_4", "u_chain_4_subgoals", "u_chain_5",
                      "u_chain_5_subgoals")
+#: issue 39: the rescue whose weak legs are judged by the path (docs/corrector.md, "Weak legs judged by the path"), on
+#: the rescue grid's judged cells; its rescue twins are read from ant_rescue.csv, not run again
+FLOOR_CODE = "bf93ae4"  # the commit of ours-corrector-redraw-rescue-floor (SearchConfig.roadmap_floor)
 
 ROADMAP_CODE = "90db56e"  # the commit of ours-corrector-roadmap's code (refine/roadmap.py)
 SOUND_CODE = "59178eb"  # the commit of ours-corrector-sound's code (Roadmap.sound)
@@ -1080,6 +1083,13 @@ GRIDS = {g.name: g for g in (
         seeds=(0,), mazes=RESCUE_MAZES, policy="data/policies/ant_stage5.pt", evaluation="adaptive",
         goal_points="centre", split_pick="confirmed", workers=1, code=RESCUE_CODE,
         table="data/results/corrector/ant_rescue.csv", out="runs/ant_corrector_rescue"),
+    ExperimentGrid(
+        "ant-corrector-floor", "docs/corrector.md, 'Weak legs judged by the path' (issue 39; fixed 2026-12-07 17:30 "
+        "UTC before its first cell ran; one rescue cell's steps log informed it): the rescue with the path's floor, "
+        "on the rescue grid's judged cells", "ant",
+        parts=(Part(("ours-corrector-redraw-rescue-floor",), (DEAF, "random")),), seeds=(0,), mazes=RESCUE_MAZES,
+        policy="data/policies/ant_stage5.pt", evaluation="adaptive", goal_points="centre", split_pick="confirmed",
+        workers=1, code=FLOOR_CODE, table="data/results/corrector/ant_floor.csv", out="runs/ant_corrector_floor"),
     ant_corrector_grid("ant-corrector-span", "docs/corrector.md, 'The point mass's corrector on the Ant' (issue 39; "
                        "fixed 2026-12-06 01:53 UTC before its first cell ran; one pilot cell informed it): "
                        "ant-corrector-redraw's cells with the point mass's default corrector, ours-corrector-span",
