@@ -8,14 +8,18 @@ from test_comparison import row, write_csv
 
 from specrefine.experiments import corrector_claims as cc
 from specrefine.experiments.corrector_claims.ant import ANT_ERRING
-from specrefine.experiments.corrector_claims.rescue import GRID as RESCUE_GRID
 from specrefine.experiments.corrector_claims.rescue import (
+    FLOOR,
+    FLOOR_PAIR,
     RESCUE,
-    rescue_markdown,
-    rescue_study,
-    rescue_text,
-    rescue_verdict,
+    RESCUE_PAIR,
+    pair_markdown,
+    pair_studies,
+    pair_study,
+    pair_text,
+    pair_verdict,
 )
+from specrefine.experiments.corrector_claims.rescue import GRID as RESCUE_GRID
 from specrefine.experiments.grids import GRIDS, OTHER_POINT_MAZES, SCALING_MAZES
 
 LEVELS = ("imperfect:mild", "imperfect:moderate")
@@ -998,10 +1002,11 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
     assert lines[0].startswith(f"| rule ({cc.LEAN} unless named) |") and lines[1] == "|---|---|---|"
     rules = [line.split(" | ")[0].removeprefix("| ") for line in lines[2:]]
     # + the two held-out mixes + the Ant's rules: its floor, 2x the one-shot, its cost, its two candidates, each
-    # successor and the rescue
-    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5 + len(cc.ANT_SUCCESSORS) + 1
-    assert rules[-1].startswith(f"Ant, deaf proposers: {RESCUE} in place of {cc.REDRAW}")
-    rules = rules[:-1]
+    # successor, the rescue and its floor
+    assert len(rules) == len(cc.variant_verdicts(vs)) + 2 + 5 + len(cc.ANT_SUCCESSORS) + 2
+    assert rules[-2].startswith(f"Ant, deaf proposers: {RESCUE} in place of {cc.REDRAW}")
+    assert rules[-1].startswith(f"Ant, deaf proposers: {FLOOR} in place of {RESCUE}")
+    rules = rules[:-2]
     assert rules[0] == "imperfect:mild: within 0.05 of the oracle on every U-chain"
     assert [r for r in rules if r.startswith("held out")][0].startswith("held out, mix A (6 layouts")
     ant = rules[-5 - len(cc.ANT_SUCCESSORS):]
@@ -1017,22 +1022,46 @@ def test_the_front_pages_table_holds_the_reported_variants_rules_its_held_out_ce
 
 def test_the_rescue_is_adopted_only_over_all_six_cells_above_redraw_and_none_below(tmp_path):
     lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.95 if m == RESCUE else 0.0, drop=1)
-    partial = rescue_study(tmp_path)
+    partial = pair_study(RESCUE_PAIR, tmp_path)
     assert partial["verdict"] == "undecided" and partial["pooled"]["cells"] == 5
-    assert rescue_verdict(partial)["verdict"] == "undecided (5 of 6 cells)"
+    assert pair_verdict(RESCUE_PAIR, partial)["verdict"] == "undecided (5 of 6 cells)"
     lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.95 if m == RESCUE else 0.0)
     lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: 0.5, part=1)  # described: never read by the rule
-    d = rescue_study(tmp_path)
+    d = pair_study(RESCUE_PAIR, tmp_path)
     assert d["verdict"] == "adopted" and d["pooled"]["difference"] == pytest.approx(0.95)
     assert [c["judged"] for c in d["cells"]] == [True] * 6 + [False] * 12
-    text = rescue_text(d)
+    text = pair_text(RESCUE_PAIR, d)
     assert text.startswith("6 of 6 cells of the rule: rescue 0.950-0.950 per cell, redraw 0.000-0.000")
     assert "runs at 0: rescue 0, redraw 6" in text and "**adopted**" in text and "12 of 12 cells" in text
     lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: (0.9 if maze == "u_chain_3" else 1.0) if m == RESCUE else
              (1.0 if maze == "u_chain_3" else 0.0))
-    d = rescue_study(tmp_path)  # above redraw pooled, but below it on U-chain 3's two cells
+    d = pair_study(RESCUE_PAIR, tmp_path)  # above redraw pooled, but below it on U-chain 3's two cells
     assert d["pooled"]["ci"][0] > 0 and d["below"] == 2 and d["verdict"] == "not adopted"
-    assert "| u_chain_3 | deaf | 0 | yes | 0.900" in "\n".join(rescue_markdown(d))
+    assert "| u_chain_3 | deaf | 0 | yes | 0.900" in "\n".join(pair_markdown(RESCUE_PAIR, d))
+
+
+def test_the_floor_is_judged_against_the_rescues_own_runs_and_only_once_the_rescue_is_adopted(tmp_path):
+    assert pair_studies(tmp_path) == {"ant-rescue": None, "ant-floor": None}
+    lay_grid(tmp_path, FLOOR_PAIR.grid, lambda maze, m, p: 0.95)
+    assert pair_study(FLOOR_PAIR, tmp_path)["verdict"] == "undecided"  # no rescue run to pair with yet
+    rescue_rate = lambda maze, m, p: (0.75 if maze == "u_chain_2" else 0.95) if m == RESCUE else 0.0
+    lay_grid(tmp_path, RESCUE_GRID, rescue_rate, drop=1)  # the rescue's rule undecided (5 of 6)
+    studies = pair_studies(tmp_path)
+    floor = studies["ant-floor"]
+    assert floor["pooled"]["cells"] == 6 and floor["pooled"]["difference"] == pytest.approx(0.4 / 6)
+    assert floor["verdict"] == "undecided" and studies["ant-rescue"]["verdict"] == "undecided"
+    lay_grid(tmp_path, RESCUE_GRID, rescue_rate)
+    floor = pair_studies(tmp_path)["ant-floor"]
+    assert floor["verdict"] == "adopted" and floor["below"] == 0  # the two U-chain 2 cells carry it
+    text = pair_text(FLOOR_PAIR, floor)
+    assert text.startswith("6 of 6 cells of the rule: floor 0.950-0.950 per cell, rescue 0.750-0.950")
+    assert pair_verdict(FLOOR_PAIR, floor)["rule"].startswith(f"Ant, deaf proposers: {FLOOR} in place of {RESCUE}, "
+                                                              "once rescue is adopted")
+    lay_grid(tmp_path, RESCUE_GRID, lambda maze, m, p: rescue_rate(maze, m, p) if m == RESCUE else 1.0)
+    studies = pair_studies(tmp_path)  # the rescue below redraw: the floor's rule has nothing to replace
+    assert studies["ant-rescue"]["verdict"] == "not adopted" and studies["ant-floor"]["verdict"] == "moot"
+    assert "**moot (rescue not adopted)**" in pair_text(FLOOR_PAIR, studies["ant-floor"])
+    assert "| u_chain_2 | random | 0 | yes | 0.950" in "\n".join(pair_markdown(FLOOR_PAIR, studies["ant-floor"]))
 
 
 def test_corrector_claims_refuses_a_file_to_fill_that_is_missing_or_a_link_before_any_work(tmp_path, capsys):

@@ -17,7 +17,7 @@ from .frontpage import fill, front
 from .glance import glance_figure, glance_panels
 from .point import held_out_study, levers_study, point_study
 from .report import markdown
-from .rescue import rescue_markdown, rescue_study, rescue_verdict
+from .rescue import PAIRS, pair_markdown, pair_studies, pair_verdict
 from .rules import variant_verdicts, verdicts
 from .statements import statement_markdown, statement_studies
 from .variants import variant_studies
@@ -43,20 +43,21 @@ def run(args, p) -> int:
     levers = levers_study()
     variants = variant_studies()
     fresh, defaults, gr, anyone = ant_fresh_study(), default_studies(), gr_study(), any_study()
-    statements, rescue = statement_studies(), rescue_study()
+    statements, pairs = statement_studies(), pair_studies()
     record = {"point": point, "held_out": held_out, "ant": ant, "levers": levers, "ant_fresh": fresh, **variants,
               "point_default": defaults, "point_default_gr": gr, "any_proposer": anyone, "statements": statements,
               "rules": verdicts(point, ant) + [v for vs in variants.values() if vs for v in variant_verdicts(vs)]
-              + [default_verdict(d) for d in defaults] + [rescue_verdict(rescue)], "ant_rescue": rescue,
+              + [default_verdict(d) for d in defaults] + [pair_verdict(p, pairs[p.marker]) for p in PAIRS],
+              **{p.marker.replace("-", "_"): pairs[p.marker] for p in PAIRS},
               "front": front(point, held_out, levers=levers, ant=ant, fresh=fresh, defaults=defaults, gr=gr,
-                             anyone=anyone, statements=statements, rescue=rescue, **variants)}
+                             anyone=anyone, statements=statements, pairs=pairs, **variants)}
     with locked(ensure_dir(args.out)):
         tail = "\n".join(ant_fresh.markdown(fresh)) + "\n" if fresh else ""
         tail += "".join("\n".join(default_markdown(d)) + "\n" for d in defaults)
         tail += "\n".join(gr_markdown(gr)) + "\n" if gr else ""
         tail += "\n".join(any_markdown(anyone)) + "\n" if anyone else ""
         tail += "".join("\n".join(statement_markdown(d)) + "\n" for d in statements.values() if d)
-        tail += "\n".join(rescue_markdown(rescue)) + "\n" if rescue else ""
+        tail += "".join("\n".join(pair_markdown(p, pairs[p.marker])) + "\n" for p in PAIRS if pairs[p.marker])
         write_atomic(args.out / "claims.md", markdown(point, ant, held_out, levers, **variants) + tail)
         write_atomic(args.out / "claims.json", json.dumps(record, indent=1, default=float) + "\n")
         save_figure(rooms_figure(point), args.out / "rooms.png", dpi=110)

@@ -34,8 +34,7 @@ from .common import (
 from .default import DEFAULTS, default_marker, default_studies, default_text, default_verdict, gr_study, gr_text
 from .formats import _ant_against, _cost_pair, _cost_text, _num, _paired_text, _partial, _signed
 from .layouts import FRESH_GRIDS, INFORMED_PARTS, NEW_GRIDS, NEW_STUDIES, unseen
-from .rescue import GRID as RESCUE_GRID
-from .rescue import rescue_study, rescue_text, rescue_verdict
+from .rescue import PAIRS, pair_studies, pair_text, pair_verdict
 from .rules import (
     _adoption_rows,
     _cost_verdict,
@@ -71,10 +70,10 @@ def fill(path: Path, texts: dict[str, str]) -> None:
 
 
 def rules_table(variant: dict | None, point: dict, ant: dict | None, defaults: list[dict] = (),
-                rescue: dict | None = None) -> str:
+                pairs: dict | None = None) -> str:
     """Issue 39's rules for the reported variant, the held-out cells it is described on, the point mass's default
-    methods (``default_studies``) and the Ant's rules (the rescue's last), as one markdown table (README's front
-    page)."""
+    methods (``default_studies``) and the Ant's rules (the paired studies' last, ``pair_studies``), as one markdown
+    table (README's front page)."""
     if not variant:
         return "not run yet"
     method = variant["method"]
@@ -83,7 +82,8 @@ def rules_table(variant: dict | None, point: dict, ant: dict | None, defaults: l
     order += [v for v in rows if "cost at most" in v["rule"]] + [v for v in rows if v["rule"].startswith(method)]
     order += [row for mix in MIX_NAMES.values() if (row := _held_out_row(variant, mix))]
     order += [default_verdict(d) for d in defaults]
-    order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")] + [rescue_verdict(rescue)]
+    order += [v for v in verdicts(point, ant) if v["rule"].startswith("Ant")]
+    order += [pair_verdict(pair, (pairs or {}).get(pair.marker)) for pair in PAIRS]
     table = [f"| rule ({method} unless named) | estimate [95 % CI] | verdict |", "|---|---|---|"]
     table += [f"| {v['rule']} | {v['value']} | {v['verdict']} |" for v in order]
     return "\n" + "\n".join(table) + "\n\n"  # the markers on lines of their own, around the table
@@ -116,7 +116,7 @@ def progress(name: str, root: Path = ROOT) -> tuple[int, int]:
 def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | None = None,
           ant: dict | None = None, fresh: dict | None = None, defaults: list[dict] | None = None,
           gr: dict | None = None, anyone: dict | None = None, statements: dict | None = None,
-          rescue: dict | None = None, **variants: dict | None) -> dict[str, str]:
+          pairs: dict | None = None, **variants: dict | None) -> dict[str, str]:
     """README's sentences, by marker name (``<!-- front corrector NAME -->``), from the studies (``variants`` by
     their ``VARIANTS`` name; ``fresh``: ``ant_fresh_study``'s; ``defaults`` and ``gr``: ``default_studies``'s and
     ``gr_study``'s, ``anyone`` ``any_study``'s, ``statements`` ``statement_studies``'s, computed here when not
@@ -124,7 +124,8 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     _known(variants)
     grids = ("corrector", "taxonomy", "corrector-held-out", ANT_FIRST, "corrector-levers",
              *(VARIANT_GRIDS[m] for m in VARIANTS.values()), *VARIANT_SUITE.values(), *FRESH_GRIDS, *NEW_GRIDS,
-             *(st.grid for st in STATEMENTS), ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES, *ANT_SUCCESSORS, RESCUE_GRID)
+             *(st.grid for st in STATEMENTS), ANT_BEFORE, ANT_GRID, *ANT_CANDIDATES, *ANT_SUCCESSORS,
+             *(pair.grid for pair in PAIRS))
     counts = {name: progress(name, root) for name in grids}
     out = {"status": "cells done: " + ", ".join(f"{name} {d} of {t}" for name, (d, t) in counts.items())
                      + ("" if all(d == t for d, t in counts.values()) else "; the grids resume next session")}
@@ -174,9 +175,10 @@ def front(point: dict, held_out: dict | None, root: Path = ROOT, levers: dict | 
     out["ant-forecast"] = forecast_text(ant) if ant else "not run yet"
     out["unseen"] = unseen_text(unseen(root))
     defaults = default_studies(root) if defaults is None else defaults
-    rescue = rescue_study(root) if rescue is None else rescue
-    out["table"] = rules_table(variants.get(reported(variants)), point, ant, defaults, rescue)
-    out["ant-rescue"] = rescue_text(rescue)
+    pairs = pair_studies(root) if pairs is None else pairs
+    out["table"] = rules_table(variants.get(reported(variants)), point, ant, defaults, pairs)
+    for pair in PAIRS:
+        out[pair.marker] = pair_text(pair, pairs[pair.marker])
     for _, method in DEFAULTS:
         out[default_marker(method)] = default_text(next((d for d in defaults if d["method"] == method), None))
     out["point-default-gr"] = gr_text(gr_study(root) if gr is None else gr)
