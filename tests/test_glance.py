@@ -30,7 +30,7 @@ def test_each_curve_counts_the_episodes_of_its_tables_runs(tmp_path):
     assert panels[2]["floor"] == 0.85 and panels[0]["floor"] is None
     labels = legend_labels(panels)
     assert labels["corrector"] == ("point mass: ours-corrector-span-bridge (default); "
-                                   "Ant: ours-corrector-redraw (default)")
+                                   "Ant: ours-corrector-redraw (the default's run: its rescue never fires here)")
     assert labels["span"].startswith("Ant: ours-corrector-span") and labels["ours"] == "ours (the paper's search)"
     # the Ant's oracle at its correctors' settings (a confirmed pick), every cell run
     assert labels["oracle"] == ("point mass: oracle (ours, geometric planner); "

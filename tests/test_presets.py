@@ -30,7 +30,7 @@ def test_the_defaults_are_the_best_measured_and_paper_restores_the_papers_rules(
     best, paper = resolved("--agent", "ant"), resolved("--agent", "ant", "--preset", "paper")
     assert (best.evaluation, best.goal_points, best.policy) == ("adaptive", "centre", "ant_stage5")
     assert (paper.evaluation, paper.goal_points, paper.policy) == ("fixed", "sampled", "ant_stage5")
-    assert (best.method, paper.method) == ("ours-corrector-redraw", "ours")  # the paper's algorithm under paper
+    assert (best.method, paper.method) == ("ours-corrector-redraw-rescue", "ours")  # the paper's algorithm under paper
     assert (best.w, best.d, best.k, best.rollouts) == (paper.w, paper.d, paper.k, paper.rollouts) == (3, 2, 5, 32)
     point, point_paper = resolved(), resolved("--preset", "paper")
     # the point mass: the same settings but the goal points (centre since grid corrector-centre) and the method (the

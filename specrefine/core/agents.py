@@ -98,8 +98,9 @@ AGENTS: dict[str, Agent] = {
         # A confirmed split pick passed lever 5's rule on the oracle grid (docs/ant_experiments.md, "lever 5").
         default_evaluation="adaptive", default_goal_points="centre", default_policy="ant_stage5",
         # The corrector with the oracle passed lever 7's grid on the nine U-chains (docs/ant_experiments.md, "Issue 42,
-        # lever 7 on every U-chain").
-        default_split_pick="confirmed", default_method="ours-corrector-redraw"),
+        # lever 7 on every U-chain"); its rescue for deaf proposers passed its rule (docs/corrector.md, "A rescue for
+        # the Ant's default"), and is the corrector step for step wherever the rescue does not fire.
+        default_split_pick="confirmed", default_method="ours-corrector-redraw-rescue"),
 }
 
 
