@@ -65,7 +65,7 @@ mended on the roadmap").
 
 ``floor`` (``SearchConfig.roadmap_floor``; the rescue's changes of method ``ours-corrector-redraw-rescue-floor``): while
 the path's fresh check is below ``floor``, a live leg is weak below ``floor ** (1 / legs)`` too, where that is above
-``roadmap_weak``: on the Ant, thirteen legs at 0.92-0.98, each above mend's level, took a path to 0.75, and a deaf
+``roadmap_weak``: on the Ant, thirteen legs at 0.92-1.00, each above mend's level, took a path to 0.75, and a deaf
 proposer's splits could not mend them (docs/corrector.md, "Weak legs judged by the path"). The chain's own legs are
 held to the same level (else the weak leg itself would count as reaching its end); it is judged as any alternative.
 

@@ -445,7 +445,7 @@ FLOOR = dict(roadmap_floor=0.85)
 register_method("ours-corrector-redraw-rescue-floor", ours_variant(**REDRAW | dict(rescue=SPAN_BRIDGE | FLOOR)),
                 "beyond the paper: ours-corrector-redraw-rescue whose rescue, while the path's fresh check is below "
                 "0.85, also offers the roadmap's chain to a live leg below 0.85 ** (1 / legs), not only below 0.9: "
-                "thirteen legs at 0.92-0.98, each above mend's level, took an Ant path to 0.75", colour="#ffab40")
+                "thirteen legs at 0.92-1.00, each above mend's level, took an Ant path to 0.75", colour="#ffab40")
 #: ours-corrector-sparing: redraw, whose two passes ask the proposer only about a leg with at least 3 fresh failures
 #: (docs/corrector.md, "A gate for the Ant's corrector")
 SPARING = REDRAW | dict(correct_min_failures=3)
