@@ -942,8 +942,11 @@ def test_a_leg_above_mends_level_is_mended_where_the_path_is_below_the_floor(flo
         assert xs(result) == [0.0, 3.0, 5.0, 6.0, 10.0] and check_refines(result.graph, g) == []
         others = [s for s in result.steps if s["event"] == "roadmap" and s["edge"] != ["x0", "x1"]]
         assert others == []
+        assert leg["weak_below"] == pytest.approx(0.85 ** (1 / 3))  # the steps log shows the raised level
+        assert "(weak below 0.947: the path is below its floor)" in describe(leg)
     else:
         assert "roadmap" not in kinds and leg["accepted"] is None and xs(result) == [0.0, 3.0, 6.0, 10.0]
+        assert "weak_below" not in leg and "floor" not in describe(leg)
 
 
 def test_the_floors_share_is_the_weak_level_only_while_the_path_is_below_it():

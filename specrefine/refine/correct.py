@@ -262,8 +262,9 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
     tried: set = set()
     while (leg := weakest_untried(state.check, tried, dead_only=advance and state.check.p <= 0.0)) is not None:
         tried.add(_leg_key(state.check, leg))
+        weak = weak_below(state.check, roadmap_weak, floor)
         groups = _alternatives(state, leg, evaluator, split_leg, may_split, reach, clearance, min_failures, roadmap,
-                               reaim, weak_below(state.check, roadmap_weak, floor), bridge, backtrack, span)
+                               reaim, weak, bridge, backtrack, span)
         if not first_win:
             groups = iter([[option for group in groups for option in group]])
         check, path, seen, accepted = state.check, state.path, [], None
@@ -273,7 +274,7 @@ def correct(graph: TaskGraph, path: list[str], evaluator: SubtaskEvaluator, *, r
             if accepted is not None:
                 break
         log("correct-leg", leg=leg, edge=path[leg:leg + 2], p_leg=check.probabilities[leg], p_window=judged.current,
-            tried=seen, accepted=accepted)
+            tried=seen, accepted=accepted, **({"weak_below": weak} if weak != roadmap_weak else {}))
     if lean:
         _prune(state, reach, clearance, log)
     log("correct-done", path=state.path, p=state.check.p, probabilities=state.check.probabilities,

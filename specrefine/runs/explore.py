@@ -23,7 +23,7 @@ EVENT_TEXT = {
     "split-repaired": "repair the split of {edge[0]} -> {edge[1]}: {legs_repaired} leg(s) split again",
     "correct-check": "check the path on fresh rollouts{pass_text}: p = {p:.3f} over {n_legs} legs",
     "correct-leg": "correct leg {leg} ({edge[0]} -> {edge[1]}, fresh p {p_leg:.3f}, window {p_window:.3f}): "
-                   "tried {tried_text}; accepted {accepted_text}",
+                   "tried {tried_text}; accepted {accepted_text}{floor_text}",
     "correct-done": "correction done{pass_text}: p = {p:.3f} over {n_legs} legs (on the rollouts that chose them)",
     "rescue": "rescue: {reason}; the path corrected once more, {n_changes} settings changed",
     "roadmap": "roadmap for {edge[0]} -> {edge[1]} over {pooled} pooled waypoints: a chain of {waypoints}, "
@@ -58,6 +58,8 @@ def describe(step: dict) -> str:
         detail["tried_text"] = ", ".join(f"{t['kind']} {t['p_window']:.3f}" + _nearer(t) for t in detail["tried"]) \
             or "nothing"
         detail["accepted_text"] = detail.get("accepted") or "none"
+        detail["floor_text"] = (f" (weak below {detail['weak_below']:.3f}: the path is below its floor)"
+                                if "weak_below" in detail else "")
     try:
         return f"step {step['step']}: " + EVENT_TEXT[step["event"]].format(**detail)
     except (KeyError, IndexError, TypeError, ValueError):
